@@ -1,0 +1,42 @@
+// Final display encode: samples the scene's output (linear, possibly HDR) and writes
+// sRGB-encoded, clamped values into an 8-bit target that is *not* an sRGB format, so the
+// window surface (egui wants Bgra8Unorm) and off-screen PNGs get identical bytes.
+
+@group(0) @binding(0) var source: texture_2d<f32>;
+
+struct VertexOut {
+    @builtin(position) position: vec4<f32>,
+};
+
+// One triangle that covers the target; no vertex buffer.
+@vertex
+fn vs_main(@builtin(vertex_index) index: u32) -> VertexOut {
+    let uv = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
+    var out: VertexOut;
+    out.position = vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+    return out;
+}
+
+fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
+    let x = clamp(c, vec3<f32>(0.0), vec3<f32>(1.0));
+    let low = x * 12.92;
+    let high = 1.055 * pow(x, vec3<f32>(1.0 / 2.4)) - 0.055;
+    return select(high, low, x <= vec3<f32>(0.0031308));
+}
+
+// One invocation per target pixel; the source is read texel-exact when sizes match, and
+// nearest-scaled otherwise (the window may differ from the render size).
+@fragment
+fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    let src_size = vec2<f32>(textureDimensions(source));
+    let dst_size = vec2<f32>(f32(display.width), f32(display.height));
+    let texel = vec2<i32>(floor(in.position.xy * src_size / dst_size));
+    let c = textureLoad(source, texel, 0);
+    return vec4<f32>(linear_to_srgb(c.rgb), 1.0);
+}
+
+struct Display {
+    width: u32,
+    height: u32,
+};
+@group(0) @binding(1) var<uniform> display: Display;

@@ -1,0 +1,353 @@
+//! The winit application: window and surface lifetime, input, and the per-frame loop.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use winit::application::ApplicationHandler;
+use winit::event::{ElementState, KeyEvent, WindowEvent};
+use winit::event_loop::ActiveEventLoop;
+use winit::keyboard::{Key, NamedKey};
+use winit::window::{Fullscreen, Window, WindowId};
+
+use super::WindowOptions;
+use super::panel::{Overlay, draw_ui};
+use crate::assets::Assets;
+use crate::gpu::{Blit, Gpu, GpuOptions};
+use crate::graph::GraphRuntime;
+use crate::scene::{Scene, SceneInstance};
+use crate::time::FixedClock;
+
+/// Everything that exists once the window does.
+struct Running {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    gpu: Gpu,
+    instance: SceneInstance,
+    runtime: GraphRuntime,
+    blit: Blit,
+    clock: FixedClock,
+    last: Instant,
+    egui_state: egui_winit::State,
+    egui_renderer: egui_wgpu::Renderer,
+    overlay: Overlay,
+}
+
+/// The winit handler; creates the window on `resumed`, as winit 0.30 asks.
+pub struct WindowApp {
+    assets: Assets,
+    gpu_options: GpuOptions,
+    scene: Option<Scene>,
+    options: WindowOptions,
+    running: Option<Running>,
+    failure: Option<String>,
+}
+
+impl WindowApp {
+    /// A handler that will show `scene`.
+    pub fn new(
+        assets: Assets,
+        gpu_options: GpuOptions,
+        scene: Scene,
+        options: WindowOptions,
+    ) -> Self {
+        Self {
+            assets,
+            gpu_options,
+            scene: Some(scene),
+            options,
+            running: None,
+            failure: None,
+        }
+    }
+
+    /// Ok when the window was closed normally, or why it could not run.
+    pub fn into_result(self) -> Result<(), String> {
+        self.failure.map_or(Ok(()), Err)
+    }
+
+    fn start(&mut self, event_loop: &ActiveEventLoop) -> Result<Running, String> {
+        let scene = self.scene.take().ok_or("the window was already started")?;
+        let attributes = Window::default_attributes()
+            .with_title(format!("indra — {}", scene.name))
+            .with_inner_size(winit::dpi::PhysicalSize::new(scene.size.0, scene.size.1));
+        let window = Arc::new(
+            event_loop
+                .create_window(attributes)
+                .map_err(|e| format!("cannot create a window: {e}"))?,
+        );
+        if self.options.fullscreen {
+            window.set_fullscreen(Some(fullscreen_on(
+                event_loop,
+                &window,
+                self.options.monitor,
+            )));
+        }
+        let mut desc = crate::gpu::instance_descriptor(self.gpu_options.backend);
+        desc.display = Some(Box::new(event_loop.owned_display_handle()));
+        let wgpu_instance = wgpu::Instance::new(desc);
+        let surface = wgpu_instance
+            .create_surface(window.clone())
+            .map_err(|e| format!("cannot draw into the window: {e}"))?;
+        let gpu = pollster::block_on(Gpu::with_instance(
+            wgpu_instance,
+            &self.gpu_options,
+            Some(&surface),
+        ))
+        .map_err(|e| e.to_string())?;
+        let caps = surface.get_capabilities(&gpu.adapter);
+        // egui and our display encode both write sRGB bytes themselves: use a non-sRGB format.
+        let format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(|f| !f.is_srgb())
+            .unwrap_or(caps.formats[0]);
+        let size = window.inner_size();
+        let config = wgpu::SurfaceConfiguration {
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            format,
+            color_space: wgpu::SurfaceColorSpace::Auto,
+            width: size.width.max(1),
+            height: size.height.max(1),
+            present_mode: wgpu::PresentMode::AutoVsync,
+            desired_maximum_frame_latency: 2,
+            alpha_mode: caps.alpha_modes[0],
+            view_formats: vec![],
+        };
+        surface.configure(&gpu.device, &config);
+        log::info!(
+            "window {}x{} on {}",
+            config.width,
+            config.height,
+            gpu.adapter_label()
+        );
+        for (i, m) in event_loop.available_monitors().enumerate() {
+            log::info!("monitor {i}: {}", m.name().unwrap_or_default());
+        }
+        let clock = FixedClock::new(scene.dt, scene.seed);
+        let instance = SceneInstance::new(&gpu, &self.assets, scene, (config.width, config.height))
+            .map_err(|e| format!("the scene's shaders do not compile: {e}"))?;
+        let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
+        let blit = Blit::new(&gpu.device);
+        let egui_ctx = egui::Context::default();
+        let max_side = gpu.device.limits().max_texture_dimension_2d as usize;
+        let egui_state = egui_winit::State::new(
+            egui_ctx,
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(max_side),
+        );
+        let egui_renderer =
+            egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
+        Ok(Running {
+            window,
+            surface,
+            config,
+            gpu,
+            instance,
+            runtime,
+            blit,
+            clock,
+            last: Instant::now(),
+            egui_state,
+            egui_renderer,
+            overlay: Overlay::default(),
+        })
+    }
+}
+
+fn fullscreen_on(
+    event_loop: &ActiveEventLoop,
+    window: &Window,
+    monitor: Option<usize>,
+) -> Fullscreen {
+    let chosen = monitor.and_then(|i| event_loop.available_monitors().nth(i));
+    if monitor.is_some() && chosen.is_none() {
+        log::warn!(
+            "no monitor {}; using the window's own",
+            monitor.unwrap_or_default()
+        );
+    }
+    Fullscreen::Borderless(chosen.or_else(|| window.current_monitor()))
+}
+
+impl ApplicationHandler for WindowApp {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.running.is_some() {
+            return;
+        }
+        match self.start(event_loop) {
+            Ok(running) => {
+                running.window.request_redraw();
+                self.running = Some(running);
+            }
+            Err(e) => {
+                self.failure = Some(e);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let Some(r) = self.running.as_mut() else {
+            return;
+        };
+        let consumed = r.egui_state.on_window_event(&r.window, &event).consumed;
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => {
+                r.config.width = size.width.max(1);
+                r.config.height = size.height.max(1);
+                r.surface.configure(&r.gpu.device, &r.config);
+            }
+            WindowEvent::KeyboardInput {
+                event:
+                    KeyEvent {
+                        logical_key,
+                        state: ElementState::Pressed,
+                        repeat: false,
+                        ..
+                    },
+                ..
+            } if !consumed => {
+                match logical_key {
+                    Key::Named(NamedKey::F11) => {
+                        let next = match r.window.fullscreen() {
+                            Some(_) => None,
+                            None => {
+                                Some(fullscreen_on(event_loop, &r.window, self.options.monitor))
+                            }
+                        };
+                        r.window.set_fullscreen(next);
+                    }
+                    // Esc leaves fullscreen and nothing else: a stray key must not end a show.
+                    Key::Named(NamedKey::Escape) => r.window.set_fullscreen(None),
+                    Key::Named(NamedKey::Tab) => r.overlay.panel_visible = !r.overlay.panel_visible,
+                    _ => {}
+                }
+            }
+            WindowEvent::RedrawRequested => {
+                r.frame();
+                r.window.request_redraw();
+            }
+            _ => {}
+        }
+    }
+}
+
+impl Running {
+    /// Steps the clock by real time, renders the scene and the overlay, presents.
+    fn frame(&mut self) {
+        let now = Instant::now();
+        let steps = self.clock.accumulate((now - self.last).as_secs_f64());
+        self.last = now;
+        for _ in 0..steps {
+            self.instance.step(&self.clock.now());
+            self.clock.step();
+        }
+        let frame = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(f)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(&self.gpu.device, &self.config);
+                return;
+            }
+            other => {
+                log::debug!("no surface texture this frame: {other:?}");
+                return;
+            }
+        };
+        let target = frame.texture.create_view(&Default::default());
+        let size = (self.config.width, self.config.height);
+        let mut encoder = self
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("window_frame"),
+            });
+        let time = self.clock.now();
+        match self
+            .instance
+            .encode(&self.gpu, &mut self.runtime, &mut encoder, size, &time)
+        {
+            Ok(output) => {
+                self.blit.record(
+                    &self.gpu.device,
+                    &self.gpu.queue,
+                    &mut encoder,
+                    &output.view,
+                    &target,
+                    self.config.format,
+                    size,
+                );
+                self.overlay.stats = Some(output.stats);
+            }
+            Err(e) => self.overlay.report(format!("frame graph: {e}")),
+        }
+        for e in self.gpu.take_uncaptured_errors() {
+            self.overlay.report(format!("GPU: {e}"));
+        }
+        self.overlay.timings = self.runtime.timings();
+        let extra = self.draw_overlay(&mut encoder, &target, size);
+        self.gpu
+            .queue
+            .submit(extra.into_iter().chain([encoder.finish()]));
+        self.runtime.after_submit();
+        self.window.pre_present_notify();
+        self.gpu.queue.present(frame);
+    }
+
+    /// Runs the egui frame and records its draw on top of the scene.
+    fn draw_overlay(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        size: (u32, u32),
+    ) -> Vec<wgpu::CommandBuffer> {
+        let input = self.egui_state.take_egui_input(&self.window);
+        let ctx = self.egui_state.egui_ctx().clone();
+        let (instance, overlay, clock) = (&mut self.instance, &mut self.overlay, &self.clock);
+        let output = ctx.run_ui(input, |ui| draw_ui(ui, instance, overlay, clock.now()));
+        self.egui_state
+            .handle_platform_output(&self.window, output.platform_output);
+        let primitives = ctx.tessellate(output.shapes, output.pixels_per_point);
+        let (device, queue) = (&self.gpu.device, &self.gpu.queue);
+        for (id, deltas) in &output.textures_delta.set {
+            for delta in deltas {
+                self.egui_renderer.update_texture(device, queue, *id, delta);
+            }
+        }
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [size.0, size.1],
+            pixels_per_point: output.pixels_per_point,
+        };
+        let extra = self
+            .egui_renderer
+            .update_buffers(device, queue, encoder, &primitives, &screen);
+        {
+            let mut pass = encoder
+                .begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("egui_pass"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: target,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Load,
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    ..Default::default()
+                })
+                .forget_lifetime();
+            self.egui_renderer.render(&mut pass, &primitives, &screen);
+        }
+        for id in &output.textures_delta.free {
+            self.egui_renderer.free_texture(id);
+        }
+        extra
+    }
+}

@@ -1,0 +1,323 @@
+//! What each CLI command does, on top of the library. Every failure is one sentence for the
+//! user; nothing here panics on bad input.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use indra::assets::{AssetKind, Assets};
+use indra::gpu::{Gpu, GpuOptions, validate_wgsl};
+use indra::offscreen::{OffscreenRenderer, write_png};
+use indra::scene::{Scene, load_scene};
+
+/// The scene `indra` opens with no arguments.
+pub const DEFAULT_SCENE: &str = "kleinian";
+
+/// `indra run`.
+#[derive(Args, Clone, Default)]
+pub struct RunArgs {
+    /// Scene name (from scenes/) or path to a .ron file.
+    #[arg(default_value = DEFAULT_SCENE)]
+    pub scene: String,
+    /// Start in borderless fullscreen (F11 toggles, Esc leaves fullscreen).
+    #[arg(long)]
+    pub fullscreen: bool,
+    /// Monitor index for fullscreen (see the log for the list).
+    #[arg(long)]
+    pub monitor: Option<usize>,
+    /// Set a parameter at start: node.param=value (repeatable).
+    #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
+    pub sets: Vec<String>,
+}
+
+/// `indra render`.
+#[derive(Args, Clone)]
+pub struct RenderArgs {
+    /// Scene name (from scenes/) or path to a .ron file.
+    pub scene: String,
+    /// Number of frames to render.
+    #[arg(long, default_value_t = 1)]
+    pub frames: u64,
+    /// First frame index (time = frame × dt).
+    #[arg(long, default_value_t = 0)]
+    pub start: u64,
+    /// Output size WxH (default: the scene's).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Fixed time step in seconds (default: the scene's).
+    #[arg(long)]
+    pub dt: Option<f32>,
+    /// Seed (default: the scene's).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Output folder; frames are written as <scene>_<frame>.png.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    /// Set a parameter: node.param=value (repeatable).
+    #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
+    pub sets: Vec<String>,
+}
+
+/// `indra bench`.
+#[derive(Args, Clone)]
+pub struct BenchArgs {
+    /// Scene name (from scenes/) or path to a .ron file.
+    pub scene: String,
+    /// Output size WxH.
+    #[arg(long, value_parser = parse_size, default_value = "1920x1080")]
+    pub size: (u32, u32),
+    /// Frames to measure (after warm-up).
+    #[arg(long, default_value_t = 100)]
+    pub frames: u64,
+    /// Frames rendered before measuring.
+    #[arg(long, default_value_t = 10)]
+    pub warmup: u64,
+    /// Set a parameter: node.param=value (repeatable).
+    #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
+    pub sets: Vec<String>,
+    /// Hold tracks still (measure one parameter set, not an animation).
+    #[arg(long)]
+    pub no_animation: bool,
+}
+
+fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("'{text}' is not WxH (e.g. 1920x1080)"))?;
+    let parse = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|v| (1..=16384).contains(v))
+    };
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(format!("'{text}' is not WxH with sides from 1 to 16384")),
+    }
+}
+
+/// Loads a scene and applies `--set` assignments.
+fn scene_with_sets(assets: &Assets, name: &str, sets: &[String]) -> Result<Scene, String> {
+    let mut scene = load_scene(assets, name).map_err(|e| e.to_string())?;
+    for assignment in sets {
+        scene.set_from_str(assignment)?;
+    }
+    Ok(scene)
+}
+
+/// Opens the scene in a window.
+pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), String> {
+    let scene = scene_with_sets(assets, &args.scene, &args.sets)?;
+    let options = indra::app::WindowOptions {
+        fullscreen: args.fullscreen,
+        monitor: args.monitor,
+    };
+    indra::app::run(assets.clone(), gpu.clone(), scene, options)
+}
+
+/// Renders a PNG sequence.
+pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<(), String> {
+    let scene = scene_with_sets(assets, &args.scene, &args.sets)?;
+    let stem = Path::new(&args.scene)
+        .file_stem()
+        .map_or("frame".into(), |s| s.to_string_lossy().into_owned());
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
+    eprintln!("rendering '{}' on {}", scene.name, device.adapter_label());
+    let mut renderer = OffscreenRenderer::new(device, assets, scene, args.size, args.dt, args.seed)
+        .map_err(|e| e.to_string())?;
+    renderer.seek(args.start);
+    let bar = indicatif::ProgressBar::new(args.frames);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}",
+        )
+        .expect("valid template"),
+    );
+    for _ in 0..args.frames {
+        let frame = renderer.render_next().map_err(|e| e.to_string())?;
+        let path = args.out.join(format!("{stem}_{:05}.png", frame.time.frame));
+        write_png(&path, frame.size, &frame.rgba)?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    for e in renderer.gpu().take_uncaptured_errors() {
+        eprintln!("GPU error during the render: {e}");
+    }
+    eprintln!("wrote {} frame(s) to {}", args.frames, args.out.display());
+    Ok(())
+}
+
+/// Validates scenes and shaders; prints every located error.
+pub fn check(assets: &Assets, files: &[PathBuf]) -> Result<(), String> {
+    let mut targets: Vec<(AssetKind, String)> = Vec::new();
+    if files.is_empty() {
+        targets.extend(
+            assets
+                .names(AssetKind::Shader)
+                .into_iter()
+                .map(|n| (AssetKind::Shader, n)),
+        );
+        targets.extend(
+            assets
+                .names(AssetKind::Scene)
+                .into_iter()
+                .map(|n| (AssetKind::Scene, n)),
+        );
+    } else {
+        for f in files {
+            let kind = if f.extension().is_some_and(|e| e == "wgsl") {
+                AssetKind::Shader
+            } else {
+                AssetKind::Scene
+            };
+            targets.push((kind, f.display().to_string()));
+        }
+    }
+    let mut failures = 0;
+    for (kind, name) in &targets {
+        let result = match kind {
+            AssetKind::Scene => load_scene(assets, name)
+                .map(|_| ())
+                .map_err(|e| e.to_string()),
+            AssetKind::Shader => read_shader(assets, name).and_then(|(origin, source)| {
+                validate_wgsl(&origin, &source)
+                    .map(|_| ())
+                    .map_err(|e| e.to_string())
+            }),
+        };
+        match result {
+            Ok(()) => println!("ok     {name}"),
+            Err(e) => {
+                failures += 1;
+                println!("error  {e}");
+            }
+        }
+    }
+    println!("{} checked, {failures} with errors", targets.len());
+    if failures > 0 {
+        Err(format!("{failures} file(s) have errors"))
+    } else {
+        Ok(())
+    }
+}
+
+fn read_shader(assets: &Assets, name: &str) -> Result<(String, String), String> {
+    let path = Path::new(name);
+    if path.is_file() {
+        return std::fs::read_to_string(path)
+            .map(|s| (name.to_string(), s))
+            .map_err(|e| format!("{name}: {e}"));
+    }
+    assets
+        .load(AssetKind::Shader, name)
+        .map(|a| (a.origin, a.source))
+}
+
+/// Lists scenes with their nodes and parameters.
+pub fn list(assets: &Assets) -> Result<(), String> {
+    for name in assets.names(AssetKind::Scene) {
+        match load_scene(assets, &name) {
+            Err(e) => println!("{name}: INVALID\n{e}\n"),
+            Ok(scene) => {
+                let stem = name.trim_end_matches(".ron");
+                println!(
+                    "{stem} — {} ({}x{}): {}",
+                    scene.name, scene.size.0, scene.size.1, scene.description
+                );
+                for (i, node) in scene.nodes.iter().enumerate() {
+                    println!("  node {} ({})", node.id, node.technique.name);
+                    for (p, decl) in node.params.decls().iter().enumerate() {
+                        let animated = scene.tracks.iter().any(|t| t.node == i && t.param == p);
+                        let range = decl
+                            .range
+                            .map(|(lo, hi)| format!(" [{lo} … {hi}]"))
+                            .unwrap_or_default();
+                        println!(
+                            "    /indra/{}/{:<18} {:<6} = {:?}{range}{}",
+                            node.id,
+                            decl.name,
+                            decl.ty(),
+                            node.params.value_at(p),
+                            if animated { "  (animated)" } else { "" }
+                        );
+                    }
+                }
+                println!();
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Renders `frames` frames and prints per-pass GPU medians and frame time.
+pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), String> {
+    let scene = scene_with_sets(assets, &args.scene, &args.sets)?;
+    let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
+    let adapter = device.adapter_label();
+    let timestamps = device.has_timestamps();
+    let name = scene.name.clone();
+    let mut renderer = OffscreenRenderer::new(device, assets, scene, Some(args.size), None, None)
+        .map_err(|e| e.to_string())?;
+    renderer.instance_mut().animate = !args.no_animation;
+    for _ in 0..args.warmup {
+        renderer.render_only().map_err(|e| e.to_string())?;
+    }
+    renderer.finish_timings();
+    let mut walls = Vec::with_capacity(args.frames as usize);
+    let mut last = Instant::now();
+    let mut stats = None;
+    for _ in 0..args.frames {
+        let (_, s) = renderer.render_only().map_err(|e| e.to_string())?;
+        // Waiting each frame makes wall time the frame's full latency, not queue depth.
+        let _ = renderer
+            .gpu()
+            .device
+            .poll(wgpu::PollType::wait_indefinitely());
+        let now = Instant::now();
+        walls.push((now - last).as_secs_f64() * 1e3);
+        last = now;
+        stats = Some(s);
+    }
+    renderer.finish_timings();
+    walls.sort_by(f64::total_cmp);
+    let wall_median = walls.get(walls.len() / 2).copied().unwrap_or(0.0);
+    println!("scene      {name}");
+    println!("adapter    {adapter}");
+    println!(
+        "size       {}x{}   frames {} (+{} warm-up)",
+        args.size.0, args.size.1, args.frames, args.warmup
+    );
+    for s in &args.sets {
+        println!("set        {s}");
+    }
+    if timestamps {
+        println!("{:<28} {:>12} {:>8}", "pass", "GPU median", "samples");
+        for t in renderer.runtime().timings() {
+            println!("{:<28} {:>9.3} ms {:>8}", t.name, t.median_ms, t.samples);
+        }
+        if let Some(ms) = renderer.runtime().frame_gpu_median_ms() {
+            println!("{:<28} {:>9.3} ms", "all passes (GPU)", ms);
+        }
+    } else {
+        println!("(this adapter has no TIMESTAMP_QUERY_INSIDE_ENCODERS: wall-clock only)");
+    }
+    println!(
+        "{:<28} {:>9.3} ms  ({:.1} fps)",
+        "frame wall time (median)",
+        wall_median,
+        1e3 / wall_median.max(1e-9)
+    );
+    if let Some(s) = stats {
+        println!(
+            "graph      passes {}/{} executed, transient {} KiB requested / {} KiB allocated, compile {:.1} µs",
+            s.passes_executed,
+            s.passes_declared,
+            s.transient_bytes_requested / 1024,
+            s.transient_bytes_allocated / 1024,
+            s.compile_time.as_secs_f64() * 1e6
+        );
+    }
+    Ok(())
+}

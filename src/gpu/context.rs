@@ -1,0 +1,202 @@
+//! Creating the wgpu instance, adapter and device, with our own error handler.
+
+use std::sync::{Arc, Mutex};
+
+/// Which graphics API to ask wgpu for.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum BackendChoice {
+    /// Whatever wgpu finds (honours `WGPU_BACKEND`).
+    #[default]
+    Auto,
+    /// Vulkan (lavapipe on a machine without a GPU).
+    Vulkan,
+    /// OpenGL / GLES through EGL.
+    Gl,
+}
+
+/// How to pick the adapter.
+#[derive(Clone, Debug, Default)]
+pub struct GpuOptions {
+    /// Graphics API.
+    pub backend: BackendChoice,
+    /// Case-insensitive substring of the adapter name (e.g. "llvmpipe", "H100").
+    pub adapter: Option<String>,
+}
+
+/// Why no device could be had; each variant's message says what to do.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// No adapter at all.
+    #[error(
+        "no GPU adapter found for backend {backend:?}. On Linux without a GPU install Mesa's software Vulkan: `sudo apt-get install mesa-vulkan-drivers libvulkan1`"
+    )]
+    NoAdapter {
+        /// The backend asked for.
+        backend: BackendChoice,
+    },
+    /// Adapters exist, but none matches `--adapter`.
+    #[error("no adapter name contains '{wanted}'; adapters found: {found}")]
+    NoMatchingAdapter {
+        /// The substring asked for.
+        wanted: String,
+        /// The adapters that exist.
+        found: String,
+    },
+    /// The device request failed.
+    #[error("the adapter '{adapter}' refused to create a device: {reason}")]
+    Device {
+        /// Adapter name.
+        adapter: String,
+        /// wgpu's reason.
+        reason: String,
+    },
+}
+
+/// A device and queue plus what we learned about the adapter.
+#[derive(Clone)]
+pub struct Gpu {
+    /// The wgpu instance (kept to create surfaces).
+    pub instance: wgpu::Instance,
+    /// The chosen adapter.
+    pub adapter: wgpu::Adapter,
+    /// The logical device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// Validation errors wgpu raised outside an error scope, newest last. Read and cleared by the
+    /// runtime to show them; wgpu's default handler would panic instead.
+    pub uncaptured: Arc<Mutex<Vec<String>>>,
+}
+
+impl Gpu {
+    /// A device with no surface, for off-screen rendering, tests and benchmarks.
+    pub fn headless(options: &GpuOptions) -> Result<Self, GpuError> {
+        let instance = wgpu::Instance::new(instance_descriptor(options.backend));
+        pollster::block_on(Self::with_instance(instance, options, None))
+    }
+
+    /// A device on `instance` that can present to `surface` (if given).
+    pub async fn with_instance(
+        instance: wgpu::Instance,
+        options: &GpuOptions,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<Self, GpuError> {
+        let adapter = pick_adapter(&instance, options, surface).await?;
+        let info = adapter.get_info();
+        // Timestamps are optional: used for per-pass timing when the adapter has them.
+        let wanted =
+            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let required_features = adapter.features() & wanted;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("indra_device"),
+                required_features,
+                required_limits: adapter.limits(),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| GpuError::Device {
+                adapter: info.name.clone(),
+                reason: e.to_string(),
+            })?;
+        let uncaptured = Arc::new(Mutex::new(Vec::new()));
+        let sink = uncaptured.clone();
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            let text = error.to_string();
+            log::error!("GPU error: {text}");
+            if let Ok(mut list) = sink.lock() {
+                list.push(text);
+                let excess = list.len().saturating_sub(32);
+                list.drain(..excess);
+            }
+        }));
+        log::info!(
+            "adapter: {} ({:?}, {:?})",
+            info.name,
+            info.backend,
+            info.device_type
+        );
+        Ok(Self {
+            instance,
+            adapter,
+            device,
+            queue,
+            uncaptured,
+        })
+    }
+
+    /// "name (backend)" of the adapter, for logs, reports and golden file names.
+    pub fn adapter_label(&self) -> String {
+        let info = self.adapter.get_info();
+        format!("{} ({:?})", info.name, info.backend)
+    }
+
+    /// Whether per-pass GPU timestamps can be recorded.
+    pub fn has_timestamps(&self) -> bool {
+        self.device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
+    }
+
+    /// Takes the errors wgpu reported outside error scopes since the last call.
+    pub fn take_uncaptured_errors(&self) -> Vec<String> {
+        self.uncaptured
+            .lock()
+            .map(|mut l| std::mem::take(&mut *l))
+            .unwrap_or_default()
+    }
+}
+
+/// The instance descriptor for a backend choice; `Auto` reads `WGPU_BACKEND` and friends.
+pub fn instance_descriptor(backend: BackendChoice) -> wgpu::InstanceDescriptor {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    match backend {
+        BackendChoice::Auto => {}
+        BackendChoice::Vulkan => desc.backends = wgpu::Backends::VULKAN,
+        BackendChoice::Gl => desc.backends = wgpu::Backends::GL,
+    }
+    desc
+}
+
+async fn pick_adapter(
+    instance: &wgpu::Instance,
+    options: &GpuOptions,
+    surface: Option<&wgpu::Surface<'_>>,
+) -> Result<wgpu::Adapter, GpuError> {
+    let all = instance.enumerate_adapters(wgpu::Backends::all()).await;
+    let usable: Vec<wgpu::Adapter> = all
+        .into_iter()
+        .filter(|a| surface.is_none_or(|s| a.is_surface_supported(s)))
+        .collect();
+    if usable.is_empty() {
+        return Err(GpuError::NoAdapter {
+            backend: options.backend,
+        });
+    }
+    if let Some(wanted) = &options.adapter {
+        let lower = wanted.to_lowercase();
+        let found = usable
+            .iter()
+            .map(|a| a.get_info().name)
+            .collect::<Vec<_>>()
+            .join(", ");
+        return usable
+            .into_iter()
+            .find(|a| a.get_info().name.to_lowercase().contains(&lower))
+            .ok_or(GpuError::NoMatchingAdapter {
+                wanted: wanted.clone(),
+                found,
+            });
+    }
+    // Prefer a real GPU over a software one; among equals keep wgpu's order (Vulkan first).
+    let rank = |a: &wgpu::Adapter| match a.get_info().device_type {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Cpu => 3,
+        wgpu::DeviceType::Other => 4,
+    };
+    let mut usable = usable;
+    usable.sort_by_key(rank);
+    Ok(usable.remove(0))
+}

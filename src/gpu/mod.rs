@@ -1,0 +1,15 @@
+//! The GPU layer: adapter and device (headless or for a window surface), shader compilation with
+//! naga validation and located errors, texture readback and the final display encode.
+//! Knows nothing of scenes or techniques.
+
+mod blit;
+mod compute;
+mod context;
+mod readback;
+mod shader;
+
+pub use blit::{Blit, DISPLAY_FORMAT};
+pub use compute::ComputeKernel;
+pub use context::{BackendChoice, Gpu, GpuError, GpuOptions, instance_descriptor};
+pub use readback::read_texture_rgba8;
+pub use shader::{ShaderError, compile_wgsl, validate_wgsl};

@@ -1,0 +1,297 @@
+//! Running a compiled frame: resolve transients from the pool as their lifetimes begin, record
+//! each pass between timestamps, release textures after their last reader.
+
+use std::collections::BTreeSet;
+use std::time::{Duration, Instant};
+
+use super::builder::{
+    Access, BufferOrigin, FrameGraph, PassContext, ResolvedTexture, Resource, TextureOrigin,
+};
+use super::compile::{GraphError, compile};
+use super::pool::{PoolKey, TexturePool, texture_bytes};
+use super::resource::next_resource_id;
+use super::timing::{GpuTimer, PassTiming};
+
+/// What the graph reports about one frame.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct FrameStats {
+    /// Passes the nodes declared.
+    pub passes_declared: usize,
+    /// Passes that ran after culling.
+    pub passes_executed: usize,
+    /// Bytes of every transient texture used this frame, as if each had its own.
+    pub transient_bytes_requested: u64,
+    /// Bytes of the distinct pool textures that served them.
+    pub transient_bytes_allocated: u64,
+    /// Pool textures created this frame (0 once the pool is warm).
+    pub textures_created: usize,
+    /// CPU time of compiling the graph.
+    pub compile_time: Duration,
+}
+
+/// The frame's output texture (to encode for display or read back) and its stats.
+pub struct FrameOutput {
+    /// The output texture.
+    pub texture: wgpu::Texture,
+    /// Its view.
+    pub view: wgpu::TextureView,
+    /// Stats of this frame.
+    pub stats: FrameStats,
+}
+
+struct PooledBuffer {
+    size: u64,
+    buffer: wgpu::Buffer,
+    id: u64,
+    in_use: bool,
+}
+
+/// What persists between frames for the graph: the texture pool, pooled buffers and the timer.
+pub struct GraphRuntime {
+    pool: TexturePool,
+    buffers: Vec<PooledBuffer>,
+    timer: Option<GpuTimer>,
+}
+
+impl GraphRuntime {
+    /// A runtime that times passes when the device has `TIMESTAMP_QUERY_INSIDE_ENCODERS`.
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
+        let timed = device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+        Self {
+            pool: TexturePool::new(),
+            buffers: Vec::new(),
+            timer: timed.then(|| GpuTimer::new(device, queue)),
+        }
+    }
+
+    /// The transient texture pool.
+    pub fn pool(&self) -> &TexturePool {
+        &self.pool
+    }
+
+    /// Compiles and records `graph` into `encoder`. Submit the encoder, then call `after_submit`.
+    pub fn execute(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        mut graph: FrameGraph<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> Result<FrameOutput, GraphError> {
+        let started = Instant::now();
+        let compiled = compile(&graph)?;
+        let compile_time = started.elapsed();
+        let output = graph.output.ok_or(GraphError::NoOutput)?;
+        let usages = texture_usages(&graph, output.0);
+
+        let mut textures: Vec<Option<ResolvedTexture>> = vec![None; graph.textures.len()];
+        let mut pool_index: Vec<Option<usize>> = vec![None; graph.textures.len()];
+        let mut buffers: Vec<Option<(wgpu::Buffer, u64)>> = vec![None; graph.buffers.len()];
+        let mut buffer_index: Vec<Option<usize>> = vec![None; graph.buffers.len()];
+        let mut stats = FrameStats {
+            passes_declared: graph.passes.len(),
+            passes_executed: compiled.executed(),
+            compile_time,
+            ..Default::default()
+        };
+        let mut used_pool_entries = BTreeSet::new();
+        let timing = self.timer.as_mut().is_some_and(|t| t.begin_frame());
+
+        for (position, &p) in compiled.order.iter().enumerate() {
+            for (t, life) in compiled.texture_lifetimes.iter().enumerate() {
+                if life.is_some_and(|(first, _)| first == position) {
+                    let (resolved, pooled) = self.resolve_texture(device, &graph, t, usages[t]);
+                    if let Some(i) = pooled {
+                        stats.transient_bytes_requested +=
+                            texture_bytes(size_of(&resolved), resolved.texture.format());
+                        if used_pool_entries.insert(i) {
+                            stats.transient_bytes_allocated +=
+                                texture_bytes(size_of(&resolved), resolved.texture.format());
+                        }
+                    }
+                    textures[t] = Some(resolved);
+                    pool_index[t] = pooled;
+                }
+            }
+            for (b, life) in compiled.buffer_lifetimes.iter().enumerate() {
+                if life.is_some_and(|(first, _)| first == position) {
+                    let (buffer, id, pooled) = self.resolve_buffer(device, &graph, b);
+                    buffers[b] = Some((buffer, id));
+                    buffer_index[b] = pooled;
+                }
+            }
+
+            let pass = &mut graph.passes[p];
+            if timing && let Some(t) = self.timer.as_mut() {
+                t.begin_pass(encoder, position, &pass.name);
+            }
+            if let Some(record) = pass.record.take() {
+                encoder.push_debug_group(&pass.name);
+                let mut ctx = PassContext {
+                    device,
+                    queue,
+                    encoder,
+                    textures: &textures,
+                    buffers: &buffers,
+                    pass_name: &pass.name,
+                };
+                record(&mut ctx);
+                encoder.pop_debug_group();
+            }
+            if timing && let Some(t) = self.timer.as_mut() {
+                t.end_pass(encoder, position);
+            }
+
+            for (t, life) in compiled.texture_lifetimes.iter().enumerate() {
+                if life.is_some_and(|(_, last)| last == position)
+                    && let Some(i) = pool_index[t]
+                {
+                    self.pool.release(i);
+                }
+            }
+            for (b, life) in compiled.buffer_lifetimes.iter().enumerate() {
+                if life.is_some_and(|(_, last)| last == position)
+                    && let Some(i) = buffer_index[b]
+                {
+                    self.buffers[i].in_use = false;
+                }
+            }
+        }
+        if timing && let Some(t) = self.timer.as_mut() {
+            t.end_frame(encoder);
+        }
+        stats.textures_created = self.pool.created_this_frame();
+        self.pool.end_frame();
+        for b in &mut self.buffers {
+            b.in_use = false;
+        }
+        let out =
+            textures[output.0 as usize]
+                .take()
+                .ok_or_else(|| GraphError::ReadOfUnwritten {
+                    pass: "<output>".into(),
+                    resource: graph.textures[output.0 as usize].name.clone(),
+                })?;
+        Ok(FrameOutput {
+            texture: out.texture,
+            view: out.view,
+            stats,
+        })
+    }
+
+    /// Call after the frame's encoder was submitted: starts reading back its timestamps.
+    pub fn after_submit(&mut self) {
+        if let Some(t) = self.timer.as_mut() {
+            t.after_submit();
+        }
+    }
+
+    /// Rolling medians per pass (empty without timestamp support).
+    pub fn timings(&self) -> Vec<PassTiming> {
+        self.timer.as_ref().map(|t| t.timings()).unwrap_or_default()
+    }
+
+    /// Rolling median of the summed GPU pass time per frame, milliseconds.
+    pub fn frame_gpu_median_ms(&self) -> Option<f64> {
+        self.timer.as_ref().and_then(|t| t.frame_median_ms())
+    }
+
+    /// Waits for outstanding timestamp readbacks and folds them into the medians.
+    pub fn drain_timings(&mut self, device: &wgpu::Device) {
+        if let Some(t) = self.timer.as_mut() {
+            t.drain(device);
+        }
+    }
+
+    fn resolve_texture(
+        &mut self,
+        device: &wgpu::Device,
+        graph: &FrameGraph<'_>,
+        t: usize,
+        usage: wgpu::TextureUsages,
+    ) -> (ResolvedTexture, Option<usize>) {
+        match &graph.textures[t].origin {
+            TextureOrigin::Imported(texture, view, id) => (
+                ResolvedTexture {
+                    texture: texture.clone(),
+                    view: view.clone(),
+                    id: *id,
+                },
+                None,
+            ),
+            TextureOrigin::Transient(desc) => {
+                let key = PoolKey {
+                    size: desc.extent.resolve(graph.output_size),
+                    format: desc.format,
+                    usage,
+                };
+                let (index, resolved) = self.pool.acquire(device, key);
+                (resolved, Some(index))
+            }
+        }
+    }
+
+    fn resolve_buffer(
+        &mut self,
+        device: &wgpu::Device,
+        graph: &FrameGraph<'_>,
+        b: usize,
+    ) -> (wgpu::Buffer, u64, Option<usize>) {
+        match &graph.buffers[b].origin {
+            BufferOrigin::Imported(buffer, id) => (buffer.clone(), *id, None),
+            BufferOrigin::Transient { size } => {
+                let index = self
+                    .buffers
+                    .iter()
+                    .position(|e| !e.in_use && e.size == *size)
+                    .unwrap_or_else(|| {
+                        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                            label: Some("graph_transient_buffer"),
+                            size: *size,
+                            usage: wgpu::BufferUsages::STORAGE
+                                | wgpu::BufferUsages::COPY_DST
+                                | wgpu::BufferUsages::COPY_SRC,
+                            mapped_at_creation: false,
+                        });
+                        self.buffers.push(PooledBuffer {
+                            size: *size,
+                            buffer,
+                            id: next_resource_id(),
+                            in_use: false,
+                        });
+                        self.buffers.len() - 1
+                    });
+                self.buffers[index].in_use = true;
+                (
+                    self.buffers[index].buffer.clone(),
+                    self.buffers[index].id,
+                    Some(index),
+                )
+            }
+        }
+    }
+}
+
+fn size_of(t: &ResolvedTexture) -> (u32, u32) {
+    (t.texture.width(), t.texture.height())
+}
+
+/// Usage flags of each texture, inferred from how passes access it.
+fn texture_usages(graph: &FrameGraph<'_>, output: u32) -> Vec<wgpu::TextureUsages> {
+    let mut usages = vec![wgpu::TextureUsages::empty(); graph.textures.len()];
+    for pass in &graph.passes {
+        for &(res, access) in &pass.accesses {
+            if let Resource::Texture(t) = res {
+                usages[t as usize] |= match access {
+                    Access::Read => wgpu::TextureUsages::TEXTURE_BINDING,
+                    Access::Write => wgpu::TextureUsages::STORAGE_BINDING,
+                    Access::RenderTarget => wgpu::TextureUsages::RENDER_ATTACHMENT,
+                };
+            }
+        }
+    }
+    // The output is encoded for display (sampled) or copied for readback.
+    usages[output as usize] |= wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    usages
+}

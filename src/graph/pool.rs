@@ -1,0 +1,135 @@
+//! The transient texture pool: textures persist across frames and are handed out again within a
+//! frame once their previous user's last reader has run (wgpu has no memory aliasing; this reuse
+//! is how the graph saves memory).
+
+use super::builder::ResolvedTexture;
+use super::resource::next_resource_id;
+
+/// What makes two transient textures interchangeable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PoolKey {
+    /// Size in texels.
+    pub size: (u32, u32),
+    /// Texel format.
+    pub format: wgpu::TextureFormat,
+    /// Usage flags the user needs.
+    pub usage: wgpu::TextureUsages,
+}
+
+struct Entry {
+    key: PoolKey,
+    resolved: ResolvedTexture,
+    in_use: bool,
+    last_frame: u64,
+}
+
+/// Frames a pooled texture may sit unused before it is freed (after a resize, say).
+const EVICT_AFTER_FRAMES: u64 = 120;
+
+/// Owns the GPU textures behind transient graph resources.
+#[derive(Default)]
+pub struct TexturePool {
+    entries: Vec<Entry>,
+    frame: u64,
+    created_this_frame: usize,
+}
+
+impl TexturePool {
+    /// An empty pool.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// A free texture matching `key` (same size and format, at least the usage), or a new one.
+    pub(crate) fn acquire(
+        &mut self,
+        device: &wgpu::Device,
+        key: PoolKey,
+    ) -> (usize, ResolvedTexture) {
+        let found = self.entries.iter().position(|e| {
+            !e.in_use
+                && e.key.size == key.size
+                && e.key.format == key.format
+                && e.key.usage.contains(key.usage)
+        });
+        let index = found.unwrap_or_else(|| {
+            self.created_this_frame += 1;
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("graph_transient"),
+                size: wgpu::Extent3d {
+                    width: key.size.0,
+                    height: key.size.1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: key.format,
+                usage: key.usage,
+                view_formats: &[],
+            });
+            let view = texture.create_view(&Default::default());
+            let resolved = ResolvedTexture {
+                texture,
+                view,
+                id: next_resource_id(),
+            };
+            self.entries.push(Entry {
+                key,
+                resolved,
+                in_use: false,
+                last_frame: self.frame,
+            });
+            self.entries.len() - 1
+        });
+        let entry = &mut self.entries[index];
+        entry.in_use = true;
+        entry.last_frame = self.frame;
+        (index, entry.resolved.clone())
+    }
+
+    /// Returns a texture for later passes of this frame (its last reader has run).
+    pub(crate) fn release(&mut self, index: usize) {
+        self.entries[index].in_use = false;
+    }
+
+    /// Ends a frame: everything becomes free; textures idle for long are dropped.
+    pub(crate) fn end_frame(&mut self) {
+        let frame = self.frame;
+        self.entries
+            .retain(|e| frame.saturating_sub(e.last_frame) < EVICT_AFTER_FRAMES);
+        for e in &mut self.entries {
+            e.in_use = false;
+        }
+        self.frame += 1;
+        self.created_this_frame = 0;
+    }
+
+    /// Textures created during the current frame (0 in a steady state).
+    pub fn created_this_frame(&self) -> usize {
+        self.created_this_frame
+    }
+
+    /// Textures the pool holds.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// Whether the pool holds no texture.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// Bytes of all pooled textures.
+    pub fn bytes(&self) -> u64 {
+        self.entries
+            .iter()
+            .map(|e| texture_bytes(e.key.size, e.key.format))
+            .sum()
+    }
+}
+
+/// Bytes a single-mip 2-D texture occupies.
+pub fn texture_bytes(size: (u32, u32), format: wgpu::TextureFormat) -> u64 {
+    u64::from(format.block_copy_size(None).unwrap_or(4)) * u64::from(size.0) * u64::from(size.1)
+}

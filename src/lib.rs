@@ -1,0 +1,19 @@
+//! indra — a real-time visual-art engine for live VJ sets and installations, rendering the
+//! techniques of *Unity Graphics Programming vol.4* with wgpu.
+//!
+//! Layers, from the bottom (a layer never imports one above it; see `DESIGN.md`):
+//! [`time`] and [`assets`] → [`gpu`] → [`graph`] → [`params`] → [`techniques`] → [`scene`] →
+//! [`offscreen`] / [`app`]; `main.rs` is the command line only.
+
+#![warn(missing_docs)]
+
+pub mod app;
+pub mod assets;
+
+pub mod gpu;
+pub mod graph;
+pub mod offscreen;
+pub mod params;
+pub mod scene;
+pub mod techniques;
+pub mod time;

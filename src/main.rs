@@ -1,0 +1,80 @@
+//! The `indra` command line: parsing only; each command's work is in `commands`.
+
+mod commands;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand};
+use indra::gpu::BackendChoice;
+
+/// indra — real-time visual-art engine (Unity Graphics Programming vol.4 techniques on wgpu).
+#[derive(Parser)]
+#[command(name = "indra", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    #[command(flatten)]
+    gpu: GpuArgs,
+    /// Folder holding `shaders/` and `scenes/` (default: $INDRA_ROOT, the current folder, or
+    /// the source tree; built-in copies otherwise).
+    #[arg(long, global = true)]
+    root: Option<PathBuf>,
+}
+
+/// Options that pick the GPU.
+#[derive(Args, Clone)]
+struct GpuArgs {
+    /// Graphics API.
+    #[arg(long, global = true, value_enum, default_value_t = BackendChoice::Auto)]
+    backend: BackendChoice,
+    /// Use the adapter whose name contains this text (e.g. llvmpipe, H100).
+    #[arg(long, global = true)]
+    adapter: Option<String>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Open a scene in a window with live controls (default: the kleinian scene).
+    Run(commands::RunArgs),
+    /// Render frames off-screen to a PNG sequence.
+    Render(commands::RenderArgs),
+    /// Validate every scene and shader (or the given files); non-zero exit on any error.
+    Check {
+        /// Scene (.ron) or shader (.wgsl) files; all known ones when empty.
+        files: Vec<PathBuf>,
+    },
+    /// List scenes and their parameters.
+    List,
+    /// Render off-screen and print per-pass GPU medians and frame time.
+    Bench(commands::BenchArgs),
+}
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,indra=info"))
+        .init();
+    let cli = Cli::parse();
+    let assets = match cli.root {
+        Some(root) => indra::assets::Assets::new(Some(root)),
+        None => indra::assets::Assets::discover(),
+    };
+    let gpu = indra::gpu::GpuOptions {
+        backend: cli.gpu.backend,
+        adapter: cli.gpu.adapter,
+    };
+    let result = match cli.command {
+        None => commands::run(&assets, &gpu, &commands::RunArgs::default()),
+        Some(Command::Run(args)) => commands::run(&assets, &gpu, &args),
+        Some(Command::Render(args)) => commands::render(&assets, &gpu, &args),
+        Some(Command::Check { files }) => commands::check(&assets, &files),
+        Some(Command::List) => commands::list(&assets),
+        Some(Command::Bench(args)) => commands::bench(&assets, &gpu, &args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,8 @@
+//! The headless runtime: a fixed clock, N frames, PNG output and image comparison against
+//! golden references. Knows nothing of windows or UI.
+
+mod golden;
+mod renderer;
+
+pub use golden::{FlipScore, GoldenCheck, flip_score};
+pub use renderer::{OffscreenRenderer, RenderedFrame, write_png};

@@ -1,0 +1,215 @@
+//! Parameter values and their declarations.
+
+use std::fmt;
+
+/// The type of a parameter; decides its UI widget and how values are coerced.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ParamType {
+    /// One float (slider).
+    Float,
+    /// One integer (integer slider).
+    Int,
+    /// On/off (checkbox).
+    Bool,
+    /// Two floats (2-D pad).
+    Vec2,
+    /// Three floats.
+    Vec3,
+    /// Four floats.
+    Vec4,
+    /// RGBA, sRGB-encoded as a colour picker shows it (colour picker).
+    Color,
+}
+
+impl ParamType {
+    /// Number of float components.
+    pub fn components(self) -> usize {
+        match self {
+            ParamType::Float | ParamType::Int | ParamType::Bool => 1,
+            ParamType::Vec2 => 2,
+            ParamType::Vec3 => 3,
+            ParamType::Vec4 | ParamType::Color => 4,
+        }
+    }
+
+    /// Lower-case name used in files and messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            ParamType::Float => "float",
+            ParamType::Int => "int",
+            ParamType::Bool => "bool",
+            ParamType::Vec2 => "vec2",
+            ParamType::Vec3 => "vec3",
+            ParamType::Vec4 => "vec4",
+            ParamType::Color => "color",
+        }
+    }
+
+    /// Builds a value of this type from numbers; `None` if the count or kind does not fit.
+    /// Colours accept 3 numbers (alpha 1). Ints must be whole; bools are 0 or 1.
+    pub fn value_from(self, numbers: &[f64]) -> Option<ParamValue> {
+        let f = |i: usize| numbers[i] as f32;
+        let exact = numbers.len() == self.components();
+        Some(match self {
+            ParamType::Float if exact => ParamValue::Float(f(0)),
+            ParamType::Int if exact && numbers[0].fract() == 0.0 && numbers[0].abs() < 2e9 => {
+                ParamValue::Int(numbers[0] as i32)
+            }
+            ParamType::Bool if exact && (numbers[0] == 0.0 || numbers[0] == 1.0) => {
+                ParamValue::Bool(numbers[0] == 1.0)
+            }
+            ParamType::Vec2 if exact => ParamValue::Vec2([f(0), f(1)]),
+            ParamType::Vec3 if exact => ParamValue::Vec3([f(0), f(1), f(2)]),
+            ParamType::Vec4 if exact => ParamValue::Vec4([f(0), f(1), f(2), f(3)]),
+            ParamType::Color if exact => ParamValue::Color([f(0), f(1), f(2), f(3)]),
+            ParamType::Color if numbers.len() == 3 => ParamValue::Color([f(0), f(1), f(2), 1.0]),
+            _ => return None,
+        })
+    }
+}
+
+impl fmt::Display for ParamType {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A parameter value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParamValue {
+    /// See [`ParamType::Float`].
+    Float(f32),
+    /// See [`ParamType::Int`].
+    Int(i32),
+    /// See [`ParamType::Bool`].
+    Bool(bool),
+    /// See [`ParamType::Vec2`].
+    Vec2([f32; 2]),
+    /// See [`ParamType::Vec3`].
+    Vec3([f32; 3]),
+    /// See [`ParamType::Vec4`].
+    Vec4([f32; 4]),
+    /// See [`ParamType::Color`].
+    Color([f32; 4]),
+}
+
+impl ParamValue {
+    /// The value's type.
+    pub fn ty(&self) -> ParamType {
+        match self {
+            ParamValue::Float(_) => ParamType::Float,
+            ParamValue::Int(_) => ParamType::Int,
+            ParamValue::Bool(_) => ParamType::Bool,
+            ParamValue::Vec2(_) => ParamType::Vec2,
+            ParamValue::Vec3(_) => ParamType::Vec3,
+            ParamValue::Vec4(_) => ParamType::Vec4,
+            ParamValue::Color(_) => ParamType::Color,
+        }
+    }
+
+    /// All components as floats (bool → 0/1).
+    pub fn components(&self) -> Vec<f32> {
+        match *self {
+            ParamValue::Float(x) => vec![x],
+            ParamValue::Int(i) => vec![i as f32],
+            ParamValue::Bool(b) => vec![if b { 1.0 } else { 0.0 }],
+            ParamValue::Vec2(v) => v.to_vec(),
+            ParamValue::Vec3(v) => v.to_vec(),
+            ParamValue::Vec4(v) | ParamValue::Color(v) => v.to_vec(),
+        }
+    }
+
+    /// A value of type `ty` from float components (ints round, bools threshold at 0.5).
+    pub fn from_components(ty: ParamType, c: &[f32]) -> ParamValue {
+        let at = |i: usize| c.get(i).copied().unwrap_or(0.0);
+        match ty {
+            ParamType::Float => ParamValue::Float(at(0)),
+            ParamType::Int => ParamValue::Int(at(0).round() as i32),
+            ParamType::Bool => ParamValue::Bool(at(0) >= 0.5),
+            ParamType::Vec2 => ParamValue::Vec2([at(0), at(1)]),
+            ParamType::Vec3 => ParamValue::Vec3([at(0), at(1), at(2)]),
+            ParamType::Vec4 => ParamValue::Vec4([at(0), at(1), at(2), at(3)]),
+            ParamType::Color => ParamValue::Color([at(0), at(1), at(2), at(3)]),
+        }
+    }
+
+    /// Clamps every component into `range` (colours are not clamped by a range; they keep [0, ∞)).
+    pub fn clamped(&self, range: Option<(f32, f32)>) -> ParamValue {
+        let Some((lo, hi)) = range else { return *self };
+        if matches!(self, ParamValue::Bool(_)) {
+            return *self;
+        }
+        let c: Vec<f32> = self.components().iter().map(|x| x.clamp(lo, hi)).collect();
+        ParamValue::from_components(self.ty(), &c)
+    }
+}
+
+/// A parameter a technique exposes: name, type, default, range, unit and meaning.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamDecl {
+    /// snake_case name, unique in its node; also the last part of its OSC address.
+    pub name: String,
+    /// Default value (its type is the parameter's type).
+    pub default: ParamValue,
+    /// Inclusive range of each component, if bounded; UI sliders and incoming values use it.
+    pub range: Option<(f32, f32)>,
+    /// Unit shown next to the value ("", "px", "s", "°").
+    pub unit: String,
+    /// One sentence on what it does.
+    pub doc: String,
+}
+
+impl ParamDecl {
+    /// A declaration; `range` bounds each component.
+    pub fn new(name: &str, default: ParamValue, range: Option<(f32, f32)>, doc: &str) -> Self {
+        Self {
+            name: name.into(),
+            default,
+            range,
+            unit: String::new(),
+            doc: doc.into(),
+        }
+    }
+
+    /// The same declaration with a unit.
+    #[must_use]
+    pub fn with_unit(mut self, unit: &str) -> Self {
+        self.unit = unit.into();
+        self
+    }
+
+    /// The parameter's type.
+    pub fn ty(&self) -> ParamType {
+        self.default.ty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coercion_checks_count_and_kind() {
+        assert_eq!(
+            ParamType::Int.value_from(&[50.0]),
+            Some(ParamValue::Int(50))
+        );
+        assert_eq!(ParamType::Int.value_from(&[50.5]), None);
+        assert_eq!(ParamType::Vec2.value_from(&[1.0]), None);
+        assert_eq!(
+            ParamType::Color.value_from(&[1.0, 0.5, 0.0]),
+            Some(ParamValue::Color([1.0, 0.5, 0.0, 1.0]))
+        );
+        assert_eq!(ParamType::Bool.value_from(&[2.0]), None);
+    }
+
+    #[test]
+    fn clamping_is_per_component() {
+        let v = ParamValue::Vec2([-3.0, 0.5]).clamped(Some((0.0, 1.0)));
+        assert_eq!(v, ParamValue::Vec2([0.0, 0.5]));
+        assert_eq!(
+            ParamValue::Int(900).clamped(Some((1.0, 500.0))),
+            ParamValue::Int(500)
+        );
+    }
+}

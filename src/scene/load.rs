@@ -1,0 +1,519 @@
+//! Parsing and validating a scene file into a [`Scene`] the runtime can instantiate.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use super::error::{SceneError, SceneErrors, locate};
+use super::schema::{RawValue, SceneFile};
+use crate::assets::{AssetKind, Assets};
+use crate::params::{Key, ParamSet, ParamType, ParamValue, Track};
+use crate::techniques::{self, TechniqueInfo};
+
+/// A validated scene: every name resolved, every value typed.
+#[derive(Clone)]
+pub struct Scene {
+    /// Where it was loaded from.
+    pub origin: String,
+    /// Display name.
+    pub name: String,
+    /// One line on what it shows.
+    pub description: String,
+    /// Default output size.
+    pub size: (u32, u32),
+    /// Seed of all randomness.
+    pub seed: u64,
+    /// Fixed step, seconds.
+    pub dt: f32,
+    /// Nodes in dependency order (inputs before their consumers).
+    pub nodes: Vec<SceneNode>,
+    /// Index of the output node in `nodes`.
+    pub output: usize,
+    /// Tracks bound to node parameters.
+    pub tracks: Vec<BoundTrack>,
+}
+
+/// One technique instance of a validated scene.
+#[derive(Clone)]
+pub struct SceneNode {
+    /// Unique id.
+    pub id: String,
+    /// The technique.
+    pub technique: &'static TechniqueInfo,
+    /// Declarations (with the scene's defaults and ranges) and start values.
+    pub params: ParamSet,
+    /// Upstream node indices, in the technique's input order.
+    pub inputs: Vec<usize>,
+}
+
+/// A track resolved to a parameter (or one of its components).
+#[derive(Clone, Debug)]
+pub struct BoundTrack {
+    /// The target as written (`node.param[.c]`).
+    pub target: String,
+    /// Node index.
+    pub node: usize,
+    /// Parameter index within the node.
+    pub param: usize,
+    /// Component index, for targets like `t.x`.
+    pub component: Option<usize>,
+    /// The keys.
+    pub track: Track,
+}
+
+impl std::fmt::Debug for SceneNode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SceneNode")
+            .field("id", &self.id)
+            .field("technique", &self.technique.name)
+            .finish()
+    }
+}
+
+impl Scene {
+    /// Index of a node by id.
+    pub fn node_index(&self, id: &str) -> Option<usize> {
+        self.nodes.iter().position(|n| n.id == id)
+    }
+
+    /// Applies `node.param=value` (value: numbers separated by commas, or true/false), as the
+    /// CLI's `--set` does. The value is typed and clamped like any other.
+    pub fn set_from_str(&mut self, assignment: &str) -> Result<(), String> {
+        let (target, value) = assignment
+            .split_once('=')
+            .ok_or_else(|| format!("'{assignment}' is not of the form node.param=value"))?;
+        let (node_id, param) = target
+            .split_once('.')
+            .ok_or_else(|| format!("'{target}' is not of the form node.param"))?;
+        let node = self.node_index(node_id).ok_or_else(|| {
+            let ids: Vec<&str> = self.nodes.iter().map(|n| n.id.as_str()).collect();
+            format!(
+                "scene '{}' has no node '{node_id}' (nodes: {})",
+                self.name,
+                ids.join(", ")
+            )
+        })?;
+        let params = &mut self.nodes[node].params;
+        let index = params.index(param).ok_or_else(|| {
+            let names: Vec<&str> = params.decls().iter().map(|d| d.name.as_str()).collect();
+            format!(
+                "node '{node_id}' has no parameter '{param}' (parameters: {})",
+                names.join(", ")
+            )
+        })?;
+        let ty = params.decls()[index].ty();
+        let typed = parse_value_override(value, ty)?;
+        params.set_at(index, typed);
+        Ok(())
+    }
+}
+
+/// Parses a command-line value (`1.5`, `2,0`, `true`) as a value of type `ty`.
+pub fn parse_value_override(text: &str, ty: ParamType) -> Result<ParamValue, String> {
+    let raw = match text.trim() {
+        "true" => RawValue::Bool(true),
+        "false" => RawValue::Bool(false),
+        list => RawValue::List(
+            list.split(',')
+                .map(|x| {
+                    x.trim()
+                        .parse::<f64>()
+                        .map_err(|_| format!("'{x}' is not a number"))
+                })
+                .collect::<Result<_, _>>()?,
+        ),
+    };
+    let raw = match raw {
+        RawValue::List(v) if v.len() == 1 => RawValue::Number(v[0]),
+        other => other,
+    };
+    coerce(&raw, ty).ok_or_else(|| format!("'{text}' is not a {ty}"))
+}
+
+/// Loads a scene by name or path: an existing file path is read directly, anything else is
+/// looked up in `scenes/` (disk first, then the built-in copies).
+pub fn load_scene(assets: &Assets, name_or_path: &str) -> Result<Scene, SceneErrors> {
+    let path = std::path::Path::new(name_or_path);
+    let (origin, source) = if path.is_file() {
+        std::fs::read_to_string(path)
+            .map(|s| (path.display().to_string(), s))
+            .map_err(|e| one_error(name_or_path, format!("cannot read the file: {e}")))?
+    } else {
+        let asset = assets
+            .load(AssetKind::Scene, name_or_path)
+            .map_err(|m| one_error(name_or_path, m))?;
+        (asset.origin, asset.source)
+    };
+    parse_scene(&origin, &source)
+}
+
+fn one_error(origin: &str, message: String) -> SceneErrors {
+    SceneErrors(vec![SceneError {
+        origin: origin.into(),
+        line: 1,
+        column: 1,
+        message,
+    }])
+}
+
+/// Parses and validates scene text; `origin` names it in errors.
+pub fn parse_scene(origin: &str, source: &str) -> Result<Scene, SceneErrors> {
+    let file: SceneFile = ron::Options::default().from_str(source).map_err(|e| {
+        SceneErrors(vec![SceneError {
+            origin: origin.into(),
+            line: e.span.start.line.max(1),
+            column: e.span.start.col.max(1),
+            message: e.code.to_string(),
+        }])
+    })?;
+    Validator {
+        origin,
+        source,
+        errors: Vec::new(),
+    }
+    .validate(file)
+}
+
+/// Collects every semantic error of one file, each located by anchors.
+struct Validator<'a> {
+    origin: &'a str,
+    source: &'a str,
+    errors: Vec<SceneError>,
+}
+
+impl Validator<'_> {
+    fn error(&mut self, anchors: &[&str], message: String) {
+        let (line, column) = locate(self.source, anchors);
+        self.errors.push(SceneError {
+            origin: self.origin.into(),
+            line,
+            column,
+            message,
+        });
+    }
+
+    fn validate(mut self, file: SceneFile) -> Result<Scene, SceneErrors> {
+        if file.size.0 == 0 || file.size.1 == 0 || file.size.0 > 16384 || file.size.1 > 16384 {
+            self.error(
+                &["size"],
+                format!(
+                    "size {:?} must be between 1 and 16384 on each axis",
+                    file.size
+                ),
+            );
+        }
+        if !(file.dt > 0.0 && file.dt <= 1.0) {
+            self.error(&["dt"], format!("dt {} must be in (0, 1] seconds", file.dt));
+        }
+        let mut nodes = Vec::new();
+        let mut seen = BTreeSet::new();
+        for node in &file.nodes {
+            let anchor = format!("\"{}\"", node.id);
+            if !seen.insert(node.id.clone()) {
+                self.error(
+                    &[&anchor, &anchor],
+                    format!("node id '{}' is used twice", node.id),
+                );
+            }
+            if let Some(built) = self.node(node, &anchor) {
+                nodes.push(built);
+            }
+        }
+        let order = self.order_nodes(&file, &mut nodes);
+        let output = file.nodes.iter().position(|n| n.id == file.output);
+        if output.is_none() {
+            let anchor = format!("\"{}\"", file.output);
+            self.error(
+                &["output", &anchor],
+                format!("output '{}' is not a node of this scene", file.output),
+            );
+        }
+        if !self.errors.is_empty() || nodes.len() != file.nodes.len() {
+            return Err(SceneErrors(self.errors));
+        }
+        // Reorder so that inputs come first; remap input and output indices.
+        let position: BTreeMap<usize, usize> = order
+            .iter()
+            .enumerate()
+            .map(|(new, &old)| (old, new))
+            .collect();
+        let mut ordered: Vec<SceneNode> = order.iter().map(|&i| nodes[i].clone()).collect();
+        for n in &mut ordered {
+            n.inputs = n.inputs.iter().map(|i| position[i]).collect();
+        }
+        let output = position[&output.expect("checked above")];
+        let tracks = self.tracks(&file, &ordered);
+        if !self.errors.is_empty() {
+            return Err(SceneErrors(self.errors));
+        }
+        Ok(Scene {
+            origin: self.origin.into(),
+            name: file.name,
+            description: file.description,
+            size: file.size,
+            seed: file.seed,
+            dt: file.dt,
+            nodes: ordered,
+            output,
+            tracks,
+        })
+    }
+
+    /// Checks one node's technique, params, ranges and input names; input indices refer to the
+    /// file's node order.
+    fn node(&mut self, node: &super::schema::NodeFile, anchor: &str) -> Option<SceneNode> {
+        let Some(technique) = techniques::find(&node.technique) else {
+            let known: Vec<&str> = techniques::REGISTRY.iter().map(|t| t.name).collect();
+            let t_anchor = format!("\"{}\"", node.technique);
+            self.error(
+                &[anchor, &t_anchor],
+                format!(
+                    "unknown technique '{}' (known: {})",
+                    node.technique,
+                    known.join(", ")
+                ),
+            );
+            return None;
+        };
+        let mut decls = (technique.params)();
+        let names: Vec<String> = decls.iter().map(|d| d.name.clone()).collect();
+        for (name, (lo, hi)) in &node.ranges {
+            let key = format!("\"{name}\"");
+            match decls.iter_mut().find(|d| &d.name == name) {
+                None => self.error(
+                    &[anchor, "ranges", &key],
+                    unknown_param(technique, name, &names),
+                ),
+                Some(_) if lo >= hi => self.error(
+                    &[anchor, "ranges", &key],
+                    format!("range of '{name}' is empty: ({lo}, {hi})"),
+                ),
+                Some(d) => d.range = Some((*lo, *hi)),
+            }
+        }
+        for (name, raw) in &node.params {
+            let key = format!("\"{name}\"");
+            let Some(d) = decls.iter_mut().find(|d| &d.name == name) else {
+                self.error(
+                    &[anchor, "params", &key],
+                    unknown_param(technique, name, &names),
+                );
+                continue;
+            };
+            match coerce(raw, d.ty()) {
+                None => self.error(
+                    &[anchor, "params", &key],
+                    format!("'{name}' is a {}, not {}", d.ty(), describe(raw)),
+                ),
+                Some(v) if v.clamped(d.range) != v => self.error(
+                    &[anchor, "params", &key],
+                    format!(
+                        "'{name}' = {} is outside its range {:?}",
+                        describe(raw),
+                        d.range.unwrap_or_default()
+                    ),
+                ),
+                Some(v) => d.default = v,
+            }
+        }
+        for slot in node.inputs.keys() {
+            if !technique.inputs.contains(&slot.as_str()) {
+                let key = format!("\"{slot}\"");
+                self.error(
+                    &[anchor, "inputs", &key],
+                    format!(
+                        "technique '{}' has no input '{slot}' (inputs: {:?})",
+                        technique.name, technique.inputs
+                    ),
+                );
+            }
+        }
+        for slot in technique.inputs {
+            if !node.inputs.contains_key(*slot) {
+                self.error(
+                    &[anchor],
+                    format!(
+                        "node '{}' needs its input '{slot}' wired to a node",
+                        node.id
+                    ),
+                );
+            }
+        }
+        Some(SceneNode {
+            id: node.id.clone(),
+            technique,
+            params: ParamSet::new(decls),
+            inputs: Vec::new(),
+        })
+    }
+
+    /// Resolves input wiring into each node's `inputs` (file indices) and returns the node
+    /// indices in dependency order.
+    fn order_nodes(&mut self, file: &SceneFile, nodes: &mut [SceneNode]) -> Vec<usize> {
+        let identity: Vec<usize> = (0..file.nodes.len()).collect();
+        if nodes.len() != file.nodes.len() {
+            return identity;
+        }
+        let index: BTreeMap<&str, usize> = file
+            .nodes
+            .iter()
+            .enumerate()
+            .map(|(i, n)| (n.id.as_str(), i))
+            .collect();
+        for (i, node) in file.nodes.iter().enumerate() {
+            for slot in nodes[i].technique.inputs {
+                let Some(source) = node.inputs.get(*slot) else {
+                    continue;
+                };
+                match index.get(source.as_str()) {
+                    Some(&j) if j != i => nodes[i].inputs.push(j),
+                    _ => {
+                        let (anchor, s_anchor) =
+                            (format!("\"{}\"", node.id), format!("\"{source}\""));
+                        let message =
+                            format!("input '{slot}' names '{source}', which is not another node");
+                        self.error(&[&anchor, "inputs", &s_anchor], message);
+                    }
+                }
+            }
+        }
+        let mut order = Vec::new();
+        let mut placed = vec![false; nodes.len()];
+        while order.len() < nodes.len() {
+            let ready = (0..nodes.len())
+                .find(|&i| !placed[i] && nodes[i].inputs.iter().all(|&d| placed[d]));
+            let Some(next) = ready else {
+                let stuck: Vec<&str> = (0..nodes.len())
+                    .filter(|&i| !placed[i])
+                    .map(|i| nodes[i].id.as_str())
+                    .collect();
+                self.error(
+                    &["nodes"],
+                    format!("the wiring of nodes {} forms a cycle", stuck.join(", ")),
+                );
+                return identity;
+            };
+            placed[next] = true;
+            order.push(next);
+        }
+        order
+    }
+
+    fn tracks(&mut self, file: &SceneFile, nodes: &[SceneNode]) -> Vec<BoundTrack> {
+        let mut out = Vec::new();
+        for t in &file.tracks {
+            let anchor = format!("\"{}\"", t.target);
+            let anchors = ["tracks", anchor.as_str()];
+            let mut parts = t.target.split('.');
+            let (node_id, param, component) = (
+                parts.next().unwrap_or(""),
+                parts.next().unwrap_or(""),
+                parts.next(),
+            );
+            let Some(node) = nodes.iter().position(|n| n.id == node_id) else {
+                self.error(
+                    &anchors,
+                    format!("track target '{}': no node '{node_id}'", t.target),
+                );
+                continue;
+            };
+            let params = &nodes[node].params;
+            let Some(pi) = params.index(param) else {
+                let names: Vec<String> = params.decls().iter().map(|d| d.name.clone()).collect();
+                self.error(
+                    &anchors,
+                    unknown_param(nodes[node].technique, param, &names),
+                );
+                continue;
+            };
+            let ty = params.decls()[pi].ty();
+            let component = match component.map(|c| component_index(c, ty)) {
+                None => None,
+                Some(Some(c)) => Some(c),
+                Some(None) => {
+                    self.error(
+                        &anchors,
+                        format!(
+                            "track target '{}': a {ty} has no component '{}'",
+                            t.target,
+                            component.unwrap_or("")
+                        ),
+                    );
+                    continue;
+                }
+            };
+            let key_type = if component.is_some() {
+                ParamType::Float
+            } else {
+                ty
+            };
+            if t.keys.is_empty() || !(t.time_scale > 0.0) {
+                self.error(
+                    &anchors,
+                    format!(
+                        "track '{}' needs at least one key and a positive time_scale",
+                        t.target
+                    ),
+                );
+                continue;
+            }
+            let mut keys = Vec::new();
+            for (time, raw) in &t.keys {
+                match coerce(raw, key_type) {
+                    Some(value) => keys.push(Key { time: *time, value }),
+                    None => self.error(
+                        &anchors,
+                        format!(
+                            "track '{}': key at {time} s is {}, expected a {key_type}",
+                            t.target,
+                            describe(raw)
+                        ),
+                    ),
+                }
+            }
+            let track = Track::new(keys, t.interpolation, t.repeat, t.time_scale);
+            out.push(BoundTrack {
+                target: t.target.clone(),
+                node,
+                param: pi,
+                component,
+                track,
+            });
+        }
+        out
+    }
+}
+
+fn unknown_param(technique: &TechniqueInfo, name: &str, known: &[String]) -> String {
+    format!(
+        "technique '{}' has no parameter '{name}' (parameters: {})",
+        technique.name,
+        known.join(", ")
+    )
+}
+
+fn component_index(c: &str, ty: ParamType) -> Option<usize> {
+    let i = match c {
+        "x" | "r" => 0,
+        "y" | "g" => 1,
+        "z" | "b" => 2,
+        "w" | "a" => 3,
+        _ => return None,
+    };
+    (ty.components() > 1 && i < ty.components()).then_some(i)
+}
+
+/// A file value as a typed value: bools only for bool parameters, numbers for the rest.
+fn coerce(raw: &RawValue, ty: ParamType) -> Option<ParamValue> {
+    match (raw, ty) {
+        (RawValue::Bool(b), ParamType::Bool) => Some(ParamValue::Bool(*b)),
+        (RawValue::Bool(_), _) | (_, ParamType::Bool) => None,
+        (raw, ty) => ty.value_from(&raw.numbers()),
+    }
+}
+
+fn describe(raw: &RawValue) -> String {
+    match raw {
+        RawValue::Bool(b) => format!("the bool {b}"),
+        RawValue::Number(x) => format!("the number {x}"),
+        RawValue::List(v) => format!("a list of {} numbers", v.len()),
+    }
+}

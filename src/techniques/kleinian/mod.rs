@@ -1,0 +1,265 @@
+//! Limit sets of Kleinian groups: Jos Leys' escape-time membership test for the Maskit slice,
+//! drawn full-screen by a compute shader, with jittered supersampling and circle inversion.
+//!
+//! Book: [UGP4 ch.2] "Limit sets of Kleinian groups" (fuqunaga). Reference: [Leys] J. Leys,
+//! "A fast algorithm for limit sets of Kleinian groups with the Maskit parametrisation".
+//! Shader: `shaders/kleinian.wgsl`. Goldens: `tests/golden/kleinian*.png`.
+
+pub mod reference;
+
+use std::collections::HashMap;
+
+use crate::gpu::{ComputeKernel, ShaderError};
+use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
+use crate::params::{ParamDecl, ParamSet, ParamValue};
+use crate::time::FrameTime;
+
+use super::{NodeSetup, Technique, TechniqueInfo, srgb_to_linear};
+
+/// The registry entry.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "kleinian",
+    chapter: "2: Limit sets of Kleinian groups",
+    summary: "Jos Leys' escape-time limit set of the Maskit slice, with circle inversion",
+    params,
+    inputs: &[],
+    shaders: &["kleinian.wgsl"],
+    create,
+};
+
+/// The output format: linear HDR so that post effects (StarGlow) can follow.
+pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// Parameters with the book sample's C# defaults (seed-reference §2).
+pub fn params() -> Vec<ParamDecl> {
+    use ParamValue::*;
+    vec![
+        ParamDecl::new(
+            "t",
+            Vec2([2.0, 0.0]),
+            Some((-2.5, 2.5)),
+            "Maskit parameter t = (u, v); (2, 0) is the classic set, near (1.94, 0.02) it turns intricate",
+        ),
+        ParamDecl::new(
+            "iterations",
+            Int(500),
+            Some((1.0, 5000.0)),
+            "escape-time iteration cap per sample",
+        ),
+        ParamDecl::new(
+            "scale",
+            Float(1.0),
+            Some((0.01, 50.0)),
+            "fractal units per output height (zoom out)",
+        ),
+        ParamDecl::new(
+            "offset",
+            Vec2([0.0, 0.0]),
+            Some((-20.0, 20.0)),
+            "fractal position of the bottom-left corner",
+        ),
+        ParamDecl::new(
+            "hit_color",
+            Color([1.0, 0.0, 0.0, 1.0]),
+            None,
+            "colour inside the limit set's disks",
+        ),
+        ParamDecl::new(
+            "back_color",
+            Color([0.5, 0.5, 0.5, 1.0]),
+            None,
+            "background colour",
+        ),
+        ParamDecl::new(
+            "samples",
+            Int(1),
+            Some((1.0, 64.0)),
+            "jittered samples per pixel (anti-aliasing)",
+        ),
+        ParamDecl::new(
+            "circle_inversion",
+            Bool(false),
+            None,
+            "invert the plane in a circle before the test",
+        ),
+        ParamDecl::new(
+            "circle_center",
+            Vec2([0.0, 0.0]),
+            Some((-20.0, 20.0)),
+            "inversion circle centre",
+        ),
+        ParamDecl::new(
+            "circle_radius",
+            Float(1.0),
+            Some((0.01, 20.0)),
+            "inversion circle radius",
+        ),
+    ]
+}
+
+/// The shader's uniform block; layout checked against naga's reflection in the tests.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct KleinianUniforms {
+    /// (u, v).
+    pub t: [f32; 2],
+    /// Fractal units per output height.
+    pub scale: f32,
+    /// Iteration cap.
+    pub iterations: u32,
+    /// Bottom-left corner in fractal units.
+    pub offset: [f32; 2],
+    /// Samples per pixel.
+    pub samples: u32,
+    /// 1 when circle inversion is on.
+    pub inversion: u32,
+    /// Inversion centre.
+    pub circle_center: [f32; 2],
+    /// Inversion radius.
+    pub circle_radius: f32,
+    /// Jitter seed.
+    pub seed: u32,
+    /// Linear hit colour.
+    pub hit_color: [f32; 4],
+    /// Linear background colour.
+    pub back_color: [f32; 4],
+    /// Output size in pixels.
+    pub size: [u32; 2],
+    /// Padding to the WGSL struct's 16-byte alignment.
+    pub _pad: [u32; 2],
+}
+
+impl KleinianUniforms {
+    /// All per-frame precomputation: colours to linear, bools to flags.
+    pub fn from_params(p: &ParamSet, time: &FrameTime, size: (u32, u32)) -> Self {
+        let linear = |c: [f32; 4]| {
+            [
+                srgb_to_linear(c[0]),
+                srgb_to_linear(c[1]),
+                srgb_to_linear(c[2]),
+                c[3],
+            ]
+        };
+        Self {
+            t: p.vec2("t"),
+            scale: p.float("scale"),
+            iterations: p.int("iterations").max(1) as u32,
+            offset: p.vec2("offset"),
+            samples: p.int("samples").max(1) as u32,
+            inversion: u32::from(p.bool("circle_inversion")),
+            circle_center: p.vec2("circle_center"),
+            circle_radius: p.float("circle_radius"),
+            seed: time.seed as u32,
+            hit_color: linear(p.color("hit_color")),
+            back_color: linear(p.color("back_color")),
+            size: [size.0, size.1],
+            _pad: [0; 2],
+        }
+    }
+}
+
+/// A Kleinian limit-set node.
+pub struct Kleinian {
+    kernel: ComputeKernel,
+    layout: wgpu::BindGroupLayout,
+    uniforms: wgpu::Buffer,
+    /// Bind groups by output texture id: steady-state frames create none.
+    bind_groups: HashMap<u64, wgpu::BindGroup>,
+}
+
+fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
+    let device = &setup.gpu.device;
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("kleinian_layout"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: wgpu::BufferSize::new(size_of::<KleinianUniforms>() as u64),
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: OUTPUT_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            },
+        ],
+    });
+    let (origin, source) = setup.shader_source("kleinian.wgsl")?;
+    let kernel = ComputeKernel::new(device, &origin, &source, "render", &[&layout])?;
+    let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("kleinian_uniforms"),
+        size: size_of::<KleinianUniforms>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    Ok(Box::new(Kleinian {
+        kernel,
+        layout,
+        uniforms,
+        bind_groups: HashMap::new(),
+    }))
+}
+
+impl Technique for Kleinian {
+    fn add_passes<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        params: &ParamSet,
+        time: &FrameTime,
+        _inputs: &[TextureHandle],
+    ) -> TextureHandle {
+        let output = graph.create_texture("kleinian/image", TextureDesc::full(OUTPUT_FORMAT));
+        let size = graph.texture_size(output);
+        let uniforms = KleinianUniforms::from_params(params, time, size);
+        graph
+            .add_pass("kleinian/limit_set")
+            .write(output)
+            .record(move |ctx| {
+                ctx.queue
+                    .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
+                let key = ctx.texture_id(output);
+                // Old entries would keep evicted pool textures alive after resizes.
+                if self.bind_groups.len() > 8 && !self.bind_groups.contains_key(&key) {
+                    self.bind_groups.clear();
+                }
+                let bind_group = self.bind_groups.entry(key).or_insert_with(|| {
+                    ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("kleinian_bind_group"),
+                        layout: &self.layout,
+                        entries: &[
+                            wgpu::BindGroupEntry {
+                                binding: 0,
+                                resource: self.uniforms.as_entire_binding(),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 1,
+                                resource: wgpu::BindingResource::TextureView(ctx.view(output)),
+                            },
+                        ],
+                    })
+                });
+                let mut pass = ctx
+                    .encoder
+                    .begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some("kleinian/limit_set"),
+                        timestamp_writes: None,
+                    });
+                self.kernel
+                    .dispatch(&mut pass, &[bind_group], [size.0, size.1, 1]);
+            });
+        output
+    }
+}
+
+#[cfg(test)]
+mod tests;

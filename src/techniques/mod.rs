@@ -1,0 +1,91 @@
+//! One module per book chapter. A technique declares its parameters and inputs, builds its
+//! pipelines once, steps its simulation on the fixed clock and adds passes to the frame graph.
+//! It never owns the frame: no encoders, no submits, no windows, no files beyond its shader.
+//!
+//! To add a technique: write `src/techniques/<name>/`, `shaders/<name>.wgsl` and
+//! `scenes/<name>.ron`, then add its `INFO` to [`REGISTRY`]. Nothing else.
+
+pub mod kleinian;
+
+use crate::assets::{AssetKind, Assets};
+use crate::gpu::{Gpu, ShaderError};
+use crate::graph::{FrameGraph, TextureHandle};
+use crate::params::{ParamDecl, ParamSet};
+use crate::time::FrameTime;
+
+/// Every technique indra knows, by scene name.
+pub const REGISTRY: &[TechniqueInfo] = &[kleinian::INFO];
+
+/// Finds a technique by the name scenes use.
+pub fn find(name: &str) -> Option<&'static TechniqueInfo> {
+    REGISTRY.iter().find(|t| t.name == name)
+}
+
+/// What a technique is, before any instance exists.
+pub struct TechniqueInfo {
+    /// The name scenes use (`technique: "kleinian"`).
+    pub name: &'static str,
+    /// The book chapter it implements.
+    pub chapter: &'static str,
+    /// One sentence on what it draws.
+    pub summary: &'static str,
+    /// Its parameters with defaults and ranges.
+    pub params: fn() -> Vec<ParamDecl>,
+    /// Names of the textures it takes from upstream nodes, in order.
+    pub inputs: &'static [&'static str],
+    /// Shader files it loads (checked by `indra check`).
+    pub shaders: &'static [&'static str],
+    /// Builds an instance (pipelines, persistent resources).
+    pub create: fn(&NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError>,
+}
+
+/// What a technique gets when an instance is created.
+pub struct NodeSetup<'a> {
+    /// The device.
+    pub gpu: &'a Gpu,
+    /// Where to load shaders from.
+    pub assets: &'a Assets,
+    /// The node's id in the scene (for labels).
+    pub id: &'a str,
+    /// The scene's output size.
+    pub output_size: (u32, u32),
+}
+
+impl NodeSetup<'_> {
+    /// Loads a shader file's text and origin, turning a missing file into a located error.
+    pub fn shader_source(&self, file: &str) -> Result<(String, String), ShaderError> {
+        self.assets
+            .load(AssetKind::Shader, file)
+            .map(|a| (a.origin, a.source))
+            .map_err(|message| ShaderError {
+                origin: file.into(),
+                line: 1,
+                column: 1,
+                message,
+            })
+    }
+}
+
+/// A live instance of a technique inside a scene.
+pub trait Technique {
+    /// Advances the simulation by one fixed step (no-op for stateless techniques).
+    fn step(&mut self, _params: &ParamSet, _time: &FrameTime) {}
+
+    /// Adds this frame's passes; returns the texture downstream nodes (or the output) see.
+    fn add_passes<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        params: &ParamSet,
+        time: &FrameTime,
+        inputs: &[TextureHandle],
+    ) -> TextureHandle;
+}
+
+/// Converts one sRGB-encoded channel (as colour pickers and scene files give) to linear.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
