@@ -19,9 +19,7 @@ fn main() {
             })
             .unwrap_or_default();
         names.sort();
-        code.push_str(&format!(
-            "/// Every `{dir}/*.{ext}` at build time: (file name, contents).\n"
-        ));
+        code.push_str(&format!("/// Every `{dir}/*.{ext}` at build time: (file name, contents).\n"));
         code.push_str(&format!("pub const {konst}: &[(&str, &str)] = &[\n"));
         for name in names {
             println!("cargo:rerun-if-changed={dir}/{name}");

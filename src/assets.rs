@@ -71,9 +71,7 @@ impl Assets {
             return Self::new(Some(root.into()));
         }
         let cwd = std::env::current_dir().ok();
-        let candidates = cwd
-            .into_iter()
-            .chain([PathBuf::from(env!("CARGO_MANIFEST_DIR"))]);
+        let candidates = cwd.into_iter().chain([PathBuf::from(env!("CARGO_MANIFEST_DIR"))]);
         for dir in candidates {
             if dir.join("scenes").is_dir() || dir.join("shaders").is_dir() {
                 return Self::new(Some(dir));
@@ -100,21 +98,25 @@ impl Assets {
             let path = dir.join(&file);
             if path.is_file() {
                 return std::fs::read_to_string(&path)
-                    .map(|source| Asset {
-                        name: file.clone(),
-                        origin: path.display().to_string(),
-                        source,
-                    })
+                    .map(|source| Asset { name: file.clone(), origin: path.display().to_string(), source })
                     .map_err(|e| format!("cannot read {}: {e}", path.display()));
             }
         }
         kind.embedded()
             .iter()
             .find(|(n, _)| *n == file)
-            .map(|(n, s)| Asset { name: n.to_string(), origin: format!("<embedded>/{}/{n}", kind.dir()), source: s.to_string() })
+            .map(|(n, s)| Asset {
+                name: n.to_string(),
+                origin: format!("<embedded>/{}/{n}", kind.dir()),
+                source: s.to_string(),
+            })
             .ok_or_else(|| {
-                let place = self.dir(kind).map(|d| d.display().to_string()).unwrap_or_else(|| "no folder on disk".into());
-                format!("no {} named '{file}' (looked in {place} and the built-in copies; `indra list` shows what exists)", kind.dir().trim_end_matches('s'))
+                let place =
+                    self.dir(kind).map(|d| d.display().to_string()).unwrap_or_else(|| "no folder on disk".into());
+                format!(
+                    "no {} named '{file}' (looked in {place} and the built-in copies; `indra list` shows what exists)",
+                    kind.dir().trim_end_matches('s')
+                )
             })
     }
 
@@ -136,11 +138,7 @@ impl Assets {
 }
 
 fn with_ext(name: &str, kind: AssetKind) -> String {
-    if name.ends_with(&format!(".{}", kind.ext())) {
-        name.to_string()
-    } else {
-        format!("{name}.{}", kind.ext())
-    }
+    if name.ends_with(&format!(".{}", kind.ext())) { name.to_string() } else { format!("{name}.{}", kind.ext()) }
 }
 
 #[cfg(test)]
@@ -153,10 +151,7 @@ mod tests {
         std::fs::create_dir_all(tmp.join("shaders")).unwrap();
         std::fs::write(tmp.join("shaders/kleinian.wgsl"), "// on disk").unwrap();
         let assets = Assets::new(Some(tmp.clone()));
-        assert_eq!(
-            assets.load(AssetKind::Shader, "kleinian").unwrap().source,
-            "// on disk"
-        );
+        assert_eq!(assets.load(AssetKind::Shader, "kleinian").unwrap().source, "// on disk");
         let scene = assets.load(AssetKind::Scene, "kleinian").unwrap();
         assert!(scene.origin.starts_with("<embedded>"), "{}", scene.origin);
         let err = assets.load(AssetKind::Scene, "no_such_scene").unwrap_err();

@@ -81,15 +81,8 @@ pub struct BenchArgs {
 }
 
 fn parse_size(text: &str) -> Result<(u32, u32), String> {
-    let (w, h) = text
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("'{text}' is not WxH (e.g. 1920x1080)"))?;
-    let parse = |s: &str| {
-        s.trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|v| (1..=16384).contains(v))
-    };
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(|| format!("'{text}' is not WxH (e.g. 1920x1080)"))?;
+    let parse = |s: &str| s.trim().parse::<u32>().ok().filter(|v| (1..=16384).contains(v));
     match (parse(w), parse(h)) {
         (Some(w), Some(h)) => Ok((w, h)),
         _ => Err(format!("'{text}' is not WxH with sides from 1 to 16384")),
@@ -108,32 +101,24 @@ fn scene_with_sets(assets: &Assets, name: &str, sets: &[String]) -> Result<Scene
 /// Opens the scene in a window.
 pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), String> {
     let scene = scene_with_sets(assets, &args.scene, &args.sets)?;
-    let options = indra::app::WindowOptions {
-        fullscreen: args.fullscreen,
-        monitor: args.monitor,
-    };
+    let options = indra::app::WindowOptions { fullscreen: args.fullscreen, monitor: args.monitor };
     indra::app::run(assets.clone(), gpu.clone(), scene, options)
 }
 
 /// Renders a PNG sequence.
 pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<(), String> {
     let scene = scene_with_sets(assets, &args.scene, &args.sets)?;
-    let stem = Path::new(&args.scene)
-        .file_stem()
-        .map_or("frame".into(), |s| s.to_string_lossy().into_owned());
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    let stem = Path::new(&args.scene).file_stem().map_or("frame".into(), |s| s.to_string_lossy().into_owned());
+    std::fs::create_dir_all(&args.out).map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
     eprintln!("rendering '{}' on {}", scene.name, device.adapter_label());
-    let mut renderer = OffscreenRenderer::new(device, assets, scene, args.size, args.dt, args.seed)
-        .map_err(|e| e.to_string())?;
+    let mut renderer =
+        OffscreenRenderer::new(device, assets, scene, args.size, args.dt, args.seed).map_err(|e| e.to_string())?;
     renderer.seek(args.start);
     let bar = indicatif::ProgressBar::new(args.frames);
     bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}",
-        )
-        .expect("valid template"),
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}")
+            .expect("valid template"),
     );
     for _ in 0..args.frames {
         let frame = renderer.render_next().map_err(|e| e.to_string())?;
@@ -153,39 +138,20 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
 pub fn check(assets: &Assets, files: &[PathBuf]) -> Result<(), String> {
     let mut targets: Vec<(AssetKind, String)> = Vec::new();
     if files.is_empty() {
-        targets.extend(
-            assets
-                .names(AssetKind::Shader)
-                .into_iter()
-                .map(|n| (AssetKind::Shader, n)),
-        );
-        targets.extend(
-            assets
-                .names(AssetKind::Scene)
-                .into_iter()
-                .map(|n| (AssetKind::Scene, n)),
-        );
+        targets.extend(assets.names(AssetKind::Shader).into_iter().map(|n| (AssetKind::Shader, n)));
+        targets.extend(assets.names(AssetKind::Scene).into_iter().map(|n| (AssetKind::Scene, n)));
     } else {
         for f in files {
-            let kind = if f.extension().is_some_and(|e| e == "wgsl") {
-                AssetKind::Shader
-            } else {
-                AssetKind::Scene
-            };
+            let kind = if f.extension().is_some_and(|e| e == "wgsl") { AssetKind::Shader } else { AssetKind::Scene };
             targets.push((kind, f.display().to_string()));
         }
     }
     let mut failures = 0;
     for (kind, name) in &targets {
         let result = match kind {
-            AssetKind::Scene => load_scene(assets, name)
-                .map(|_| ())
-                .map_err(|e| e.to_string()),
-            AssetKind::Shader => read_shader(assets, name).and_then(|(origin, source)| {
-                validate_wgsl(&origin, &source)
-                    .map(|_| ())
-                    .map_err(|e| e.to_string())
-            }),
+            AssetKind::Scene => load_scene(assets, name).map(|_| ()).map_err(|e| e.to_string()),
+            AssetKind::Shader => read_shader(assets, name)
+                .and_then(|(origin, source)| validate_wgsl(&origin, &source).map(|_| ()).map_err(|e| e.to_string())),
         };
         match result {
             Ok(()) => println!("ok     {name}"),
@@ -196,23 +162,15 @@ pub fn check(assets: &Assets, files: &[PathBuf]) -> Result<(), String> {
         }
     }
     println!("{} checked, {failures} with errors", targets.len());
-    if failures > 0 {
-        Err(format!("{failures} file(s) have errors"))
-    } else {
-        Ok(())
-    }
+    if failures > 0 { Err(format!("{failures} file(s) have errors")) } else { Ok(()) }
 }
 
 fn read_shader(assets: &Assets, name: &str) -> Result<(String, String), String> {
     let path = Path::new(name);
     if path.is_file() {
-        return std::fs::read_to_string(path)
-            .map(|s| (name.to_string(), s))
-            .map_err(|e| format!("{name}: {e}"));
+        return std::fs::read_to_string(path).map(|s| (name.to_string(), s)).map_err(|e| format!("{name}: {e}"));
     }
-    assets
-        .load(AssetKind::Shader, name)
-        .map(|a| (a.origin, a.source))
+    assets.load(AssetKind::Shader, name).map(|a| (a.origin, a.source))
 }
 
 /// Lists scenes with their nodes and parameters.
@@ -222,18 +180,12 @@ pub fn list(assets: &Assets) -> Result<(), String> {
             Err(e) => println!("{name}: INVALID\n{e}\n"),
             Ok(scene) => {
                 let stem = name.trim_end_matches(".ron");
-                println!(
-                    "{stem} — {} ({}x{}): {}",
-                    scene.name, scene.size.0, scene.size.1, scene.description
-                );
+                println!("{stem} — {} ({}x{}): {}", scene.name, scene.size.0, scene.size.1, scene.description);
                 for (i, node) in scene.nodes.iter().enumerate() {
                     println!("  node {} ({})", node.id, node.technique.name);
                     for (p, decl) in node.params.decls().iter().enumerate() {
                         let animated = scene.tracks.iter().any(|t| t.node == i && t.param == p);
-                        let range = decl
-                            .range
-                            .map(|(lo, hi)| format!(" [{lo} … {hi}]"))
-                            .unwrap_or_default();
+                        let range = decl.range.map(|(lo, hi)| format!(" [{lo} … {hi}]")).unwrap_or_default();
                         println!(
                             "    /indra/{}/{:<18} {:<6} = {:?}{range}{}",
                             node.id,
@@ -258,8 +210,8 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     let adapter = device.adapter_label();
     let timestamps = device.has_timestamps();
     let name = scene.name.clone();
-    let mut renderer = OffscreenRenderer::new(device, assets, scene, Some(args.size), None, None)
-        .map_err(|e| e.to_string())?;
+    let mut renderer =
+        OffscreenRenderer::new(device, assets, scene, Some(args.size), None, None).map_err(|e| e.to_string())?;
     renderer.instance_mut().animate = !args.no_animation;
     for _ in 0..args.warmup {
         renderer.render_only().map_err(|e| e.to_string())?;
@@ -271,10 +223,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     for _ in 0..args.frames {
         let (_, s) = renderer.render_only().map_err(|e| e.to_string())?;
         // Waiting each frame makes wall time the frame's full latency, not queue depth.
-        let _ = renderer
-            .gpu()
-            .device
-            .poll(wgpu::PollType::wait_indefinitely());
+        let _ = renderer.gpu().device.poll(wgpu::PollType::wait_indefinitely());
         let now = Instant::now();
         walls.push((now - last).as_secs_f64() * 1e3);
         last = now;
@@ -285,10 +234,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     let wall_median = walls.get(walls.len() / 2).copied().unwrap_or(0.0);
     println!("scene      {name}");
     println!("adapter    {adapter}");
-    println!(
-        "size       {}x{}   frames {} (+{} warm-up)",
-        args.size.0, args.size.1, args.frames, args.warmup
-    );
+    println!("size       {}x{}   frames {} (+{} warm-up)", args.size.0, args.size.1, args.frames, args.warmup);
     for s in &args.sets {
         println!("set        {s}");
     }
@@ -303,12 +249,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     } else {
         println!("(this adapter has no TIMESTAMP_QUERY_INSIDE_ENCODERS: wall-clock only)");
     }
-    println!(
-        "{:<28} {:>9.3} ms  ({:.1} fps)",
-        "frame wall time (median)",
-        wall_median,
-        1e3 / wall_median.max(1e-9)
-    );
+    println!("{:<28} {:>9.3} ms  ({:.1} fps)", "frame wall time (median)", wall_median, 1e3 / wall_median.max(1e-9));
     if let Some(s) = stats {
         println!(
             "graph      passes {}/{} executed, transient {} KiB requested / {} KiB allocated, compile {:.1} µs",

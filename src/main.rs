@@ -51,17 +51,13 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,indra=info"))
-        .init();
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,indra=info,wgpu_hal=off")).init();
     let cli = Cli::parse();
     let assets = match cli.root {
         Some(root) => indra::assets::Assets::new(Some(root)),
         None => indra::assets::Assets::discover(),
     };
-    let gpu = indra::gpu::GpuOptions {
-        backend: cli.gpu.backend,
-        adapter: cli.gpu.adapter,
-    };
+    let gpu = indra::gpu::GpuOptions { backend: cli.gpu.backend, adapter: cli.gpu.adapter };
     let result = match cli.command {
         None => commands::run(&assets, &gpu, &commands::RunArgs::default()),
         Some(Command::Run(args)) => commands::run(&assets, &gpu, &args),

@@ -29,22 +29,12 @@ pub const MAX_CATCH_UP_STEPS: u32 = 4;
 impl FixedClock {
     /// A clock at frame 0.
     pub fn new(dt: f32, seed: u64) -> Self {
-        Self {
-            dt: dt.max(1e-6),
-            seed,
-            frame: 0,
-            pending: 0.0,
-        }
+        Self { dt: dt.max(1e-6), seed, frame: 0, pending: 0.0 }
     }
 
     /// The current frame's time.
     pub fn now(&self) -> FrameTime {
-        FrameTime {
-            frame: self.frame,
-            seconds: self.frame as f64 * f64::from(self.dt),
-            dt: self.dt,
-            seed: self.seed,
-        }
+        FrameTime { frame: self.frame, seconds: self.frame as f64 * f64::from(self.dt), dt: self.dt, seed: self.seed }
     }
 
     /// Advances exactly one step (off-screen rendering).
@@ -81,11 +71,7 @@ mod tests {
         assert_eq!(c.accumulate(0.025), 2);
         assert_eq!(c.accumulate(0.006), 1); // 0.005 left over + 0.006
         assert_eq!(c.accumulate(10.0), MAX_CATCH_UP_STEPS);
-        assert_eq!(
-            c.accumulate(0.0),
-            0,
-            "a long stall is dropped, not replayed"
-        );
+        assert_eq!(c.accumulate(0.0), 0, "a long stall is dropped, not replayed");
     }
 
     #[test]
@@ -94,14 +80,6 @@ mod tests {
         for _ in 0..3 {
             c.step();
         }
-        assert_eq!(
-            c.now(),
-            FrameTime {
-                frame: 3,
-                seconds: 1.5,
-                dt: 0.5,
-                seed: 1
-            }
-        );
+        assert_eq!(c.now(), FrameTime { frame: 3, seconds: 1.5, dt: 0.5, seed: 1 });
     }
 }

@@ -1,6 +1,6 @@
 //! The windowed runtime: a winit event loop, a wgpu surface, the scene drawn full-window on a
 //! fixed-step clock, and an egui overlay with the generated parameter panel, pass timings and
-//! errors. F11 toggles fullscreen, Esc leaves it (never the show), Tab hides the panel.
+//! errors. F11 toggles fullscreen, Esc leaves it (never the show), F1 hides the panel.
 
 mod panel;
 mod window;
@@ -19,18 +19,13 @@ pub struct WindowOptions {
 }
 
 /// Opens `scene` in a window and runs until the window is closed.
-pub fn run(
-    assets: Assets,
-    gpu: GpuOptions,
-    scene: Scene,
-    options: WindowOptions,
-) -> Result<(), String> {
+pub fn run(assets: Assets, gpu: GpuOptions, scene: Scene, options: WindowOptions) -> Result<(), String> {
     let event_loop = winit::event_loop::EventLoop::new().map_err(|e| {
-        format!("cannot open a window ({e}); on a machine without a display use `indra render`, or run under `xvfb-run`")
+        format!(
+            "cannot open a window ({e}); on a machine without a display use `indra render`, or run under `xvfb-run`"
+        )
     })?;
     let mut app = window::WindowApp::new(assets, gpu, scene, options);
-    event_loop
-        .run_app(&mut app)
-        .map_err(|e| format!("the window's event loop failed: {e}"))?;
+    event_loop.run_app(&mut app).map_err(|e| format!("the window's event loop failed: {e}"))?;
     app.into_result()
 }

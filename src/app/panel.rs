@@ -8,7 +8,7 @@ use crate::time::FrameTime;
 
 /// What the overlay shows besides parameters.
 pub struct Overlay {
-    /// Whether the side panel is shown (Tab toggles).
+    /// Whether the side panel is shown (F1 toggles).
     pub panel_visible: bool,
     /// Last frame's graph stats.
     pub stats: Option<FrameStats>,
@@ -20,12 +20,7 @@ pub struct Overlay {
 
 impl Default for Overlay {
     fn default() -> Self {
-        Self {
-            panel_visible: true,
-            stats: None,
-            timings: Vec::new(),
-            errors: Vec::new(),
-        }
+        Self { panel_visible: true, stats: None, timings: Vec::new(), errors: Vec::new() }
     }
 }
 
@@ -43,46 +38,29 @@ impl Overlay {
 }
 
 /// Draws the whole overlay for one frame.
-pub fn draw_ui(
-    ui: &mut egui::Ui,
-    instance: &mut SceneInstance,
-    overlay: &mut Overlay,
-    time: FrameTime,
-) {
+pub fn draw_ui(ui: &mut egui::Ui, instance: &mut SceneInstance, overlay: &mut Overlay, time: FrameTime) {
     if overlay.panel_visible {
-        egui::Panel::left("indra_params")
-            .resizable(true)
-            .default_size(300.0)
-            .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| {
-                    ui.heading(&instance.scene().name);
-                    ui.label(format!("t = {:.2} s   frame {}", time.seconds, time.frame));
-                    ui.checkbox(&mut instance.animate, "play animation tracks");
-                    param_panel(ui, instance);
-                    ui.separator();
-                    timing_panel(ui, overlay);
-                    ui.small("Tab: hide panel · F11: fullscreen · Esc: leave fullscreen");
-                });
+        egui::Panel::left("indra_params").resizable(true).default_size(300.0).show(ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                ui.heading(&instance.scene().name);
+                ui.label(format!("t = {:.2} s   frame {}", time.seconds, time.frame));
+                ui.checkbox(&mut instance.animate, "play animation tracks");
+                param_panel(ui, instance);
+                ui.separator();
+                timing_panel(ui, overlay);
+                ui.small("F1: hide panel · F11: fullscreen · Esc: leave fullscreen");
             });
+        });
     }
     if !overlay.errors.is_empty() {
         let mut dismiss = false;
-        egui::Window::new("errors")
-            .anchor(egui::Align2::RIGHT_BOTTOM, [-8.0, -8.0])
-            .show(ui.ctx(), |ui| {
-                for (message, count) in &overlay.errors {
-                    let suffix = if *count > 1 {
-                        format!("  (×{count})")
-                    } else {
-                        String::new()
-                    };
-                    ui.colored_label(
-                        egui::Color32::from_rgb(255, 110, 110),
-                        format!("{message}{suffix}"),
-                    );
-                }
-                dismiss = ui.button("dismiss").clicked();
-            });
+        egui::Window::new("errors").anchor(egui::Align2::RIGHT_BOTTOM, [-8.0, -8.0]).show(ui.ctx(), |ui| {
+            for (message, count) in &overlay.errors {
+                let suffix = if *count > 1 { format!("  (×{count})") } else { String::new() };
+                ui.colored_label(egui::Color32::from_rgb(255, 110, 110), format!("{message}{suffix}"));
+            }
+            dismiss = ui.button("dismiss").clicked();
+        });
         if dismiss {
             overlay.errors.clear();
         }
@@ -91,33 +69,27 @@ pub fn draw_ui(
 
 fn param_panel(ui: &mut egui::Ui, instance: &mut SceneInstance) {
     for node in 0..instance.scene().nodes.len() {
-        let header = format!(
-            "{} ({})",
-            instance.scene().nodes[node].id,
-            instance.scene().nodes[node].technique.name
-        );
-        egui::CollapsingHeader::new(header)
-            .default_open(true)
-            .show(ui, |ui| {
-                let count = instance.params(node).decls().len();
-                for p in 0..count {
-                    let animated = instance.is_animated(node, p);
-                    let decl = instance.params(node).decls()[p].clone();
-                    let mut value = instance.params(node).value_at(p);
-                    let changed = ui
-                        .add_enabled_ui(!animated, |ui| {
-                            ui.horizontal(|ui| {
-                                ui.label(&decl.name).on_hover_text(&decl.doc);
-                                param_widget(ui, &decl, &mut value)
-                            })
-                            .inner
+        let header = format!("{} ({})", instance.scene().nodes[node].id, instance.scene().nodes[node].technique.name);
+        egui::CollapsingHeader::new(header).default_open(true).show(ui, |ui| {
+            let count = instance.params(node).decls().len();
+            for p in 0..count {
+                let animated = instance.is_animated(node, p);
+                let decl = instance.params(node).decls()[p].clone();
+                let mut value = instance.params(node).value_at(p);
+                let changed = ui
+                    .add_enabled_ui(!animated, |ui| {
+                        ui.horizontal(|ui| {
+                            ui.label(&decl.name).on_hover_text(&decl.doc);
+                            param_widget(ui, &decl, &mut value)
                         })
-                        .inner;
-                    if changed {
-                        instance.params_mut(node).set_at(p, value);
-                    }
+                        .inner
+                    })
+                    .inner;
+                if changed {
+                    instance.params_mut(node).set_at(p, value);
                 }
-            });
+            }
+        });
     }
 }
 
@@ -125,35 +97,28 @@ fn param_panel(ui: &mut egui::Ui, instance: &mut SceneInstance) {
 fn param_widget(ui: &mut egui::Ui, decl: &ParamDecl, value: &mut ParamValue) -> bool {
     let (lo, hi) = decl.range.unwrap_or((-1e6, 1e6));
     match value {
-        ParamValue::Float(x) => ui
-            .add(egui::Slider::new(x, lo..=hi).suffix(&decl.unit))
-            .changed(),
-        ParamValue::Int(i) => ui
-            .add(egui::Slider::new(i, lo as i32..=hi as i32))
-            .changed(),
+        // Wide positive ranges (zoom, radius) need a logarithmic slider to be playable.
+        ParamValue::Float(x) => {
+            ui.add(egui::Slider::new(x, lo..=hi).logarithmic(lo > 0.0 && hi / lo >= 100.0).suffix(&decl.unit)).changed()
+        }
+        ParamValue::Int(i) => ui.add(egui::Slider::new(i, lo as i32..=hi as i32)).changed(),
         ParamValue::Bool(b) => ui.checkbox(b, "").changed(),
         ParamValue::Vec2(v) => {
             let pad = vec2_pad(ui, v, (lo, hi));
-            let a = ui
-                .add(egui::DragValue::new(&mut v[0]).speed(0.001).range(lo..=hi))
-                .changed();
-            let b = ui
-                .add(egui::DragValue::new(&mut v[1]).speed(0.001).range(lo..=hi))
-                .changed();
+            let a = ui.add(egui::DragValue::new(&mut v[0]).speed(0.001).range(lo..=hi)).changed();
+            let b = ui.add(egui::DragValue::new(&mut v[1]).speed(0.001).range(lo..=hi)).changed();
             pad || a || b
         }
-        ParamValue::Vec3(v) => v.iter_mut().fold(false, |c, x| {
-            ui.add(egui::DragValue::new(x).speed(0.01)).changed() || c
-        }),
-        ParamValue::Vec4(v) => v.iter_mut().fold(false, |c, x| {
-            ui.add(egui::DragValue::new(x).speed(0.01)).changed() || c
-        }),
+        ParamValue::Vec3(v) => {
+            v.iter_mut().fold(false, |c, x| ui.add(egui::DragValue::new(x).speed(0.01)).changed() || c)
+        }
+        ParamValue::Vec4(v) => {
+            v.iter_mut().fold(false, |c, x| ui.add(egui::DragValue::new(x).speed(0.01)).changed() || c)
+        }
         ParamValue::Color(c) => {
             // Scene colours are sRGB-encoded, as the picker's bytes are.
             let mut bytes = c.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u8);
-            let changed = ui
-                .color_edit_button_srgba_unmultiplied(&mut bytes)
-                .changed();
+            let changed = ui.color_edit_button_srgba_unmultiplied(&mut bytes).changed();
             if changed {
                 *c = bytes.map(|b| f32::from(b) / 255.0);
             }
@@ -168,10 +133,7 @@ fn vec2_pad(ui: &mut egui::Ui, v: &mut [f32; 2], (lo, hi): (f32, f32)) -> bool {
     let painter = ui.painter_at(rect);
     painter.rect_filled(rect, 3.0, ui.visuals().extreme_bg_color);
     let to_unit = |x: f32| ((x - lo) / (hi - lo)).clamp(0.0, 1.0);
-    let dot = egui::pos2(
-        rect.left() + to_unit(v[0]) * rect.width(),
-        rect.bottom() - to_unit(v[1]) * rect.height(),
-    );
+    let dot = egui::pos2(rect.left() + to_unit(v[0]) * rect.width(), rect.bottom() - to_unit(v[1]) * rect.height());
     painter.circle_filled(dot, 3.0, ui.visuals().strong_text_color());
     match response.interact_pointer_pos() {
         Some(p) if response.dragged() => {

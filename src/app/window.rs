@@ -45,20 +45,8 @@ pub struct WindowApp {
 
 impl WindowApp {
     /// A handler that will show `scene`.
-    pub fn new(
-        assets: Assets,
-        gpu_options: GpuOptions,
-        scene: Scene,
-        options: WindowOptions,
-    ) -> Self {
-        Self {
-            assets,
-            gpu_options,
-            scene: Some(scene),
-            options,
-            running: None,
-            failure: None,
-        }
+    pub fn new(assets: Assets, gpu_options: GpuOptions, scene: Scene, options: WindowOptions) -> Self {
+        Self { assets, gpu_options, scene: Some(scene), options, running: None, failure: None }
     }
 
     /// Ok when the window was closed normally, or why it could not run.
@@ -71,38 +59,21 @@ impl WindowApp {
         let attributes = Window::default_attributes()
             .with_title(format!("indra — {}", scene.name))
             .with_inner_size(winit::dpi::PhysicalSize::new(scene.size.0, scene.size.1));
-        let window = Arc::new(
-            event_loop
-                .create_window(attributes)
-                .map_err(|e| format!("cannot create a window: {e}"))?,
-        );
+        let window =
+            Arc::new(event_loop.create_window(attributes).map_err(|e| format!("cannot create a window: {e}"))?);
         if self.options.fullscreen {
-            window.set_fullscreen(Some(fullscreen_on(
-                event_loop,
-                &window,
-                self.options.monitor,
-            )));
+            window.set_fullscreen(Some(fullscreen_on(event_loop, &window, self.options.monitor)));
         }
         let mut desc = crate::gpu::instance_descriptor(self.gpu_options.backend);
         desc.display = Some(Box::new(event_loop.owned_display_handle()));
         let wgpu_instance = wgpu::Instance::new(desc);
-        let surface = wgpu_instance
-            .create_surface(window.clone())
-            .map_err(|e| format!("cannot draw into the window: {e}"))?;
-        let gpu = pollster::block_on(Gpu::with_instance(
-            wgpu_instance,
-            &self.gpu_options,
-            Some(&surface),
-        ))
-        .map_err(|e| e.to_string())?;
+        let surface =
+            wgpu_instance.create_surface(window.clone()).map_err(|e| format!("cannot draw into the window: {e}"))?;
+        let gpu = pollster::block_on(Gpu::with_instance(wgpu_instance, &self.gpu_options, Some(&surface)))
+            .map_err(|e| e.to_string())?;
         let caps = surface.get_capabilities(&gpu.adapter);
         // egui and our display encode both write sRGB bytes themselves: use a non-sRGB format.
-        let format = caps
-            .formats
-            .iter()
-            .copied()
-            .find(|f| !f.is_srgb())
-            .unwrap_or(caps.formats[0]);
+        let format = caps.formats.iter().copied().find(|f| !f.is_srgb()).unwrap_or(caps.formats[0]);
         let size = window.inner_size();
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -116,12 +87,7 @@ impl WindowApp {
             view_formats: vec![],
         };
         surface.configure(&gpu.device, &config);
-        log::info!(
-            "window {}x{} on {}",
-            config.width,
-            config.height,
-            gpu.adapter_label()
-        );
+        log::info!("window {}x{} on {}", config.width, config.height, gpu.adapter_label());
         for (i, m) in event_loop.available_monitors().enumerate() {
             log::info!("monitor {i}: {}", m.name().unwrap_or_default());
         }
@@ -140,8 +106,7 @@ impl WindowApp {
             None,
             Some(max_side),
         );
-        let egui_renderer =
-            egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
+        let egui_renderer = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
         Ok(Running {
             window,
             surface,
@@ -159,17 +124,10 @@ impl WindowApp {
     }
 }
 
-fn fullscreen_on(
-    event_loop: &ActiveEventLoop,
-    window: &Window,
-    monitor: Option<usize>,
-) -> Fullscreen {
+fn fullscreen_on(event_loop: &ActiveEventLoop, window: &Window, monitor: Option<usize>) -> Fullscreen {
     let chosen = monitor.and_then(|i| event_loop.available_monitors().nth(i));
     if monitor.is_some() && chosen.is_none() {
-        log::warn!(
-            "no monitor {}; using the window's own",
-            monitor.unwrap_or_default()
-        );
+        log::warn!("no monitor {}; using the window's own", monitor.unwrap_or_default());
     }
     Fullscreen::Borderless(chosen.or_else(|| window.current_monitor()))
 }
@@ -204,31 +162,22 @@ impl ApplicationHandler for WindowApp {
                 r.surface.configure(&r.gpu.device, &r.config);
             }
             WindowEvent::KeyboardInput {
-                event:
-                    KeyEvent {
-                        logical_key,
-                        state: ElementState::Pressed,
-                        repeat: false,
-                        ..
-                    },
+                event: KeyEvent { logical_key: Key::Named(key), state: ElementState::Pressed, repeat: false, .. },
                 ..
-            } if !consumed => {
-                match logical_key {
-                    Key::Named(NamedKey::F11) => {
-                        let next = match r.window.fullscreen() {
-                            Some(_) => None,
-                            None => {
-                                Some(fullscreen_on(event_loop, &r.window, self.options.monitor))
-                            }
-                        };
-                        r.window.set_fullscreen(next);
-                    }
-                    // Esc leaves fullscreen and nothing else: a stray key must not end a show.
-                    Key::Named(NamedKey::Escape) => r.window.set_fullscreen(None),
-                    Key::Named(NamedKey::Tab) => r.overlay.panel_visible = !r.overlay.panel_visible,
-                    _ => {}
+            } => match key {
+                // Function keys work even while a slider has keyboard focus.
+                NamedKey::F11 => {
+                    let next = match r.window.fullscreen() {
+                        Some(_) => None,
+                        None => Some(fullscreen_on(event_loop, &r.window, self.options.monitor)),
+                    };
+                    r.window.set_fullscreen(next);
                 }
-            }
+                NamedKey::F1 => r.overlay.panel_visible = !r.overlay.panel_visible,
+                // Esc leaves fullscreen and nothing else: a stray key must not end a show.
+                NamedKey::Escape if !consumed => r.window.set_fullscreen(None),
+                _ => {}
+            },
             WindowEvent::RedrawRequested => {
                 r.frame();
                 r.window.request_redraw();
@@ -249,8 +198,7 @@ impl Running {
             self.clock.step();
         }
         let frame = match self.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(f)
-            | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            wgpu::CurrentSurfaceTexture::Success(f) | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
                 self.surface.configure(&self.gpu.device, &self.config);
                 return;
@@ -262,17 +210,10 @@ impl Running {
         };
         let target = frame.texture.create_view(&Default::default());
         let size = (self.config.width, self.config.height);
-        let mut encoder = self
-            .gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("window_frame"),
-            });
+        let mut encoder =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("window_frame") });
         let time = self.clock.now();
-        match self
-            .instance
-            .encode(&self.gpu, &mut self.runtime, &mut encoder, size, &time)
-        {
+        match self.instance.encode(&self.gpu, &mut self.runtime, &mut encoder, size, &time) {
             Ok(output) => {
                 self.blit.record(
                     &self.gpu.device,
@@ -292,9 +233,7 @@ impl Running {
         }
         self.overlay.timings = self.runtime.timings();
         let extra = self.draw_overlay(&mut encoder, &target, size);
-        self.gpu
-            .queue
-            .submit(extra.into_iter().chain([encoder.finish()]));
+        self.gpu.queue.submit(extra.into_iter().chain([encoder.finish()]));
         self.runtime.after_submit();
         self.window.pre_present_notify();
         self.gpu.queue.present(frame);
@@ -310,23 +249,19 @@ impl Running {
         let input = self.egui_state.take_egui_input(&self.window);
         let ctx = self.egui_state.egui_ctx().clone();
         let (instance, overlay, clock) = (&mut self.instance, &mut self.overlay, &self.clock);
-        let output = ctx.run_ui(input, |ui| draw_ui(ui, instance, overlay, clock.now()));
-        self.egui_state
-            .handle_platform_output(&self.window, output.platform_output);
+        let mut output = ctx.run_ui(input, |ui| draw_ui(ui, instance, overlay, clock.now()));
+        self.egui_state.handle_platform_output(&self.window, output.platform_output);
         let primitives = ctx.tessellate(output.shapes, output.pixels_per_point);
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
-        for (id, deltas) in &output.textures_delta.set {
-            for delta in deltas {
-                self.egui_renderer.update_texture(device, queue, *id, delta);
+        // egui asserts that every delta is consumed: drain, never just read.
+        for (id, deltas) in output.textures_delta.set.drain() {
+            for delta in &deltas {
+                self.egui_renderer.update_texture(device, queue, id, delta);
             }
         }
-        let screen = egui_wgpu::ScreenDescriptor {
-            size_in_pixels: [size.0, size.1],
-            pixels_per_point: output.pixels_per_point,
-        };
-        let extra = self
-            .egui_renderer
-            .update_buffers(device, queue, encoder, &primitives, &screen);
+        let screen =
+            egui_wgpu::ScreenDescriptor { size_in_pixels: [size.0, size.1], pixels_per_point: output.pixels_per_point };
+        let extra = self.egui_renderer.update_buffers(device, queue, encoder, &primitives, &screen);
         {
             let mut pass = encoder
                 .begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -335,18 +270,15 @@ impl Running {
                         view: target,
                         depth_slice: None,
                         resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Load,
-                            store: wgpu::StoreOp::Store,
-                        },
+                        ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
                     })],
                     ..Default::default()
                 })
                 .forget_lifetime();
             self.egui_renderer.render(&mut pass, &primitives, &screen);
         }
-        for id in &output.textures_delta.free {
-            self.egui_renderer.free_texture(id);
+        for id in output.textures_delta.free.drain() {
+            self.egui_renderer.free_texture(&id);
         }
         extra
     }

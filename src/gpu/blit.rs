@@ -18,8 +18,8 @@ pub struct Blit {
 impl Blit {
     /// Builds the shader module and layout; pipelines are made per target format on first use.
     pub fn new(device: &wgpu::Device) -> Self {
-        let (module, _) = super::compile_wgsl(device, "<engine>/display.wgsl", SOURCE)
-            .expect("built-in display shader is valid");
+        let (module, _) =
+            super::compile_wgsl(device, "<engine>/display.wgsl", SOURCE).expect("built-in display shader is valid");
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("display_layout"),
             entries: &[
@@ -51,12 +51,7 @@ impl Blit {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Self {
-            layout,
-            module,
-            pipelines: HashMap::new(),
-            uniform,
-        }
+        Self { layout, module, pipelines: HashMap::new(), uniform }
     }
 
     /// Records a pass that draws `source` over the whole of `target` (of `size` and `format`).
@@ -70,24 +65,14 @@ impl Blit {
         format: wgpu::TextureFormat,
         size: (u32, u32),
     ) {
-        queue.write_buffer(
-            &self.uniform,
-            0,
-            bytemuck::cast_slice(&[size.0, size.1, 0, 0]),
-        );
+        queue.write_buffer(&self.uniform, 0, bytemuck::cast_slice(&[size.0, size.1, 0, 0]));
         let pipeline = self.pipeline(device, format).clone();
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("display_bind_group"),
             layout: &self.layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(source),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: self.uniform.as_entire_binding(),
-                },
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(source) },
+                wgpu::BindGroupEntry { binding: 1, resource: self.uniform.as_entire_binding() },
             ],
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -96,10 +81,7 @@ impl Blit {
                 view: target,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
             })],
             ..Default::default()
         });
@@ -108,11 +90,7 @@ impl Blit {
         pass.draw(0..3, 0..1);
     }
 
-    fn pipeline(
-        &mut self,
-        device: &wgpu::Device,
-        format: wgpu::TextureFormat,
-    ) -> &wgpu::RenderPipeline {
+    fn pipeline(&mut self, device: &wgpu::Device, format: wgpu::TextureFormat) -> &wgpu::RenderPipeline {
         let (layout, module) = (&self.layout, &self.module);
         self.pipelines.entry(format).or_insert_with(|| {
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

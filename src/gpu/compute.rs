@@ -21,20 +21,17 @@ impl ComputeKernel {
         layouts: &[&wgpu::BindGroupLayout],
     ) -> Result<Self, ShaderError> {
         let (shader, module) = compile_wgsl(device, origin, source)?;
-        let workgroup_size = module
-            .entry_points
-            .iter()
-            .find(|e| e.name == entry)
-            .map(|e| e.workgroup_size)
-            .ok_or_else(|| ShaderError {
-                origin: origin.into(),
-                line: 1,
-                column: 1,
-                message: format!("no compute entry point named '{entry}'"),
+        let workgroup_size =
+            module.entry_points.iter().find(|e| e.name == entry).map(|e| e.workgroup_size).ok_or_else(|| {
+                ShaderError {
+                    origin: origin.into(),
+                    line: 1,
+                    column: 1,
+                    message: format!("no compute entry point named '{entry}'"),
+                }
             })?;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let bind_group_layouts: Vec<Option<&wgpu::BindGroupLayout>> =
-            layouts.iter().map(|l| Some(*l)).collect();
+        let bind_group_layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(*l)).collect();
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(origin),
             bind_group_layouts: &bind_group_layouts,
@@ -49,17 +46,9 @@ impl ComputeKernel {
             cache: None,
         });
         match pollster::block_on(scope.pop()) {
-            None => Ok(Self {
-                pipeline,
-                workgroup_size,
-            }),
+            None => Ok(Self { pipeline, workgroup_size }),
             // naga accepted it but the pipeline did not (e.g. bindings differ from the layout).
-            Some(e) => Err(ShaderError {
-                origin: origin.into(),
-                line: 1,
-                column: 1,
-                message: e.to_string(),
-            }),
+            Some(e) => Err(ShaderError { origin: origin.into(), line: 1, column: 1, message: e.to_string() }),
         }
     }
 
@@ -69,12 +58,7 @@ impl ComputeKernel {
     }
 
     /// Records a dispatch covering `threads` with `bind_groups` bound in order.
-    pub fn dispatch(
-        &self,
-        pass: &mut wgpu::ComputePass<'_>,
-        bind_groups: &[&wgpu::BindGroup],
-        threads: [u32; 3],
-    ) {
+    pub fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, bind_groups: &[&wgpu::BindGroup], threads: [u32; 3]) {
         pass.set_pipeline(&self.pipeline);
         for (i, group) in bind_groups.iter().enumerate() {
             pass.set_bind_group(i as u32, *group, &[]);

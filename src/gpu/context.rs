@@ -84,8 +84,7 @@ impl Gpu {
         let adapter = pick_adapter(&instance, options, surface).await?;
         let info = adapter.get_info();
         // Timestamps are optional: used for per-pass timing when the adapter has them.
-        let wanted =
-            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let required_features = adapter.features() & wanted;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
@@ -95,10 +94,7 @@ impl Gpu {
                 ..Default::default()
             })
             .await
-            .map_err(|e| GpuError::Device {
-                adapter: info.name.clone(),
-                reason: e.to_string(),
-            })?;
+            .map_err(|e| GpuError::Device { adapter: info.name.clone(), reason: e.to_string() })?;
         let uncaptured = Arc::new(Mutex::new(Vec::new()));
         let sink = uncaptured.clone();
         device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
@@ -110,19 +106,8 @@ impl Gpu {
                 list.drain(..excess);
             }
         }));
-        log::info!(
-            "adapter: {} ({:?}, {:?})",
-            info.name,
-            info.backend,
-            info.device_type
-        );
-        Ok(Self {
-            instance,
-            adapter,
-            device,
-            queue,
-            uncaptured,
-        })
+        log::debug!("adapter: {} ({:?}, {:?})", info.name, info.backend, info.device_type);
+        Ok(Self { instance, adapter, device, queue, uncaptured })
     }
 
     /// "name (backend)" of the adapter, for logs, reports and golden file names.
@@ -133,17 +118,12 @@ impl Gpu {
 
     /// Whether per-pass GPU timestamps can be recorded.
     pub fn has_timestamps(&self) -> bool {
-        self.device
-            .features()
-            .contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
+        self.device.features().contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
     }
 
     /// Takes the errors wgpu reported outside error scopes since the last call.
     pub fn take_uncaptured_errors(&self) -> Vec<String> {
-        self.uncaptured
-            .lock()
-            .map(|mut l| std::mem::take(&mut *l))
-            .unwrap_or_default()
+        self.uncaptured.lock().map(|mut l| std::mem::take(&mut *l)).unwrap_or_default()
     }
 }
 
@@ -164,29 +144,18 @@ async fn pick_adapter(
     surface: Option<&wgpu::Surface<'_>>,
 ) -> Result<wgpu::Adapter, GpuError> {
     let all = instance.enumerate_adapters(wgpu::Backends::all()).await;
-    let usable: Vec<wgpu::Adapter> = all
-        .into_iter()
-        .filter(|a| surface.is_none_or(|s| a.is_surface_supported(s)))
-        .collect();
+    let usable: Vec<wgpu::Adapter> =
+        all.into_iter().filter(|a| surface.is_none_or(|s| a.is_surface_supported(s))).collect();
     if usable.is_empty() {
-        return Err(GpuError::NoAdapter {
-            backend: options.backend,
-        });
+        return Err(GpuError::NoAdapter { backend: options.backend });
     }
     if let Some(wanted) = &options.adapter {
         let lower = wanted.to_lowercase();
-        let found = usable
-            .iter()
-            .map(|a| a.get_info().name)
-            .collect::<Vec<_>>()
-            .join(", ");
+        let found = usable.iter().map(|a| a.get_info().name).collect::<Vec<_>>().join(", ");
         return usable
             .into_iter()
             .find(|a| a.get_info().name.to_lowercase().contains(&lower))
-            .ok_or(GpuError::NoMatchingAdapter {
-                wanted: wanted.clone(),
-                found,
-            });
+            .ok_or(GpuError::NoMatchingAdapter { wanted: wanted.clone(), found });
     }
     // Prefer a real GPU over a software one; among equals keep wgpu's order (Vulkan first).
     let rank = |a: &wgpu::Adapter| match a.get_info().device_type {

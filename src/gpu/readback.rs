@@ -2,24 +2,18 @@
 
 /// Reads an `Rgba8Unorm` (or `Bgra8Unorm`, returned as stored) texture into tightly packed rows.
 /// Blocks until the GPU is done; for tests, exports and screenshots, not for the frame loop.
-pub fn read_texture_rgba8(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    texture: &wgpu::Texture,
-) -> Vec<u8> {
+pub fn read_texture_rgba8(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) -> Vec<u8> {
     let (width, height) = (texture.width(), texture.height());
     let tight = width * 4;
-    let padded =
-        tight.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let padded = tight.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback_buffer"),
         size: u64::from(padded) * u64::from(height),
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
-    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-        label: Some("readback_encoder"),
-    });
+    let mut encoder =
+        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback_encoder") });
     encoder.copy_texture_to_buffer(
         texture.as_image_copy(),
         wgpu::TexelCopyBufferInfo {
@@ -34,12 +28,8 @@ pub fn read_texture_rgba8(
     );
     queue.submit([encoder.finish()]);
     let slice = buffer.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |r| {
-        r.expect("readback buffer mapping failed")
-    });
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .expect("device lost during readback");
+    slice.map_async(wgpu::MapMode::Read, |r| r.expect("readback buffer mapping failed"));
+    device.poll(wgpu::PollType::wait_indefinitely()).expect("device lost during readback");
     let mapped = slice.get_mapped_range().expect("readback range is mapped");
     let mut out = Vec::with_capacity((tight * height) as usize);
     for row in mapped.chunks(padded as usize) {

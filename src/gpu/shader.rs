@@ -18,11 +18,7 @@ pub struct ShaderError {
 
 impl fmt::Display for ShaderError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{}:{}:{}: {}",
-            self.origin, self.line, self.column, self.message
-        )
+        write!(f, "{}:{}:{}: {}", self.origin, self.line, self.column, self.message)
     }
 }
 
@@ -31,33 +27,23 @@ impl std::error::Error for ShaderError {}
 /// Parses and validates WGSL with naga; the module is returned for reflection.
 pub fn validate_wgsl(origin: &str, source: &str) -> Result<naga::Module, ShaderError> {
     let module = naga::front::wgsl::parse_str(source).map_err(|e| {
-        let (line, column) = e
-            .location(source)
-            .map(|l| (l.line_number, l.line_position))
-            .unwrap_or((1, 1));
-        let labels: Vec<String> = e
-            .labels()
-            .filter(|(_, l)| !l.is_empty())
-            .map(|(_, l)| l.to_string())
-            .collect();
+        let (line, column) = e.location(source).map(|l| (l.line_number, l.line_position)).unwrap_or((1, 1));
+        let labels: Vec<String> = e.labels().filter(|(_, l)| !l.is_empty()).map(|(_, l)| l.to_string()).collect();
         let mut message = e.message().to_string();
         if !labels.is_empty() {
             message = format!("{message} ({})", labels.join("; "));
         }
-        ShaderError {
-            origin: origin.to_string(),
-            line,
-            column,
-            message,
-        }
+        ShaderError { origin: origin.to_string(), line, column, message }
     })?;
-    let mut validator = naga::valid::Validator::new(
-        naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::all(),
-    );
+    let mut validator =
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
     validator.validate(&module).map_err(|e| {
+        // Spans go from the whole function down to the faulty expression: report the narrowest.
         let (line, column) = e
-            .location(source)
+            .spans()
+            .map(|(span, _)| span.location(source))
+            .filter(|l| l.length > 0)
+            .min_by_key(|l| l.length)
             .map(|l| (l.line_number, l.line_position))
             .unwrap_or((1, 1));
         // The error chain names the function and the actual fault; join it into one line.
@@ -68,12 +54,7 @@ pub fn validate_wgsl(origin: &str, source: &str) -> Result<naga::Module, ShaderE
             message.push_str(&c.to_string());
             cause = c.source();
         }
-        ShaderError {
-            origin: origin.to_string(),
-            line,
-            column,
-            message,
-        }
+        ShaderError { origin: origin.to_string(), line, column, message }
     })?;
     Ok(module)
 }
@@ -93,12 +74,7 @@ pub fn compile_wgsl(
     });
     match pollster::block_on(scope.pop()) {
         None => Ok((module, reflection)),
-        Some(e) => Err(ShaderError {
-            origin: origin.to_string(),
-            line: 1,
-            column: 1,
-            message: e.to_string(),
-        }),
+        Some(e) => Err(ShaderError { origin: origin.to_string(), line: 1, column: 1, message: e.to_string() }),
     }
 }
 

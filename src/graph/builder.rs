@@ -62,13 +62,7 @@ pub struct FrameGraph<'r> {
 impl<'r> FrameGraph<'r> {
     /// An empty graph for a frame whose output is `output_size` texels.
     pub fn new(output_size: (u32, u32)) -> Self {
-        Self {
-            output_size,
-            textures: Vec::new(),
-            buffers: Vec::new(),
-            passes: Vec::new(),
-            output: None,
-        }
+        Self { output_size, textures: Vec::new(), buffers: Vec::new(), passes: Vec::new(), output: None }
     }
 
     /// The frame's output size.
@@ -78,48 +72,26 @@ impl<'r> FrameGraph<'r> {
 
     /// Declares a texture that lives only within this frame; the pool provides it.
     pub fn create_texture(&mut self, name: impl Into<String>, desc: TextureDesc) -> TextureHandle {
-        self.textures.push(VirtualTexture {
-            name: name.into(),
-            origin: TextureOrigin::Transient(desc),
-        });
+        self.textures.push(VirtualTexture { name: name.into(), origin: TextureOrigin::Transient(desc) });
         TextureHandle(self.textures.len() as u32 - 1)
     }
 
     /// Brings a node-owned texture into the graph. Passes that write it are never culled.
-    pub fn import_texture(
-        &mut self,
-        name: impl Into<String>,
-        texture: &PersistentTexture,
-    ) -> TextureHandle {
-        let origin =
-            TextureOrigin::Imported(texture.texture.clone(), texture.view.clone(), texture.id);
-        self.textures.push(VirtualTexture {
-            name: name.into(),
-            origin,
-        });
+    pub fn import_texture(&mut self, name: impl Into<String>, texture: &PersistentTexture) -> TextureHandle {
+        let origin = TextureOrigin::Imported(texture.texture.clone(), texture.view.clone(), texture.id);
+        self.textures.push(VirtualTexture { name: name.into(), origin });
         TextureHandle(self.textures.len() as u32 - 1)
     }
 
     /// Declares a storage buffer that lives only within this frame.
     pub fn create_buffer(&mut self, name: impl Into<String>, size: u64) -> BufferHandle {
-        self.buffers.push(VirtualBuffer {
-            name: name.into(),
-            origin: BufferOrigin::Transient { size },
-        });
+        self.buffers.push(VirtualBuffer { name: name.into(), origin: BufferOrigin::Transient { size } });
         BufferHandle(self.buffers.len() as u32 - 1)
     }
 
     /// Brings a node-owned buffer into the graph. Passes that write it are never culled.
-    pub fn import_buffer(
-        &mut self,
-        name: impl Into<String>,
-        buffer: &wgpu::Buffer,
-        id: u64,
-    ) -> BufferHandle {
-        self.buffers.push(VirtualBuffer {
-            name: name.into(),
-            origin: BufferOrigin::Imported(buffer.clone(), id),
-        });
+    pub fn import_buffer(&mut self, name: impl Into<String>, buffer: &wgpu::Buffer, id: u64) -> BufferHandle {
+        self.buffers.push(VirtualBuffer { name: name.into(), origin: BufferOrigin::Imported(buffer.clone(), id) });
         BufferHandle(self.buffers.len() as u32 - 1)
     }
 
@@ -137,12 +109,7 @@ impl<'r> FrameGraph<'r> {
     pub fn add_pass(&mut self, name: impl Into<String>) -> PassBuilder<'_, 'r> {
         PassBuilder {
             graph: self,
-            decl: PassDecl {
-                name: name.into(),
-                accesses: Vec::new(),
-                side_effect: false,
-                record: None,
-            },
+            decl: PassDecl { name: name.into(), accesses: Vec::new(), side_effect: false, record: None },
         }
     }
 
@@ -172,41 +139,31 @@ pub struct PassBuilder<'g, 'r> {
 impl<'r> PassBuilder<'_, 'r> {
     /// The pass samples or loads `texture`.
     pub fn read(mut self, texture: TextureHandle) -> Self {
-        self.decl
-            .accesses
-            .push((Resource::Texture(texture.0), Access::Read));
+        self.decl.accesses.push((Resource::Texture(texture.0), Access::Read));
         self
     }
 
     /// The pass writes `texture` as a storage texture.
     pub fn write(mut self, texture: TextureHandle) -> Self {
-        self.decl
-            .accesses
-            .push((Resource::Texture(texture.0), Access::Write));
+        self.decl.accesses.push((Resource::Texture(texture.0), Access::Write));
         self
     }
 
     /// The pass renders into `texture` as a colour attachment.
     pub fn render_target(mut self, texture: TextureHandle) -> Self {
-        self.decl
-            .accesses
-            .push((Resource::Texture(texture.0), Access::RenderTarget));
+        self.decl.accesses.push((Resource::Texture(texture.0), Access::RenderTarget));
         self
     }
 
     /// The pass reads `buffer` (storage or uniform).
     pub fn read_buffer(mut self, buffer: BufferHandle) -> Self {
-        self.decl
-            .accesses
-            .push((Resource::Buffer(buffer.0), Access::Read));
+        self.decl.accesses.push((Resource::Buffer(buffer.0), Access::Read));
         self
     }
 
     /// The pass writes `buffer` as storage.
     pub fn write_buffer(mut self, buffer: BufferHandle) -> Self {
-        self.decl
-            .accesses
-            .push((Resource::Buffer(buffer.0), Access::Write));
+        self.decl.accesses.push((Resource::Buffer(buffer.0), Access::Write));
         self
     }
 
@@ -248,12 +205,7 @@ impl PassContext<'_> {
     fn resolved(&self, texture: TextureHandle) -> &ResolvedTexture {
         self.textures[texture.0 as usize]
             .as_ref()
-            .unwrap_or_else(|| {
-                panic!(
-                    "pass '{}' used a texture it did not declare",
-                    self.pass_name
-                )
-            })
+            .unwrap_or_else(|| panic!("pass '{}' used a texture it did not declare", self.pass_name))
     }
 
     /// The view of a declared texture.
@@ -281,10 +233,7 @@ impl PassContext<'_> {
 
     /// A stable id of the physical buffer, for caching bind groups.
     pub fn buffer_id(&self, buffer: BufferHandle) -> u64 {
-        self.buffers[buffer.0 as usize]
-            .as_ref()
-            .map(|b| b.1)
-            .unwrap_or(0)
+        self.buffers[buffer.0 as usize].as_ref().map(|b| b.1).unwrap_or(0)
     }
 
     /// This pass's name, for labels.

@@ -50,21 +50,9 @@ pub fn compile(graph: &FrameGraph<'_>) -> Result<CompiledGraph, GraphError> {
     let output = graph.output.ok_or(GraphError::NoOutput)?;
     let n = graph.passes.len();
     let writers = |r: Resource| -> Vec<usize> {
-        (0..n)
-            .filter(|&p| {
-                graph.passes[p]
-                    .accesses
-                    .iter()
-                    .any(|&(res, a)| res == r && a != Access::Read)
-            })
-            .collect()
+        (0..n).filter(|&p| graph.passes[p].accesses.iter().any(|&(res, a)| res == r && a != Access::Read)).collect()
     };
-    let writes = |p: usize, r: Resource| {
-        graph.passes[p]
-            .accesses
-            .iter()
-            .any(|&(res, a)| res == r && a != Access::Read)
-    };
+    let writes = |p: usize, r: Resource| graph.passes[p].accesses.iter().any(|&(res, a)| res == r && a != Access::Read);
 
     // Edges: deps[p] = passes that must run before p.
     let mut deps: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); n];
@@ -104,19 +92,11 @@ pub fn compile(graph: &FrameGraph<'_>) -> Result<CompiledGraph, GraphError> {
     if let Some((first, _)) = texture_lifetimes[output.0 as usize] {
         texture_lifetimes[output.0 as usize] = Some((first, usize::MAX));
     }
-    Ok(CompiledGraph {
-        order,
-        texture_lifetimes,
-        buffer_lifetimes,
-    })
+    Ok(CompiledGraph { order, texture_lifetimes, buffer_lifetimes })
 }
 
 /// Passes whose work reaches the output, an imported resource, or that have side effects.
-fn live_passes(
-    graph: &FrameGraph<'_>,
-    output: super::TextureHandle,
-    deps: &[BTreeSet<usize>],
-) -> Vec<bool> {
+fn live_passes(graph: &FrameGraph<'_>, output: super::TextureHandle, deps: &[BTreeSet<usize>]) -> Vec<bool> {
     let is_root = |p: usize| {
         let pass = &graph.passes[p];
         pass.side_effect
@@ -124,11 +104,7 @@ fn live_passes(
                 a != Access::Read
                     && match res {
                         Resource::Texture(t) => {
-                            t == output.0
-                                || matches!(
-                                    graph.textures[t as usize].origin,
-                                    TextureOrigin::Imported(..)
-                                )
+                            t == output.0 || matches!(graph.textures[t as usize].origin, TextureOrigin::Imported(..))
                         }
                         Resource::Buffer(b) => {
                             matches!(graph.buffers[b as usize].origin, BufferOrigin::Imported(..))
@@ -155,20 +131,14 @@ fn topological_order(
     let mut remaining: BTreeSet<usize> = (0..deps.len()).filter(|&p| live[p]).collect();
     let mut order = Vec::with_capacity(remaining.len());
     while !remaining.is_empty() {
-        let ready = remaining
-            .iter()
-            .copied()
-            .find(|&p| deps[p].iter().all(|d| !remaining.contains(d)));
+        let ready = remaining.iter().copied().find(|&p| deps[p].iter().all(|d| !remaining.contains(d)));
         match ready {
             Some(p) => {
                 remaining.remove(&p);
                 order.push(p);
             }
             None => {
-                let names = remaining
-                    .iter()
-                    .map(|&p| graph.passes[p].name.clone())
-                    .collect();
+                let names = remaining.iter().map(|&p| graph.passes[p].name.clone()).collect();
                 return Err(GraphError::Cycle(names));
             }
         }
@@ -183,27 +153,18 @@ fn check_reads(graph: &FrameGraph<'_>, order: &[usize]) -> Result<(), GraphError
         let pass = &graph.passes[p];
         for &(res, access) in &pass.accesses {
             let imported = match res {
-                Resource::Texture(t) => matches!(
-                    graph.textures[t as usize].origin,
-                    TextureOrigin::Imported(..)
-                ),
+                Resource::Texture(t) => matches!(graph.textures[t as usize].origin, TextureOrigin::Imported(..)),
                 Resource::Buffer(b) => {
                     matches!(graph.buffers[b as usize].origin, BufferOrigin::Imported(..))
                 }
             };
-            let self_written = pass
-                .accesses
-                .iter()
-                .any(|&(r, a)| r == res && a != Access::Read);
+            let self_written = pass.accesses.iter().any(|&(r, a)| r == res && a != Access::Read);
             if access == Access::Read && !imported && !self_written && !written.contains(&res) {
                 let resource = match res {
                     Resource::Texture(t) => graph.textures[t as usize].name.clone(),
                     Resource::Buffer(b) => graph.buffers[b as usize].name.clone(),
                 };
-                return Err(GraphError::ReadOfUnwritten {
-                    pass: pass.name.clone(),
-                    resource,
-                });
+                return Err(GraphError::ReadOfUnwritten { pass: pass.name.clone(), resource });
             }
         }
         for &(res, access) in &pass.accesses {
@@ -223,19 +184,10 @@ mod tests {
     const F: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
     fn names(graph: &FrameGraph<'_>, compiled: &CompiledGraph) -> Vec<String> {
-        compiled
-            .order
-            .iter()
-            .map(|&p| graph.passes[p].name.clone())
-            .collect()
+        compiled.order.iter().map(|&p| graph.passes[p].name.clone()).collect()
     }
 
-    fn pass(
-        graph: &mut FrameGraph<'_>,
-        name: &str,
-        reads: &[TextureHandle],
-        writes: &[TextureHandle],
-    ) {
+    fn pass(graph: &mut FrameGraph<'_>, name: &str, reads: &[TextureHandle], writes: &[TextureHandle]) {
         let mut b = graph.add_pass(name);
         for &r in reads {
             b = b.read(r);
@@ -302,9 +254,7 @@ mod tests {
         pass(&mut g, "final", &[y], &[out]);
         g.set_output(out);
         let err = compile(&g).unwrap_err();
-        assert!(
-            matches!(&err, GraphError::Cycle(n) if n.contains(&"p".to_string()) && n.contains(&"q".to_string()))
-        );
+        assert!(matches!(&err, GraphError::Cycle(n) if n.contains(&"p".to_string()) && n.contains(&"q".to_string())));
         assert!(err.to_string().contains("cycle"), "{err}");
     }
 
@@ -317,10 +267,7 @@ mod tests {
         g.set_output(out);
         assert_eq!(
             compile(&g).unwrap_err(),
-            GraphError::ReadOfUnwritten {
-                pass: "final".into(),
-                resource: "ghost".into()
-            }
+            GraphError::ReadOfUnwritten { pass: "final".into(), resource: "ghost".into() }
         );
     }
 

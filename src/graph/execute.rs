@@ -4,9 +4,7 @@
 use std::collections::BTreeSet;
 use std::time::{Duration, Instant};
 
-use super::builder::{
-    Access, BufferOrigin, FrameGraph, PassContext, ResolvedTexture, Resource, TextureOrigin,
-};
+use super::builder::{Access, BufferOrigin, FrameGraph, PassContext, ResolvedTexture, Resource, TextureOrigin};
 use super::compile::{GraphError, compile};
 use super::pool::{PoolKey, TexturePool, texture_bytes};
 use super::resource::next_resource_id;
@@ -56,14 +54,8 @@ pub struct GraphRuntime {
 impl GraphRuntime {
     /// A runtime that times passes when the device has `TIMESTAMP_QUERY_INSIDE_ENCODERS`.
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
-        let timed = device
-            .features()
-            .contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
-        Self {
-            pool: TexturePool::new(),
-            buffers: Vec::new(),
-            timer: timed.then(|| GpuTimer::new(device, queue)),
-        }
+        let timed = device.features().contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+        Self { pool: TexturePool::new(), buffers: Vec::new(), timer: timed.then(|| GpuTimer::new(device, queue)) }
     }
 
     /// The transient texture pool.
@@ -103,8 +95,7 @@ impl GraphRuntime {
                 if life.is_some_and(|(first, _)| first == position) {
                     let (resolved, pooled) = self.resolve_texture(device, &graph, t, usages[t]);
                     if let Some(i) = pooled {
-                        stats.transient_bytes_requested +=
-                            texture_bytes(size_of(&resolved), resolved.texture.format());
+                        stats.transient_bytes_requested += texture_bytes(size_of(&resolved), resolved.texture.format());
                         if used_pool_entries.insert(i) {
                             stats.transient_bytes_allocated +=
                                 texture_bytes(size_of(&resolved), resolved.texture.format());
@@ -126,8 +117,9 @@ impl GraphRuntime {
             if timing && let Some(t) = self.timer.as_mut() {
                 t.begin_pass(encoder, position, &pass.name);
             }
+            // No encoder debug group around the pass: lavapipe (Mesa 22.3) crashes when one
+            // encloses a render pass. Passes label their own wgpu passes instead.
             if let Some(record) = pass.record.take() {
-                encoder.push_debug_group(&pass.name);
                 let mut ctx = PassContext {
                     device,
                     queue,
@@ -137,7 +129,6 @@ impl GraphRuntime {
                     pass_name: &pass.name,
                 };
                 record(&mut ctx);
-                encoder.pop_debug_group();
             }
             if timing && let Some(t) = self.timer.as_mut() {
                 t.end_pass(encoder, position);
@@ -166,18 +157,11 @@ impl GraphRuntime {
         for b in &mut self.buffers {
             b.in_use = false;
         }
-        let out =
-            textures[output.0 as usize]
-                .take()
-                .ok_or_else(|| GraphError::ReadOfUnwritten {
-                    pass: "<output>".into(),
-                    resource: graph.textures[output.0 as usize].name.clone(),
-                })?;
-        Ok(FrameOutput {
-            texture: out.texture,
-            view: out.view,
-            stats,
-        })
+        let out = textures[output.0 as usize].take().ok_or_else(|| GraphError::ReadOfUnwritten {
+            pass: "<output>".into(),
+            resource: graph.textures[output.0 as usize].name.clone(),
+        })?;
+        Ok(FrameOutput { texture: out.texture, view: out.view, stats })
     }
 
     /// Call after the frame's encoder was submitted: starts reading back its timestamps.
@@ -212,20 +196,11 @@ impl GraphRuntime {
         usage: wgpu::TextureUsages,
     ) -> (ResolvedTexture, Option<usize>) {
         match &graph.textures[t].origin {
-            TextureOrigin::Imported(texture, view, id) => (
-                ResolvedTexture {
-                    texture: texture.clone(),
-                    view: view.clone(),
-                    id: *id,
-                },
-                None,
-            ),
+            TextureOrigin::Imported(texture, view, id) => {
+                (ResolvedTexture { texture: texture.clone(), view: view.clone(), id: *id }, None)
+            }
             TextureOrigin::Transient(desc) => {
-                let key = PoolKey {
-                    size: desc.extent.resolve(graph.output_size),
-                    format: desc.format,
-                    usage,
-                };
+                let key = PoolKey { size: desc.extent.resolve(graph.output_size), format: desc.format, usage };
                 let (index, resolved) = self.pool.acquire(device, key);
                 (resolved, Some(index))
             }
@@ -241,33 +216,20 @@ impl GraphRuntime {
         match &graph.buffers[b].origin {
             BufferOrigin::Imported(buffer, id) => (buffer.clone(), *id, None),
             BufferOrigin::Transient { size } => {
-                let index = self
-                    .buffers
-                    .iter()
-                    .position(|e| !e.in_use && e.size == *size)
-                    .unwrap_or_else(|| {
-                        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                            label: Some("graph_transient_buffer"),
-                            size: *size,
-                            usage: wgpu::BufferUsages::STORAGE
-                                | wgpu::BufferUsages::COPY_DST
-                                | wgpu::BufferUsages::COPY_SRC,
-                            mapped_at_creation: false,
-                        });
-                        self.buffers.push(PooledBuffer {
-                            size: *size,
-                            buffer,
-                            id: next_resource_id(),
-                            in_use: false,
-                        });
-                        self.buffers.len() - 1
+                let index = self.buffers.iter().position(|e| !e.in_use && e.size == *size).unwrap_or_else(|| {
+                    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("graph_transient_buffer"),
+                        size: *size,
+                        usage: wgpu::BufferUsages::STORAGE
+                            | wgpu::BufferUsages::COPY_DST
+                            | wgpu::BufferUsages::COPY_SRC,
+                        mapped_at_creation: false,
                     });
+                    self.buffers.push(PooledBuffer { size: *size, buffer, id: next_resource_id(), in_use: false });
+                    self.buffers.len() - 1
+                });
                 self.buffers[index].in_use = true;
-                (
-                    self.buffers[index].buffer.clone(),
-                    self.buffers[index].id,
-                    Some(index),
-                )
+                (self.buffers[index].buffer.clone(), self.buffers[index].id, Some(index))
             }
         }
     }

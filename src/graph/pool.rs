@@ -41,26 +41,15 @@ impl TexturePool {
     }
 
     /// A free texture matching `key` (same size and format, at least the usage), or a new one.
-    pub(crate) fn acquire(
-        &mut self,
-        device: &wgpu::Device,
-        key: PoolKey,
-    ) -> (usize, ResolvedTexture) {
+    pub(crate) fn acquire(&mut self, device: &wgpu::Device, key: PoolKey) -> (usize, ResolvedTexture) {
         let found = self.entries.iter().position(|e| {
-            !e.in_use
-                && e.key.size == key.size
-                && e.key.format == key.format
-                && e.key.usage.contains(key.usage)
+            !e.in_use && e.key.size == key.size && e.key.format == key.format && e.key.usage.contains(key.usage)
         });
         let index = found.unwrap_or_else(|| {
             self.created_this_frame += 1;
             let texture = device.create_texture(&wgpu::TextureDescriptor {
                 label: Some("graph_transient"),
-                size: wgpu::Extent3d {
-                    width: key.size.0,
-                    height: key.size.1,
-                    depth_or_array_layers: 1,
-                },
+                size: wgpu::Extent3d { width: key.size.0, height: key.size.1, depth_or_array_layers: 1 },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -69,17 +58,8 @@ impl TexturePool {
                 view_formats: &[],
             });
             let view = texture.create_view(&Default::default());
-            let resolved = ResolvedTexture {
-                texture,
-                view,
-                id: next_resource_id(),
-            };
-            self.entries.push(Entry {
-                key,
-                resolved,
-                in_use: false,
-                last_frame: self.frame,
-            });
+            let resolved = ResolvedTexture { texture, view, id: next_resource_id() };
+            self.entries.push(Entry { key, resolved, in_use: false, last_frame: self.frame });
             self.entries.len() - 1
         });
         let entry = &mut self.entries[index];
@@ -96,8 +76,7 @@ impl TexturePool {
     /// Ends a frame: everything becomes free; textures idle for long are dropped.
     pub(crate) fn end_frame(&mut self) {
         let frame = self.frame;
-        self.entries
-            .retain(|e| frame.saturating_sub(e.last_frame) < EVICT_AFTER_FRAMES);
+        self.entries.retain(|e| frame.saturating_sub(e.last_frame) < EVICT_AFTER_FRAMES);
         for e in &mut self.entries {
             e.in_use = false;
         }
@@ -122,10 +101,7 @@ impl TexturePool {
 
     /// Bytes of all pooled textures.
     pub fn bytes(&self) -> u64 {
-        self.entries
-            .iter()
-            .map(|e| texture_bytes(e.key.size, e.key.format))
-            .sum()
+        self.entries.iter().map(|e| texture_bytes(e.key.size, e.key.format)).sum()
     }
 }
 

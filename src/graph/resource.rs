@@ -17,11 +17,7 @@ impl Extent {
         match self {
             Extent::Absolute(w, h) => (w.max(1), h.max(1)),
             Extent::Relative(num, den) => {
-                let scale = |x: u32| {
-                    (u64::from(x) * u64::from(num))
-                        .div_ceil(u64::from(den.max(1)))
-                        .max(1) as u32
-                };
+                let scale = |x: u32| (u64::from(x) * u64::from(num)).div_ceil(u64::from(den.max(1))).max(1) as u32;
                 (scale(output.0), scale(output.1))
             }
         }
@@ -40,18 +36,12 @@ pub struct TextureDesc {
 impl TextureDesc {
     /// A texture the size of the output.
     pub fn full(format: wgpu::TextureFormat) -> Self {
-        Self {
-            extent: Extent::Relative(1, 1),
-            format,
-        }
+        Self { extent: Extent::Relative(1, 1), format }
     }
 
     /// A texture `num/den` of the output size.
     pub fn scaled(format: wgpu::TextureFormat, num: u32, den: u32) -> Self {
-        Self {
-            extent: Extent::Relative(num, den),
-            format,
-        }
+        Self { extent: Extent::Relative(num, den), format }
     }
 }
 
@@ -83,19 +73,10 @@ pub struct PersistentTexture {
 
 impl PersistentTexture {
     /// Creates a texture usable as storage, sampled and copy source/destination.
-    pub fn new(
-        device: &wgpu::Device,
-        label: &str,
-        size: (u32, u32),
-        format: wgpu::TextureFormat,
-    ) -> Self {
+    pub fn new(device: &wgpu::Device, label: &str, size: (u32, u32), format: wgpu::TextureFormat) -> Self {
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),
-            size: wgpu::Extent3d {
-                width: size.0,
-                height: size.1,
-                depth_or_array_layers: 1,
-            },
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -107,11 +88,7 @@ impl PersistentTexture {
             view_formats: &[],
         });
         let view = texture.create_view(&Default::default());
-        Self {
-            texture,
-            view,
-            id: next_resource_id(),
-        }
+        Self { texture, view, id: next_resource_id() }
     }
 }
 
@@ -124,26 +101,15 @@ pub struct PingPong {
 
 impl PingPong {
     /// Two textures of the same size and format, named `<label>.a` and `<label>.b`.
-    pub fn new(
-        device: &wgpu::Device,
-        label: &str,
-        size: (u32, u32),
-        format: wgpu::TextureFormat,
-    ) -> Self {
+    pub fn new(device: &wgpu::Device, label: &str, size: (u32, u32), format: wgpu::TextureFormat) -> Self {
         let a = PersistentTexture::new(device, &format!("{label}.a"), size, format);
         let b = PersistentTexture::new(device, &format!("{label}.b"), size, format);
-        Self {
-            textures: [a, b],
-            current: 0,
-        }
+        Self { textures: [a, b], current: 0 }
     }
 
     /// (the texture to write this step, the texture holding the previous state).
     pub fn write_and_history(&self) -> (&PersistentTexture, &PersistentTexture) {
-        (
-            &self.textures[1 - self.current],
-            &self.textures[self.current],
-        )
+        (&self.textures[1 - self.current], &self.textures[self.current])
     }
 
     /// The latest state.

@@ -15,10 +15,7 @@ pub struct RollingMedian {
 impl RollingMedian {
     /// Keeps the last `capacity` samples.
     pub fn new(capacity: usize) -> Self {
-        Self {
-            samples: VecDeque::with_capacity(capacity),
-            capacity: capacity.max(1),
-        }
+        Self { samples: VecDeque::with_capacity(capacity), capacity: capacity.max(1) }
     }
 
     /// Adds a sample, forgetting the oldest past capacity.
@@ -37,11 +34,7 @@ impl RollingMedian {
         }
         sorted.sort_by(f64::total_cmp);
         let mid = sorted.len() / 2;
-        Some(if sorted.len() % 2 == 0 {
-            (sorted[mid - 1] + sorted[mid]) / 2.0
-        } else {
-            sorted[mid]
-        })
+        Some(if sorted.len() % 2 == 0 { (sorted[mid - 1] + sorted[mid]) / 2.0 } else { sorted[mid] })
     }
 
     /// Number of samples held.
@@ -163,13 +156,7 @@ impl GpuTimer {
             return;
         }
         encoder.resolve_query_set(&self.queries, 0..count, &self.resolve, 0);
-        encoder.copy_buffer_to_buffer(
-            &self.resolve,
-            0,
-            &self.slots[s].buffer,
-            0,
-            u64::from(count) * 8,
-        );
+        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.slots[s].buffer, 0, u64::from(count) * 8);
     }
 
     /// After submit: starts mapping this frame's slot; its results are read in a later frame.
@@ -179,13 +166,11 @@ impl GpuTimer {
         slot.busy = true;
         slot.ready.store(false, Ordering::Release);
         let ready = slot.ready.clone();
-        slot.buffer
-            .slice(..)
-            .map_async(wgpu::MapMode::Read, move |r| {
-                if r.is_ok() {
-                    ready.store(true, Ordering::Release);
-                }
-            });
+        slot.buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            if r.is_ok() {
+                ready.store(true, Ordering::Release);
+            }
+        });
         self.next = (self.next + 1) % self.slots.len();
     }
 
@@ -204,13 +189,9 @@ impl GpuTimer {
             slot.busy = false;
             let mut total = 0.0;
             for (i, name) in slot.names.iter().enumerate().take(stamps.len() / 2) {
-                let ms =
-                    stamps[2 * i + 1].wrapping_sub(stamps[2 * i]) as f64 * self.period_ns / 1e6;
+                let ms = stamps[2 * i + 1].wrapping_sub(stamps[2 * i]) as f64 * self.period_ns / 1e6;
                 total += ms;
-                self.medians
-                    .entry(name.clone())
-                    .or_insert_with(|| RollingMedian::new(WINDOW))
-                    .push(ms);
+                self.medians.entry(name.clone()).or_insert_with(|| RollingMedian::new(WINDOW)).push(ms);
             }
             self.frame_total.push(total);
         }
@@ -221,11 +202,7 @@ impl GpuTimer {
         self.medians
             .iter()
             .filter_map(|(name, m)| {
-                m.median().map(|median_ms| PassTiming {
-                    name: name.clone(),
-                    median_ms,
-                    samples: m.len(),
-                })
+                m.median().map(|median_ms| PassTiming { name: name.clone(), median_ms, samples: m.len() })
             })
             .collect()
     }

@@ -16,25 +16,13 @@ pub struct FlipScore {
 
 /// Compares two RGBA8 images of `size` (alpha ignored); returns the score and a colour-mapped
 /// error image (RGB8).
-pub fn flip_score(
-    reference: &[u8],
-    test: &[u8],
-    size: (u32, u32),
-    percentile: f32,
-) -> (FlipScore, Vec<u8>) {
-    let rgb = |rgba: &[u8]| {
-        rgba.chunks_exact(4)
-            .flat_map(|p| [p[0], p[1], p[2]])
-            .collect::<Vec<u8>>()
-    };
+pub fn flip_score(reference: &[u8], test: &[u8], size: (u32, u32), percentile: f32) -> (FlipScore, Vec<u8>) {
+    let rgb = |rgba: &[u8]| rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect::<Vec<u8>>();
     let r = nv_flip::FlipImageRgb8::with_data(size.0, size.1, &rgb(reference));
     let t = nv_flip::FlipImageRgb8::with_data(size.0, size.1, &rgb(test));
     let error = nv_flip::flip(r, t, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
     let mut pool = nv_flip::FlipPool::from_image(&error);
-    let score = FlipScore {
-        mean: pool.mean(),
-        percentile: pool.get_percentile(percentile, true),
-    };
+    let score = FlipScore { mean: pool.mean(), percentile: pool.get_percentile(percentile, true) };
     (score, error.apply_color_lut(&nv_flip::magma_lut()).to_vec())
 }
 
@@ -54,12 +42,7 @@ pub struct GoldenCheck {
 impl GoldenCheck {
     /// Thresholds that tolerate rasterisation noise across drivers but not a changed picture.
     pub fn new(dir: impl Into<PathBuf>) -> Self {
-        Self {
-            dir: dir.into(),
-            max_mean: 0.01,
-            percentile: 0.99,
-            max_percentile: 0.3,
-        }
+        Self { dir: dir.into(), max_mean: 0.01, percentile: 0.99, max_percentile: 0.3 }
     }
 
     /// Checks `rgba` against `<dir>/<name>.png`. With `INDRA_BLESS=1` it writes the reference
@@ -69,10 +52,7 @@ impl GoldenCheck {
         if std::env::var("INDRA_BLESS").is_ok_and(|v| v == "1") {
             std::fs::create_dir_all(&self.dir).map_err(|e| e.to_string())?;
             super::write_png(&reference_path, size, rgba)?;
-            return Ok(FlipScore {
-                mean: 0.0,
-                percentile: 0.0,
-            });
+            return Ok(FlipScore { mean: 0.0, percentile: 0.0 });
         }
         let reference = load_rgba(&reference_path).map_err(|e| {
             format!("{e}\n  no reference for '{name}': run the test with INDRA_BLESS=1 to create it, then look at it")
@@ -95,14 +75,8 @@ impl GoldenCheck {
             return Ok(score);
         }
         super::write_png(&actual_path, size, rgba)?;
-        image::save_buffer(
-            &diff_path,
-            &diff,
-            size.0,
-            size.1,
-            image::ExtendedColorType::Rgb8,
-        )
-        .map_err(|e| e.to_string())?;
+        image::save_buffer(&diff_path, &diff, size.0, size.1, image::ExtendedColorType::Rgb8)
+            .map_err(|e| e.to_string())?;
         Err(format!(
             "'{name}' differs from {}: FLIP mean {:.4} (max {}), p{} {:.4} (max {})\n  actual: {}\n  diff:   {}\n  if the change is intended: INDRA_BLESS=1",
             reference_path.display(),
@@ -119,9 +93,7 @@ impl GoldenCheck {
 
 /// Loads a PNG as RGBA8 with its size.
 pub fn load_rgba(path: &Path) -> Result<(Vec<u8>, (u32, u32)), String> {
-    let img = image::open(path)
-        .map_err(|e| format!("cannot read {}: {e}", path.display()))?
-        .to_rgba8();
+    let img = image::open(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?.to_rgba8();
     let size = img.dimensions();
     Ok((img.into_raw(), size))
 }

@@ -48,11 +48,7 @@ impl OffscreenRenderer {
         let blit = Blit::new(&gpu.device);
         let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("offscreen_target"),
-            size: wgpu::Extent3d {
-                width: size.0,
-                height: size.1,
-                depth_or_array_layers: 1,
-            },
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -60,15 +56,7 @@ impl OffscreenRenderer {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        Ok(Self {
-            gpu,
-            instance,
-            runtime,
-            blit,
-            clock,
-            size,
-            target,
-        })
+        Ok(Self { gpu, instance, runtime, blit, clock, size, target })
     }
 
     /// The live scene (to change parameters between frames).
@@ -96,15 +84,9 @@ impl OffscreenRenderer {
     pub fn render_only(&mut self) -> Result<(FrameTime, FrameStats), crate::graph::GraphError> {
         let time = self.clock.now();
         self.instance.step(&time);
-        let mut encoder = self
-            .gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("offscreen_frame"),
-            });
-        let output =
-            self.instance
-                .encode(&self.gpu, &mut self.runtime, &mut encoder, self.size, &time)?;
+        let mut encoder =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("offscreen_frame") });
+        let output = self.instance.encode(&self.gpu, &mut self.runtime, &mut encoder, self.size, &time)?;
         let target_view = self.target.create_view(&Default::default());
         self.blit.record(
             &self.gpu.device,
@@ -125,12 +107,7 @@ impl OffscreenRenderer {
     pub fn render_next(&mut self) -> Result<RenderedFrame, crate::graph::GraphError> {
         let (time, stats) = self.render_only()?;
         let rgba = read_texture_rgba8(&self.gpu.device, &self.gpu.queue, &self.target);
-        Ok(RenderedFrame {
-            time,
-            rgba,
-            size: self.size,
-            stats,
-        })
+        Ok(RenderedFrame { time, rgba, size: self.size, stats })
     }
 
     /// Waits for the GPU and folds outstanding pass timings into the medians.

@@ -34,11 +34,8 @@ impl ParamSet {
     /// Sets parameter `i`, converting to its type and clamping to its range.
     pub fn set_at(&mut self, i: usize, value: ParamValue) {
         let decl = &self.decls[i];
-        let typed = if value.ty() == decl.ty() {
-            value
-        } else {
-            ParamValue::from_components(decl.ty(), &value.components())
-        };
+        let typed =
+            if value.ty() == decl.ty() { value } else { ParamValue::from_components(decl.ty(), &value.components()) };
         self.values[i] = typed.clamped(decl.range);
     }
 
@@ -57,9 +54,7 @@ impl ParamSet {
     /// If the technique asks for a parameter it never declared: a programming error that every
     /// render test of that technique would show.
     pub fn get(&self, name: &str) -> ParamValue {
-        let i = self
-            .index(name)
-            .unwrap_or_else(|| panic!("parameter '{name}' is not declared"));
+        let i = self.index(name).unwrap_or_else(|| panic!("parameter '{name}' is not declared"));
         self.values[i]
     }
 

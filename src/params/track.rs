@@ -52,34 +52,16 @@ pub struct Track {
 
 impl Track {
     /// A track over `keys` (sorted here by time).
-    pub fn new(
-        mut keys: Vec<Key>,
-        interpolation: Interpolation,
-        repeat: LoopMode,
-        time_scale: f32,
-    ) -> Self {
+    pub fn new(mut keys: Vec<Key>, interpolation: Interpolation, repeat: LoopMode, time_scale: f32) -> Self {
         keys.sort_by(|a, b| a.time.total_cmp(&b.time));
-        Self {
-            keys,
-            interpolation,
-            repeat,
-            time_scale,
-        }
+        Self { keys, interpolation, repeat, time_scale }
     }
 
     /// The track's value at clock time `seconds`.
     pub fn sample(&self, seconds: f64) -> ParamValue {
         let (first, last) = (&self.keys[0], &self.keys[self.keys.len() - 1]);
-        let t = self.local_time(
-            seconds * f64::from(self.time_scale),
-            f64::from(first.time),
-            f64::from(last.time),
-        );
-        let next = self
-            .keys
-            .iter()
-            .position(|k| f64::from(k.time) > t)
-            .unwrap_or(self.keys.len());
+        let t = self.local_time(seconds * f64::from(self.time_scale), f64::from(first.time), f64::from(last.time));
+        let next = self.keys.iter().position(|k| f64::from(k.time) > t).unwrap_or(self.keys.len());
         if next == 0 {
             return first.value;
         }
@@ -119,12 +101,7 @@ fn mix(a: ParamValue, b: ParamValue, w: f32) -> ParamValue {
     if a.ty() == ParamType::Bool {
         return if w >= 1.0 { b } else { a };
     }
-    let c: Vec<f32> = a
-        .components()
-        .iter()
-        .zip(b.components())
-        .map(|(x, y)| x + (y - x) * w)
-        .collect();
+    let c: Vec<f32> = a.components().iter().zip(b.components()).map(|(x, y)| x + (y - x) * w).collect();
     ParamValue::from_components(a.ty(), &c)
 }
 
@@ -133,10 +110,7 @@ mod tests {
     use super::*;
 
     fn f(time: f32, v: f32) -> Key {
-        Key {
-            time,
-            value: ParamValue::Float(v),
-        }
+        Key { time, value: ParamValue::Float(v) }
     }
 
     fn value(track: &Track, t: f64) -> f32 {
@@ -177,12 +151,7 @@ mod tests {
 
     #[test]
     fn before_the_first_key_holds_and_time_scale_applies() {
-        let t = Track::new(
-            vec![f(1.0, 3.0), f(2.0, 5.0)],
-            Interpolation::Linear,
-            LoopMode::PingPong,
-            0.5,
-        );
+        let t = Track::new(vec![f(1.0, 3.0), f(2.0, 5.0)], Interpolation::Linear, LoopMode::PingPong, 0.5);
         assert_eq!(value(&t, 0.0), 3.0);
         assert!((value(&t, 3.0) - 4.0).abs() < 1e-6); // local time 1.5
     }
@@ -190,14 +159,8 @@ mod tests {
     #[test]
     fn vectors_interpolate_per_component() {
         let keys = vec![
-            Key {
-                time: 0.0,
-                value: ParamValue::Vec2([0.0, 10.0]),
-            },
-            Key {
-                time: 1.0,
-                value: ParamValue::Vec2([1.0, 20.0]),
-            },
+            Key { time: 0.0, value: ParamValue::Vec2([0.0, 10.0]) },
+            Key { time: 1.0, value: ParamValue::Vec2([1.0, 20.0]) },
         ];
         let t = Track::new(keys, Interpolation::Linear, LoopMode::Once, 1.0);
         assert_eq!(t.sample(0.5), ParamValue::Vec2([0.5, 15.0]));

@@ -55,9 +55,7 @@ impl ParamType {
             ParamType::Int if exact && numbers[0].fract() == 0.0 && numbers[0].abs() < 2e9 => {
                 ParamValue::Int(numbers[0] as i32)
             }
-            ParamType::Bool if exact && (numbers[0] == 0.0 || numbers[0] == 1.0) => {
-                ParamValue::Bool(numbers[0] == 1.0)
-            }
+            ParamType::Bool if exact && (numbers[0] == 0.0 || numbers[0] == 1.0) => ParamValue::Bool(numbers[0] == 1.0),
             ParamType::Vec2 if exact => ParamValue::Vec2([f(0), f(1)]),
             ParamType::Vec3 if exact => ParamValue::Vec3([f(0), f(1), f(2)]),
             ParamType::Vec4 if exact => ParamValue::Vec4([f(0), f(1), f(2), f(3)]),
@@ -162,13 +160,7 @@ pub struct ParamDecl {
 impl ParamDecl {
     /// A declaration; `range` bounds each component.
     pub fn new(name: &str, default: ParamValue, range: Option<(f32, f32)>, doc: &str) -> Self {
-        Self {
-            name: name.into(),
-            default,
-            range,
-            unit: String::new(),
-            doc: doc.into(),
-        }
+        Self { name: name.into(), default, range, unit: String::new(), doc: doc.into() }
     }
 
     /// The same declaration with a unit.
@@ -190,16 +182,10 @@ mod tests {
 
     #[test]
     fn coercion_checks_count_and_kind() {
-        assert_eq!(
-            ParamType::Int.value_from(&[50.0]),
-            Some(ParamValue::Int(50))
-        );
+        assert_eq!(ParamType::Int.value_from(&[50.0]), Some(ParamValue::Int(50)));
         assert_eq!(ParamType::Int.value_from(&[50.5]), None);
         assert_eq!(ParamType::Vec2.value_from(&[1.0]), None);
-        assert_eq!(
-            ParamType::Color.value_from(&[1.0, 0.5, 0.0]),
-            Some(ParamValue::Color([1.0, 0.5, 0.0, 1.0]))
-        );
+        assert_eq!(ParamType::Color.value_from(&[1.0, 0.5, 0.0]), Some(ParamValue::Color([1.0, 0.5, 0.0, 1.0])));
         assert_eq!(ParamType::Bool.value_from(&[2.0]), None);
     }
 
@@ -207,9 +193,6 @@ mod tests {
     fn clamping_is_per_component() {
         let v = ParamValue::Vec2([-3.0, 0.5]).clamped(Some((0.0, 1.0)));
         assert_eq!(v, ParamValue::Vec2([0.0, 0.5]));
-        assert_eq!(
-            ParamValue::Int(900).clamped(Some((1.0, 500.0))),
-            ParamValue::Int(500)
-        );
+        assert_eq!(ParamValue::Int(900).clamped(Some((1.0, 500.0))), ParamValue::Int(500));
     }
 }

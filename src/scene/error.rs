@@ -17,11 +17,7 @@ pub struct SceneError {
 
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{}:{}:{}: {}",
-            self.origin, self.line, self.column, self.message
-        )
+        write!(f, "{}:{}:{}: {}", self.origin, self.line, self.column, self.message)
     }
 }
 

@@ -20,31 +20,14 @@ pub struct SceneInstance {
 
 impl SceneInstance {
     /// Creates every node's technique (pipelines, persistent resources) for `output_size`.
-    pub fn new(
-        gpu: &Gpu,
-        assets: &Assets,
-        scene: Scene,
-        output_size: (u32, u32),
-    ) -> Result<Self, ShaderError> {
+    pub fn new(gpu: &Gpu, assets: &Assets, scene: Scene, output_size: (u32, u32)) -> Result<Self, ShaderError> {
         let nodes = scene
             .nodes
             .iter()
-            .map(|n| {
-                (n.technique.create)(&NodeSetup {
-                    gpu,
-                    assets,
-                    id: &n.id,
-                    output_size,
-                })
-            })
+            .map(|n| (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size }))
             .collect::<Result<Vec<_>, _>>()?;
         let params = scene.nodes.iter().map(|n| n.params.clone()).collect();
-        Ok(Self {
-            scene,
-            params,
-            nodes,
-            animate: true,
-        })
+        Ok(Self { scene, params, nodes, animate: true })
     }
 
     /// The validated scene.
@@ -64,12 +47,7 @@ impl SceneInstance {
 
     /// Whether a track drives parameter `param` of node `node`.
     pub fn is_animated(&self, node: usize, param: usize) -> bool {
-        self.animate
-            && self
-                .scene
-                .tracks
-                .iter()
-                .any(|t| t.node == node && t.param == param)
+        self.animate && self.scene.tracks.iter().any(|t| t.node == node && t.param == param)
     }
 
     /// Sets every tracked parameter to its value at `time`.
@@ -99,11 +77,7 @@ impl SceneInstance {
         let mut graph = FrameGraph::new(output_size);
         let mut outputs = Vec::with_capacity(self.nodes.len());
         for (i, node) in self.nodes.iter_mut().enumerate() {
-            let inputs: Vec<_> = self.scene.nodes[i]
-                .inputs
-                .iter()
-                .map(|&j| outputs[j])
-                .collect();
+            let inputs: Vec<_> = self.scene.nodes[i].inputs.iter().map(|&j| outputs[j]).collect();
             outputs.push(node.add_passes(&mut graph, &self.params[i], time, &inputs));
         }
         graph.set_output(outputs[self.scene.output]);

@@ -61,10 +61,7 @@ pub struct BoundTrack {
 
 impl std::fmt::Debug for SceneNode {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("SceneNode")
-            .field("id", &self.id)
-            .field("technique", &self.technique.name)
-            .finish()
+        f.debug_struct("SceneNode").field("id", &self.id).field("technique", &self.technique.name).finish()
     }
 }
 
@@ -77,27 +74,18 @@ impl Scene {
     /// Applies `node.param=value` (value: numbers separated by commas, or true/false), as the
     /// CLI's `--set` does. The value is typed and clamped like any other.
     pub fn set_from_str(&mut self, assignment: &str) -> Result<(), String> {
-        let (target, value) = assignment
-            .split_once('=')
-            .ok_or_else(|| format!("'{assignment}' is not of the form node.param=value"))?;
-        let (node_id, param) = target
-            .split_once('.')
-            .ok_or_else(|| format!("'{target}' is not of the form node.param"))?;
+        let (target, value) =
+            assignment.split_once('=').ok_or_else(|| format!("'{assignment}' is not of the form node.param=value"))?;
+        let (node_id, param) =
+            target.split_once('.').ok_or_else(|| format!("'{target}' is not of the form node.param"))?;
         let node = self.node_index(node_id).ok_or_else(|| {
             let ids: Vec<&str> = self.nodes.iter().map(|n| n.id.as_str()).collect();
-            format!(
-                "scene '{}' has no node '{node_id}' (nodes: {})",
-                self.name,
-                ids.join(", ")
-            )
+            format!("scene '{}' has no node '{node_id}' (nodes: {})", self.name, ids.join(", "))
         })?;
         let params = &mut self.nodes[node].params;
         let index = params.index(param).ok_or_else(|| {
             let names: Vec<&str> = params.decls().iter().map(|d| d.name.as_str()).collect();
-            format!(
-                "node '{node_id}' has no parameter '{param}' (parameters: {})",
-                names.join(", ")
-            )
+            format!("node '{node_id}' has no parameter '{param}' (parameters: {})", names.join(", "))
         })?;
         let ty = params.decls()[index].ty();
         let typed = parse_value_override(value, ty)?;
@@ -113,11 +101,7 @@ pub fn parse_value_override(text: &str, ty: ParamType) -> Result<ParamValue, Str
         "false" => RawValue::Bool(false),
         list => RawValue::List(
             list.split(',')
-                .map(|x| {
-                    x.trim()
-                        .parse::<f64>()
-                        .map_err(|_| format!("'{x}' is not a number"))
-                })
+                .map(|x| x.trim().parse::<f64>().map_err(|_| format!("'{x}' is not a number")))
                 .collect::<Result<_, _>>()?,
         ),
     };
@@ -137,21 +121,14 @@ pub fn load_scene(assets: &Assets, name_or_path: &str) -> Result<Scene, SceneErr
             .map(|s| (path.display().to_string(), s))
             .map_err(|e| one_error(name_or_path, format!("cannot read the file: {e}")))?
     } else {
-        let asset = assets
-            .load(AssetKind::Scene, name_or_path)
-            .map_err(|m| one_error(name_or_path, m))?;
+        let asset = assets.load(AssetKind::Scene, name_or_path).map_err(|m| one_error(name_or_path, m))?;
         (asset.origin, asset.source)
     };
     parse_scene(&origin, &source)
 }
 
 fn one_error(origin: &str, message: String) -> SceneErrors {
-    SceneErrors(vec![SceneError {
-        origin: origin.into(),
-        line: 1,
-        column: 1,
-        message,
-    }])
+    SceneErrors(vec![SceneError { origin: origin.into(), line: 1, column: 1, message }])
 }
 
 /// Parses and validates scene text; `origin` names it in errors.
@@ -164,12 +141,7 @@ pub fn parse_scene(origin: &str, source: &str) -> Result<Scene, SceneErrors> {
             message: e.code.to_string(),
         }])
     })?;
-    Validator {
-        origin,
-        source,
-        errors: Vec::new(),
-    }
-    .validate(file)
+    Validator { origin, source, errors: Vec::new() }.validate(file)
 }
 
 /// Collects every semantic error of one file, each located by anchors.
@@ -182,23 +154,12 @@ struct Validator<'a> {
 impl Validator<'_> {
     fn error(&mut self, anchors: &[&str], message: String) {
         let (line, column) = locate(self.source, anchors);
-        self.errors.push(SceneError {
-            origin: self.origin.into(),
-            line,
-            column,
-            message,
-        });
+        self.errors.push(SceneError { origin: self.origin.into(), line, column, message });
     }
 
     fn validate(mut self, file: SceneFile) -> Result<Scene, SceneErrors> {
         if file.size.0 == 0 || file.size.1 == 0 || file.size.0 > 16384 || file.size.1 > 16384 {
-            self.error(
-                &["size"],
-                format!(
-                    "size {:?} must be between 1 and 16384 on each axis",
-                    file.size
-                ),
-            );
+            self.error(&["size"], format!("size {:?} must be between 1 and 16384 on each axis", file.size));
         }
         if !(file.dt > 0.0 && file.dt <= 1.0) {
             self.error(&["dt"], format!("dt {} must be in (0, 1] seconds", file.dt));
@@ -208,10 +169,7 @@ impl Validator<'_> {
         for node in &file.nodes {
             let anchor = format!("\"{}\"", node.id);
             if !seen.insert(node.id.clone()) {
-                self.error(
-                    &[&anchor, &anchor],
-                    format!("node id '{}' is used twice", node.id),
-                );
+                self.error(&[&anchor, &anchor], format!("node id '{}' is used twice", node.id));
             }
             if let Some(built) = self.node(node, &anchor) {
                 nodes.push(built);
@@ -221,20 +179,13 @@ impl Validator<'_> {
         let output = file.nodes.iter().position(|n| n.id == file.output);
         if output.is_none() {
             let anchor = format!("\"{}\"", file.output);
-            self.error(
-                &["output", &anchor],
-                format!("output '{}' is not a node of this scene", file.output),
-            );
+            self.error(&["output", &anchor], format!("output '{}' is not a node of this scene", file.output));
         }
         if !self.errors.is_empty() || nodes.len() != file.nodes.len() {
             return Err(SceneErrors(self.errors));
         }
         // Reorder so that inputs come first; remap input and output indices.
-        let position: BTreeMap<usize, usize> = order
-            .iter()
-            .enumerate()
-            .map(|(new, &old)| (old, new))
-            .collect();
+        let position: BTreeMap<usize, usize> = order.iter().enumerate().map(|(new, &old)| (old, new)).collect();
         let mut ordered: Vec<SceneNode> = order.iter().map(|&i| nodes[i].clone()).collect();
         for n in &mut ordered {
             n.inputs = n.inputs.iter().map(|i| position[i]).collect();
@@ -265,11 +216,7 @@ impl Validator<'_> {
             let t_anchor = format!("\"{}\"", node.technique);
             self.error(
                 &[anchor, &t_anchor],
-                format!(
-                    "unknown technique '{}' (known: {})",
-                    node.technique,
-                    known.join(", ")
-                ),
+                format!("unknown technique '{}' (known: {})", node.technique, known.join(", ")),
             );
             return None;
         };
@@ -278,38 +225,26 @@ impl Validator<'_> {
         for (name, (lo, hi)) in &node.ranges {
             let key = format!("\"{name}\"");
             match decls.iter_mut().find(|d| &d.name == name) {
-                None => self.error(
-                    &[anchor, "ranges", &key],
-                    unknown_param(technique, name, &names),
-                ),
-                Some(_) if lo >= hi => self.error(
-                    &[anchor, "ranges", &key],
-                    format!("range of '{name}' is empty: ({lo}, {hi})"),
-                ),
+                None => self.error(&[anchor, "ranges", &key], unknown_param(technique, name, &names)),
+                Some(_) if lo >= hi => {
+                    self.error(&[anchor, "ranges", &key], format!("range of '{name}' is empty: ({lo}, {hi})"))
+                }
                 Some(d) => d.range = Some((*lo, *hi)),
             }
         }
         for (name, raw) in &node.params {
             let key = format!("\"{name}\"");
             let Some(d) = decls.iter_mut().find(|d| &d.name == name) else {
-                self.error(
-                    &[anchor, "params", &key],
-                    unknown_param(technique, name, &names),
-                );
+                self.error(&[anchor, "params", &key], unknown_param(technique, name, &names));
                 continue;
             };
             match coerce(raw, d.ty()) {
-                None => self.error(
-                    &[anchor, "params", &key],
-                    format!("'{name}' is a {}, not {}", d.ty(), describe(raw)),
-                ),
+                None => {
+                    self.error(&[anchor, "params", &key], format!("'{name}' is a {}, not {}", d.ty(), describe(raw)))
+                }
                 Some(v) if v.clamped(d.range) != v => self.error(
                     &[anchor, "params", &key],
-                    format!(
-                        "'{name}' = {} is outside its range {:?}",
-                        describe(raw),
-                        d.range.unwrap_or_default()
-                    ),
+                    format!("'{name}' = {} is outside its range {:?}", describe(raw), d.range.unwrap_or_default()),
                 ),
                 Some(v) => d.default = v,
             }
@@ -319,30 +254,16 @@ impl Validator<'_> {
                 let key = format!("\"{slot}\"");
                 self.error(
                     &[anchor, "inputs", &key],
-                    format!(
-                        "technique '{}' has no input '{slot}' (inputs: {:?})",
-                        technique.name, technique.inputs
-                    ),
+                    format!("technique '{}' has no input '{slot}' (inputs: {:?})", technique.name, technique.inputs),
                 );
             }
         }
         for slot in technique.inputs {
             if !node.inputs.contains_key(*slot) {
-                self.error(
-                    &[anchor],
-                    format!(
-                        "node '{}' needs its input '{slot}' wired to a node",
-                        node.id
-                    ),
-                );
+                self.error(&[anchor], format!("node '{}' needs its input '{slot}' wired to a node", node.id));
             }
         }
-        Some(SceneNode {
-            id: node.id.clone(),
-            technique,
-            params: ParamSet::new(decls),
-            inputs: Vec::new(),
-        })
+        Some(SceneNode { id: node.id.clone(), technique, params: ParamSet::new(decls), inputs: Vec::new() })
     }
 
     /// Resolves input wiring into each node's `inputs` (file indices) and returns the node
@@ -352,12 +273,7 @@ impl Validator<'_> {
         if nodes.len() != file.nodes.len() {
             return identity;
         }
-        let index: BTreeMap<&str, usize> = file
-            .nodes
-            .iter()
-            .enumerate()
-            .map(|(i, n)| (n.id.as_str(), i))
-            .collect();
+        let index: BTreeMap<&str, usize> = file.nodes.iter().enumerate().map(|(i, n)| (n.id.as_str(), i)).collect();
         for (i, node) in file.nodes.iter().enumerate() {
             for slot in nodes[i].technique.inputs {
                 let Some(source) = node.inputs.get(*slot) else {
@@ -366,10 +282,8 @@ impl Validator<'_> {
                 match index.get(source.as_str()) {
                     Some(&j) if j != i => nodes[i].inputs.push(j),
                     _ => {
-                        let (anchor, s_anchor) =
-                            (format!("\"{}\"", node.id), format!("\"{source}\""));
-                        let message =
-                            format!("input '{slot}' names '{source}', which is not another node");
+                        let (anchor, s_anchor) = (format!("\"{}\"", node.id), format!("\"{source}\""));
+                        let message = format!("input '{slot}' names '{source}', which is not another node");
                         self.error(&[&anchor, "inputs", &s_anchor], message);
                     }
                 }
@@ -378,17 +292,10 @@ impl Validator<'_> {
         let mut order = Vec::new();
         let mut placed = vec![false; nodes.len()];
         while order.len() < nodes.len() {
-            let ready = (0..nodes.len())
-                .find(|&i| !placed[i] && nodes[i].inputs.iter().all(|&d| placed[d]));
+            let ready = (0..nodes.len()).find(|&i| !placed[i] && nodes[i].inputs.iter().all(|&d| placed[d]));
             let Some(next) = ready else {
-                let stuck: Vec<&str> = (0..nodes.len())
-                    .filter(|&i| !placed[i])
-                    .map(|i| nodes[i].id.as_str())
-                    .collect();
-                self.error(
-                    &["nodes"],
-                    format!("the wiring of nodes {} forms a cycle", stuck.join(", ")),
-                );
+                let stuck: Vec<&str> = (0..nodes.len()).filter(|&i| !placed[i]).map(|i| nodes[i].id.as_str()).collect();
+                self.error(&["nodes"], format!("the wiring of nodes {} forms a cycle", stuck.join(", ")));
                 return identity;
             };
             placed[next] = true;
@@ -403,25 +310,15 @@ impl Validator<'_> {
             let anchor = format!("\"{}\"", t.target);
             let anchors = ["tracks", anchor.as_str()];
             let mut parts = t.target.split('.');
-            let (node_id, param, component) = (
-                parts.next().unwrap_or(""),
-                parts.next().unwrap_or(""),
-                parts.next(),
-            );
+            let (node_id, param, component) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""), parts.next());
             let Some(node) = nodes.iter().position(|n| n.id == node_id) else {
-                self.error(
-                    &anchors,
-                    format!("track target '{}': no node '{node_id}'", t.target),
-                );
+                self.error(&anchors, format!("track target '{}': no node '{node_id}'", t.target));
                 continue;
             };
             let params = &nodes[node].params;
             let Some(pi) = params.index(param) else {
                 let names: Vec<String> = params.decls().iter().map(|d| d.name.clone()).collect();
-                self.error(
-                    &anchors,
-                    unknown_param(nodes[node].technique, param, &names),
-                );
+                self.error(&anchors, unknown_param(nodes[node].technique, param, &names));
                 continue;
             };
             let ty = params.decls()[pi].ty();
@@ -431,28 +328,14 @@ impl Validator<'_> {
                 Some(None) => {
                     self.error(
                         &anchors,
-                        format!(
-                            "track target '{}': a {ty} has no component '{}'",
-                            t.target,
-                            component.unwrap_or("")
-                        ),
+                        format!("track target '{}': a {ty} has no component '{}'", t.target, component.unwrap_or("")),
                     );
                     continue;
                 }
             };
-            let key_type = if component.is_some() {
-                ParamType::Float
-            } else {
-                ty
-            };
+            let key_type = if component.is_some() { ParamType::Float } else { ty };
             if t.keys.is_empty() || !(t.time_scale > 0.0) {
-                self.error(
-                    &anchors,
-                    format!(
-                        "track '{}' needs at least one key and a positive time_scale",
-                        t.target
-                    ),
-                );
+                self.error(&anchors, format!("track '{}' needs at least one key and a positive time_scale", t.target));
                 continue;
             }
             let mut keys = Vec::new();
@@ -461,33 +344,19 @@ impl Validator<'_> {
                     Some(value) => keys.push(Key { time: *time, value }),
                     None => self.error(
                         &anchors,
-                        format!(
-                            "track '{}': key at {time} s is {}, expected a {key_type}",
-                            t.target,
-                            describe(raw)
-                        ),
+                        format!("track '{}': key at {time} s is {}, expected a {key_type}", t.target, describe(raw)),
                     ),
                 }
             }
             let track = Track::new(keys, t.interpolation, t.repeat, t.time_scale);
-            out.push(BoundTrack {
-                target: t.target.clone(),
-                node,
-                param: pi,
-                component,
-                track,
-            });
+            out.push(BoundTrack { target: t.target.clone(), node, param: pi, component, track });
         }
         out
     }
 }
 
 fn unknown_param(technique: &TechniqueInfo, name: &str, known: &[String]) -> String {
-    format!(
-        "technique '{}' has no parameter '{name}' (parameters: {})",
-        technique.name,
-        known.join(", ")
-    )
+    format!("technique '{}' has no parameter '{name}' (parameters: {})", technique.name, known.join(", "))
 }
 
 fn component_index(c: &str, ty: ParamType) -> Option<usize> {
@@ -515,5 +384,109 @@ fn describe(raw: &RawValue) -> String {
         RawValue::Bool(b) => format!("the bool {b}"),
         RawValue::Number(x) => format!("the number {x}"),
         RawValue::List(v) => format!("a list of {} numbers", v.len()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"(
+    name: "test",
+    size: (64, 32),
+    nodes: [
+        (id: "k", technique: "kleinian", params: { "scale": 2.0, "t": (1.9, 0.1) }),
+    ],
+    output: "k",
+    tracks: [
+        (target: "k.t.y", interpolation: Linear, repeat: Loop, keys: [(0.0, 0.0), (1.0, 0.2)]),
+    ],
+)"#;
+
+    fn first_error(src: &str) -> SceneError {
+        parse_scene("test.ron", src).map(|_| ()).unwrap_err().0.remove(0)
+    }
+
+    #[test]
+    fn a_valid_scene_resolves_params_and_tracks() {
+        let scene = parse_scene("test.ron", GOOD).unwrap();
+        assert_eq!(scene.nodes[0].params.get("scale"), ParamValue::Float(2.0));
+        assert_eq!(scene.tracks[0].component, Some(1));
+        assert_eq!(scene.dt, 1.0 / 60.0);
+    }
+
+    #[test]
+    fn unknown_field_is_located_by_ron() {
+        let e = first_error(&GOOD.replace("size: (64, 32),", "size: (64, 32),\n    colour: 3,"));
+        assert_eq!(e.line, 4, "{e}");
+        assert!(e.message.contains("colour"), "{e}");
+    }
+
+    #[test]
+    fn syntax_error_is_located() {
+        let e = first_error(&GOOD.replace("output: \"k\",", "output: \"k\""));
+        assert!(e.line >= 7, "{e}");
+    }
+
+    #[test]
+    fn unknown_param_names_the_param_and_its_line() {
+        let e = first_error(&GOOD.replace("\"scale\": 2.0", "\"zoom\": 2.0"));
+        assert_eq!((e.line, e.column), (5, 52), "{e}");
+        assert!(e.message.contains("no parameter 'zoom'") && e.message.contains("scale"), "{e}");
+    }
+
+    #[test]
+    fn type_mismatch_is_an_error_not_a_default() {
+        let e = first_error(&GOOD.replace("\"scale\": 2.0", "\"scale\": (2.0, 1.0)"));
+        assert!(e.message.contains("'scale' is a float, not a list of 2 numbers"), "{e}");
+        let e = first_error(&GOOD.replace("\"scale\": 2.0", "\"scale\": true"));
+        assert!(e.message.contains("float"), "{e}");
+        let e = first_error(&GOOD.replace("\"scale\": 2.0", "\"iterations\": 2.5"));
+        assert!(e.message.contains("int"), "{e}");
+    }
+
+    #[test]
+    fn out_of_range_default_is_an_error() {
+        let e = first_error(&GOOD.replace("\"scale\": 2.0", "\"scale\": 500.0"));
+        assert!(e.message.contains("outside its range"), "{e}");
+    }
+
+    #[test]
+    fn unknown_technique_output_and_track_targets_are_errors() {
+        assert!(
+            first_error(&GOOD.replace("\"kleinian\"", "\"kleinain\"")).message.contains("unknown technique 'kleinain'")
+        );
+        assert!(first_error(&GOOD.replace("output: \"k\"", "output: \"q\"")).message.contains("output 'q'"));
+        let e = first_error(&GOOD.replace("k.t.y", "k.scale.y"));
+        assert!(e.message.contains("no component 'y'"), "{e}");
+        assert_eq!(e.line, 9, "{e}");
+        assert!(first_error(&GOOD.replace("k.t.y", "k.tt")).message.contains("no parameter 'tt'"));
+    }
+
+    #[test]
+    fn every_error_is_reported_not_just_the_first() {
+        let src = GOOD.replace("\"scale\": 2.0", "\"zoom\": 2.0").replace("output: \"k\"", "output: \"q\"");
+        assert_eq!(parse_scene("test.ron", &src).map(|_| ()).unwrap_err().0.len(), 2);
+    }
+
+    #[test]
+    fn cli_overrides_are_typed_and_clamped() {
+        let mut scene = parse_scene("test.ron", GOOD).unwrap();
+        scene.set_from_str("k.samples=10").unwrap();
+        scene.set_from_str("k.t=1.5,0.25").unwrap();
+        scene.set_from_str("k.iterations=99999").unwrap();
+        let p = &scene.nodes[0].params;
+        assert_eq!((p.int("samples"), p.vec2("t"), p.int("iterations")), (10, [1.5, 0.25], 5000));
+        assert!(scene.set_from_str("k.samples=lots").unwrap_err().contains("not a number"));
+        assert!(scene.set_from_str("k.t=1").unwrap_err().contains("vec2"));
+        assert!(scene.set_from_str("x.t=1").unwrap_err().contains("no node 'x'"));
+    }
+
+    #[test]
+    fn every_bundled_scene_is_valid() {
+        let assets = Assets::new(None);
+        for name in assets.names(AssetKind::Scene) {
+            load_scene(&assets, &name).unwrap_or_else(|e| panic!("{e}"));
+        }
     }
 }

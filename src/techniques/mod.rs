@@ -54,15 +54,12 @@ pub struct NodeSetup<'a> {
 impl NodeSetup<'_> {
     /// Loads a shader file's text and origin, turning a missing file into a located error.
     pub fn shader_source(&self, file: &str) -> Result<(String, String), ShaderError> {
-        self.assets
-            .load(AssetKind::Shader, file)
-            .map(|a| (a.origin, a.source))
-            .map_err(|message| ShaderError {
-                origin: file.into(),
-                line: 1,
-                column: 1,
-                message,
-            })
+        self.assets.load(AssetKind::Shader, file).map(|a| (a.origin, a.source)).map_err(|message| ShaderError {
+            origin: file.into(),
+            line: 1,
+            column: 1,
+            message,
+        })
     }
 }
 
@@ -83,9 +80,5 @@ pub trait Technique {
 
 /// Converts one sRGB-encoded channel (as colour pickers and scene files give) to linear.
 pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }

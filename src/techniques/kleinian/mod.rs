@@ -40,60 +40,15 @@ pub fn params() -> Vec<ParamDecl> {
             Some((-2.5, 2.5)),
             "Maskit parameter t = (u, v); (2, 0) is the classic set, near (1.94, 0.02) it turns intricate",
         ),
-        ParamDecl::new(
-            "iterations",
-            Int(500),
-            Some((1.0, 5000.0)),
-            "escape-time iteration cap per sample",
-        ),
-        ParamDecl::new(
-            "scale",
-            Float(1.0),
-            Some((0.01, 50.0)),
-            "fractal units per output height (zoom out)",
-        ),
-        ParamDecl::new(
-            "offset",
-            Vec2([0.0, 0.0]),
-            Some((-20.0, 20.0)),
-            "fractal position of the bottom-left corner",
-        ),
-        ParamDecl::new(
-            "hit_color",
-            Color([1.0, 0.0, 0.0, 1.0]),
-            None,
-            "colour inside the limit set's disks",
-        ),
-        ParamDecl::new(
-            "back_color",
-            Color([0.5, 0.5, 0.5, 1.0]),
-            None,
-            "background colour",
-        ),
-        ParamDecl::new(
-            "samples",
-            Int(1),
-            Some((1.0, 64.0)),
-            "jittered samples per pixel (anti-aliasing)",
-        ),
-        ParamDecl::new(
-            "circle_inversion",
-            Bool(false),
-            None,
-            "invert the plane in a circle before the test",
-        ),
-        ParamDecl::new(
-            "circle_center",
-            Vec2([0.0, 0.0]),
-            Some((-20.0, 20.0)),
-            "inversion circle centre",
-        ),
-        ParamDecl::new(
-            "circle_radius",
-            Float(1.0),
-            Some((0.01, 20.0)),
-            "inversion circle radius",
-        ),
+        ParamDecl::new("iterations", Int(500), Some((1.0, 5000.0)), "escape-time iteration cap per sample"),
+        ParamDecl::new("scale", Float(1.0), Some((0.01, 50.0)), "fractal units per output height (zoom out)"),
+        ParamDecl::new("offset", Vec2([0.0, 0.0]), Some((-20.0, 20.0)), "fractal position of the bottom-left corner"),
+        ParamDecl::new("hit_color", Color([1.0, 0.0, 0.0, 1.0]), None, "colour inside the limit set's disks"),
+        ParamDecl::new("back_color", Color([0.5, 0.5, 0.5, 1.0]), None, "background colour"),
+        ParamDecl::new("samples", Int(1), Some((1.0, 64.0)), "jittered samples per pixel (anti-aliasing)"),
+        ParamDecl::new("circle_inversion", Bool(false), None, "invert the plane in a circle before the test"),
+        ParamDecl::new("circle_center", Vec2([0.0, 0.0]), Some((-20.0, 20.0)), "inversion circle centre"),
+        ParamDecl::new("circle_radius", Float(1.0), Some((0.01, 20.0)), "inversion circle radius"),
     ]
 }
 
@@ -132,14 +87,7 @@ pub struct KleinianUniforms {
 impl KleinianUniforms {
     /// All per-frame precomputation: colours to linear, bools to flags.
     pub fn from_params(p: &ParamSet, time: &FrameTime, size: (u32, u32)) -> Self {
-        let linear = |c: [f32; 4]| {
-            [
-                srgb_to_linear(c[0]),
-                srgb_to_linear(c[1]),
-                srgb_to_linear(c[2]),
-                c[3],
-            ]
-        };
+        let linear = |c: [f32; 4]| [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3]];
         Self {
             t: p.vec2("t"),
             scale: p.float("scale"),
@@ -202,12 +150,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    Ok(Box::new(Kleinian {
-        kernel,
-        layout,
-        uniforms,
-        bind_groups: HashMap::new(),
-    }))
+    Ok(Box::new(Kleinian { kernel, layout, uniforms, bind_groups: HashMap::new() }))
 }
 
 impl Technique for Kleinian {
@@ -221,42 +164,32 @@ impl Technique for Kleinian {
         let output = graph.create_texture("kleinian/image", TextureDesc::full(OUTPUT_FORMAT));
         let size = graph.texture_size(output);
         let uniforms = KleinianUniforms::from_params(params, time, size);
-        graph
-            .add_pass("kleinian/limit_set")
-            .write(output)
-            .record(move |ctx| {
-                ctx.queue
-                    .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
-                let key = ctx.texture_id(output);
-                // Old entries would keep evicted pool textures alive after resizes.
-                if self.bind_groups.len() > 8 && !self.bind_groups.contains_key(&key) {
-                    self.bind_groups.clear();
-                }
-                let bind_group = self.bind_groups.entry(key).or_insert_with(|| {
-                    ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("kleinian_bind_group"),
-                        layout: &self.layout,
-                        entries: &[
-                            wgpu::BindGroupEntry {
-                                binding: 0,
-                                resource: self.uniforms.as_entire_binding(),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 1,
-                                resource: wgpu::BindingResource::TextureView(ctx.view(output)),
-                            },
-                        ],
-                    })
-                });
-                let mut pass = ctx
-                    .encoder
-                    .begin_compute_pass(&wgpu::ComputePassDescriptor {
-                        label: Some("kleinian/limit_set"),
-                        timestamp_writes: None,
-                    });
-                self.kernel
-                    .dispatch(&mut pass, &[bind_group], [size.0, size.1, 1]);
+        graph.add_pass("kleinian/limit_set").write(output).record(move |ctx| {
+            ctx.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
+            let key = ctx.texture_id(output);
+            // Old entries would keep evicted pool textures alive after resizes.
+            if self.bind_groups.len() > 8 && !self.bind_groups.contains_key(&key) {
+                self.bind_groups.clear();
+            }
+            let bind_group = self.bind_groups.entry(key).or_insert_with(|| {
+                ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("kleinian_bind_group"),
+                    layout: &self.layout,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::TextureView(ctx.view(output)),
+                        },
+                    ],
+                })
             });
+            let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("kleinian/limit_set"),
+                timestamp_writes: None,
+            });
+            self.kernel.dispatch(&mut pass, &[bind_group], [size.0, size.1, 1]);
+        });
         output
     }
 }

@@ -68,10 +68,7 @@ mod tests {
         // a maps the disk |z - i/4| < 1/4 (the inverse of the line y = u = 2) below y = 0.
         assert!(in_limit_set([0.0, 0.2], t, 200));
         assert!(in_limit_set([2.0, 0.2], t, 200), "period 2 along x");
-        assert!(
-            in_limit_set([0.0, 1.8], t, 200),
-            "point symmetry about (-v/2, u/2) = (0, 1)"
-        );
+        assert!(in_limit_set([0.0, 1.8], t, 200), "point symmetry about (-v/2, u/2) = (0, 1)");
         // (0, 1) is the fixed point of the reflection and of a: it cycles, never escapes.
         assert!(!in_limit_set([0.0, 1.0], t, 200));
         assert!(!in_limit_set([0.0, -0.1], t, 200), "below the strip");

@@ -1,0 +1,169 @@
+//! The `indra` binary end to end: render, check, list, bench, and one clear sentence for every
+//! kind of bad input.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn indra(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_indra"))
+        .args(args)
+        .args(["--backend", "vulkan"])
+        .env("INDRA_ROOT", env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the binary runs")
+}
+
+fn text(o: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("indra-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn render_writes_a_png_sequence_of_the_requested_size() {
+    let out = temp_dir("render");
+    let o = indra(&[
+        "render",
+        "kleinian",
+        "--frames",
+        "3",
+        "--start",
+        "10",
+        "--size",
+        "64x48",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let mut names: Vec<String> =
+        std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(names, ["kleinian_00010.png", "kleinian_00011.png", "kleinian_00012.png"]);
+    let img = image::open(out.join("kleinian_00011.png")).unwrap();
+    assert_eq!((img.width(), img.height()), (64, 48));
+}
+
+#[test]
+fn render_set_overrides_a_parameter() {
+    let base = temp_dir("set-base");
+    let changed = temp_dir("set-changed");
+    let run = |dir: &PathBuf, extra: &[&str]| {
+        let mut args = vec!["render", "kleinian_classic", "--size", "64x64", "--out", dir.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = indra(&args);
+        assert!(o.status.success(), "{}", text(&o));
+        std::fs::read(dir.join("kleinian_classic_00000.png")).unwrap()
+    };
+    assert_ne!(run(&base, &[]), run(&changed, &["--set", "limit_set.hit_color=0,0,1"]));
+}
+
+#[test]
+fn check_passes_on_the_bundled_files() {
+    let o = indra(&["check"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("0 with errors"), "{}", text(&o));
+}
+
+#[test]
+fn check_reports_a_broken_scene_with_file_line_and_column() {
+    let dir = temp_dir("check-scene");
+    let path = dir.join("broken.ron");
+    let source = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/kleinian.ron")).unwrap();
+    std::fs::write(&path, source.replace("\"scale\": 1.9", "\"scael\": 1.9")).unwrap();
+    let o = indra(&["check", path.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let line = source.lines().position(|l| l.contains("\"scale\": 1.9")).unwrap() + 1;
+    let expected = format!("broken.ron:{line}:17: technique 'kleinian' has no parameter 'scael'");
+    assert!(text(&o).contains(&expected), "expected «{expected}» in:\n{}", text(&o));
+}
+
+#[test]
+fn check_reports_a_broken_shader_with_its_line() {
+    let dir = temp_dir("check-shader");
+    let path = dir.join("broken.wgsl");
+    std::fs::write(&path, "@compute @workgroup_size(8, 8, 1)\nfn main() {\n    let x = vec2<f32>(1.0) +;\n}\n")
+        .unwrap();
+    let o = indra(&["check", path.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o).contains("broken.wgsl:3:"), "{}", text(&o));
+}
+
+#[test]
+fn list_shows_osc_addresses_of_every_scene() {
+    let o = indra(&["list"]);
+    assert!(o.status.success());
+    let t = text(&o);
+    for scene in ["kleinian", "kleinian_circle_inversion", "kleinian_classic"] {
+        assert!(t.contains(&format!("{scene} — ")), "{scene} missing from:\n{t}");
+    }
+    assert!(t.contains("/indra/limit_set/t") && t.contains("(animated)"), "{t}");
+}
+
+#[test]
+fn bench_prints_pass_medians_and_frame_time() {
+    let o = indra(&[
+        "bench",
+        "kleinian",
+        "--size",
+        "64x64",
+        "--frames",
+        "6",
+        "--warmup",
+        "2",
+        "--set",
+        "limit_set.samples=2",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let t = text(&o);
+    assert!(t.contains("frame wall time (median)") && t.contains("set        limit_set.samples=2"), "{t}");
+    assert!(t.contains("kleinian/limit_set") || t.contains("wall-clock only"), "{t}");
+}
+
+#[test]
+fn bad_input_gets_one_clear_sentence() {
+    let missing = indra(&["render", "no_such_scene"]);
+    assert_eq!(missing.status.code(), Some(1));
+    assert!(text(&missing).contains("no scene named 'no_such_scene.ron'"), "{}", text(&missing));
+
+    let bad_size = indra(&["render", "kleinian", "--size", "0x5"]);
+    assert_eq!(bad_size.status.code(), Some(2));
+    assert!(text(&bad_size).contains("is not WxH"), "{}", text(&bad_size));
+
+    let bad_set = indra(&["render", "kleinian", "--set", "limit_set.zoom=2"]);
+    assert_eq!(bad_set.status.code(), Some(1));
+    assert!(text(&bad_set).contains("has no parameter 'zoom'"), "{}", text(&bad_set));
+
+    for t in [&missing, &bad_set] {
+        assert!(!text(t).contains("panicked"), "{}", text(t));
+    }
+}
+
+#[test]
+fn no_gpu_says_how_to_get_one() {
+    let o = Command::new(env!("CARGO_BIN_EXE_indra"))
+        .args(["--backend", "vulkan", "render", "kleinian"])
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("no GPU adapter found") && text(&o).contains("mesa-vulkan-drivers"), "{}", text(&o));
+}
+
+#[test]
+fn no_display_says_what_to_do_instead() {
+    let o = Command::new(env!("CARGO_BIN_EXE_indra"))
+        .arg("run")
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("WAYLAND_SOCKET")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("cannot open a window") && text(&o).contains("indra render"), "{}", text(&o));
+}

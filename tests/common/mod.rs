@@ -1,0 +1,48 @@
+//! Helpers shared by the integration tests: a lavapipe-friendly device, scene rendering, and
+//! pixel classification.
+#![allow(dead_code)]
+
+use indra::assets::Assets;
+use indra::gpu::{BackendChoice, Gpu, GpuOptions};
+use indra::offscreen::{GoldenCheck, OffscreenRenderer, RenderedFrame};
+use indra::scene::{Scene, load_scene, parse_scene};
+
+/// A headless device. Vulkan (lavapipe on CI) so that goldens are made by one backend.
+pub fn gpu() -> Gpu {
+    Gpu::headless(&GpuOptions { backend: BackendChoice::Vulkan, adapter: None })
+        .expect("a Vulkan adapter (on a machine without a GPU: apt-get install mesa-vulkan-drivers libvulkan1)")
+}
+
+/// The project's assets (scenes/ and shaders/ of this checkout).
+pub fn assets() -> Assets {
+    Assets::new(Some(env!("CARGO_MANIFEST_DIR").into()))
+}
+
+/// Renders frame `frame` of `scene` at `size`.
+pub fn render_scene(scene: Scene, size: (u32, u32), frame: u64) -> RenderedFrame {
+    let mut r = OffscreenRenderer::new(gpu(), &assets(), scene, Some(size), None, None).expect("scene builds");
+    r.seek(frame);
+    r.render_next().expect("frame renders")
+}
+
+/// Renders a bundled scene by name.
+pub fn render_named(name: &str, size: (u32, u32), frame: u64) -> RenderedFrame {
+    render_scene(load_scene(&assets(), name).expect("scene is valid"), size, frame)
+}
+
+/// Renders a scene given as RON text.
+pub fn render_text(ron: &str, size: (u32, u32)) -> RenderedFrame {
+    render_scene(parse_scene("inline.ron", ron).unwrap_or_else(|e| panic!("{e}")), size, 0)
+}
+
+/// The golden checker for `tests/golden/`.
+pub fn golden() -> GoldenCheck {
+    GoldenCheck::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/golden"))
+}
+
+/// Whether pixel (x, y) is bright (mean of RGB above half).
+pub fn bright(frame: &RenderedFrame, x: u32, y: u32) -> bool {
+    let i = ((y * frame.size.0 + x) * 4) as usize;
+    let p = &frame.rgba[i..i + 3];
+    (u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2])) > 3 * 128
+}
