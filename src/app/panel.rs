@@ -109,12 +109,8 @@ fn param_widget(ui: &mut egui::Ui, decl: &ParamDecl, value: &mut ParamValue) -> 
             let b = ui.add(egui::DragValue::new(&mut v[1]).speed(0.001).range(lo..=hi)).changed();
             pad || a || b
         }
-        ParamValue::Vec3(v) => {
-            v.iter_mut().fold(false, |c, x| ui.add(egui::DragValue::new(x).speed(0.01)).changed() || c)
-        }
-        ParamValue::Vec4(v) => {
-            v.iter_mut().fold(false, |c, x| ui.add(egui::DragValue::new(x).speed(0.01)).changed() || c)
-        }
+        ParamValue::Vec3(v) => drag_components(ui, v),
+        ParamValue::Vec4(v) => drag_components(ui, v),
         ParamValue::Color(c) => {
             // Scene colours are sRGB-encoded, as the picker's bytes are.
             let mut bytes = c.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u8);
@@ -125,6 +121,15 @@ fn param_widget(ui: &mut egui::Ui, decl: &ParamDecl, value: &mut ParamValue) -> 
             changed
         }
     }
+}
+
+/// One drag field per component; every field is drawn even after one changed.
+fn drag_components(ui: &mut egui::Ui, components: &mut [f32]) -> bool {
+    let mut changed = false;
+    for x in components {
+        changed |= ui.add(egui::DragValue::new(x).speed(0.01)).changed();
+    }
+    changed
 }
 
 /// A square pad: dragging inside sets both components across the range.

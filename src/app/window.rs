@@ -12,7 +12,7 @@ use winit::window::{Fullscreen, Window, WindowId};
 use super::WindowOptions;
 use super::panel::{Overlay, draw_ui};
 use crate::assets::Assets;
-use crate::gpu::{Blit, Gpu, GpuOptions};
+use crate::gpu::{Blit, BlitTarget, Gpu, GpuOptions};
 use crate::graph::GraphRuntime;
 use crate::scene::{Scene, SceneInstance};
 use crate::time::FixedClock;
@@ -220,9 +220,7 @@ impl Running {
                     &self.gpu.queue,
                     &mut encoder,
                     &output.view,
-                    &target,
-                    self.config.format,
-                    size,
+                    BlitTarget { view: &target, format: self.config.format, size },
                 );
                 self.overlay.stats = Some(output.stats);
             }

@@ -7,6 +7,16 @@ pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 const SOURCE: &str = include_str!("../../shaders/display.wgsl");
 
+/// Where a blit draws: a render-target view of `format` and `size`.
+pub struct BlitTarget<'a> {
+    /// The view to draw into.
+    pub view: &'a wgpu::TextureView,
+    /// Its format (picks the pipeline).
+    pub format: wgpu::TextureFormat,
+    /// Its size in pixels.
+    pub size: (u32, u32),
+}
+
 /// Draws a texture into a render target, converting linear colour to sRGB bytes.
 pub struct Blit {
     layout: wgpu::BindGroupLayout,
@@ -54,17 +64,16 @@ impl Blit {
         Self { layout, module, pipelines: HashMap::new(), uniform }
     }
 
-    /// Records a pass that draws `source` over the whole of `target` (of `size` and `format`).
+    /// Records a pass that draws `source` over the whole of `target`.
     pub fn record(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         source: &wgpu::TextureView,
-        target: &wgpu::TextureView,
-        format: wgpu::TextureFormat,
-        size: (u32, u32),
+        target: BlitTarget<'_>,
     ) {
+        let BlitTarget { view: target, format, size } = target;
         queue.write_buffer(&self.uniform, 0, bytemuck::cast_slice(&[size.0, size.1, 0, 0]));
         let pipeline = self.pipeline(device, format).clone();
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {

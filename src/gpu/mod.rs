@@ -8,7 +8,7 @@ mod context;
 mod readback;
 mod shader;
 
-pub use blit::{Blit, DISPLAY_FORMAT};
+pub use blit::{Blit, BlitTarget, DISPLAY_FORMAT};
 pub use compute::ComputeKernel;
 pub use context::{BackendChoice, Gpu, GpuError, GpuOptions, instance_descriptor};
 pub use readback::read_texture_rgba8;

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use crate::assets::Assets;
-use crate::gpu::{Blit, DISPLAY_FORMAT, Gpu, read_texture_rgba8};
+use crate::gpu::{Blit, BlitTarget, DISPLAY_FORMAT, Gpu, read_texture_rgba8};
 use crate::graph::{FrameStats, GraphRuntime};
 use crate::scene::{Scene, SceneInstance};
 use crate::time::{FixedClock, FrameTime};
@@ -93,9 +93,7 @@ impl OffscreenRenderer {
             &self.gpu.queue,
             &mut encoder,
             &output.view,
-            &target_view,
-            DISPLAY_FORMAT,
-            self.size,
+            BlitTarget { view: &target_view, format: DISPLAY_FORMAT, size: self.size },
         );
         self.gpu.queue.submit([encoder.finish()]);
         self.runtime.after_submit();

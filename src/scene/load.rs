@@ -334,7 +334,7 @@ impl Validator<'_> {
                 }
             };
             let key_type = if component.is_some() { ParamType::Float } else { ty };
-            if t.keys.is_empty() || !(t.time_scale > 0.0) {
+            if t.keys.is_empty() || t.time_scale.is_nan() || t.time_scale <= 0.0 {
                 self.error(&anchors, format!("track '{}' needs at least one key and a positive time_scale", t.target));
                 continue;
             }
