@@ -10,6 +10,14 @@ use indra::gpu::{Gpu, GpuOptions, validate_wgsl};
 use indra::offscreen::{OffscreenRenderer, write_png};
 use indra::scene::{Scene, load_scene};
 
+/// Prints a line to stdout, ignoring a closed pipe (`indra list | head` must not panic).
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 /// The scene `indra` opens with no arguments.
 pub const DEFAULT_SCENE: &str = "kleinian";
 
@@ -154,14 +162,14 @@ pub fn check(assets: &Assets, files: &[PathBuf]) -> Result<(), String> {
                 .and_then(|(origin, source)| validate_wgsl(&origin, &source).map(|_| ()).map_err(|e| e.to_string())),
         };
         match result {
-            Ok(()) => println!("ok     {name}"),
+            Ok(()) => say!("ok     {name}"),
             Err(e) => {
                 failures += 1;
-                println!("error  {e}");
+                say!("error  {e}");
             }
         }
     }
-    println!("{} checked, {failures} with errors", targets.len());
+    say!("{} checked, {failures} with errors", targets.len());
     if failures > 0 { Err(format!("{failures} file(s) have errors")) } else { Ok(()) }
 }
 
@@ -177,17 +185,17 @@ fn read_shader(assets: &Assets, name: &str) -> Result<(String, String), String> 
 pub fn list(assets: &Assets) -> Result<(), String> {
     for name in assets.names(AssetKind::Scene) {
         match load_scene(assets, &name) {
-            Err(e) => println!("{name}: INVALID\n{e}\n"),
+            Err(e) => say!("{name}: INVALID\n{e}\n"),
             Ok(scene) => {
                 let stem = name.trim_end_matches(".ron");
-                println!("{stem} — {} ({}x{}): {}", scene.name, scene.size.0, scene.size.1, scene.description);
+                say!("{stem} — {} ({}x{}): {}", scene.name, scene.size.0, scene.size.1, scene.description);
                 for (i, node) in scene.nodes.iter().enumerate() {
-                    println!("  node {} ({})", node.id, node.technique.name);
+                    say!("  node {} ({})", node.id, node.technique.name);
                     for (p, decl) in node.params.decls().iter().enumerate() {
                         let animated = scene.tracks.iter().any(|t| t.node == i && t.param == p);
                         let range = decl.range.map(|(lo, hi)| format!(" [{lo} … {hi}]")).unwrap_or_default();
-                        println!(
-                            "    /indra/{}/{:<18} {:<6} = {:?}{range}{}",
+                        say!(
+                            "    /indra/{}/{:<18} {:<6} = {}{range}{}",
                             node.id,
                             decl.name,
                             decl.ty(),
@@ -196,7 +204,7 @@ pub fn list(assets: &Assets) -> Result<(), String> {
                         );
                     }
                 }
-                println!();
+                say!();
             }
         }
     }
@@ -232,26 +240,26 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     renderer.finish_timings();
     walls.sort_by(f64::total_cmp);
     let wall_median = walls.get(walls.len() / 2).copied().unwrap_or(0.0);
-    println!("scene      {name}");
-    println!("adapter    {adapter}");
-    println!("size       {}x{}   frames {} (+{} warm-up)", args.size.0, args.size.1, args.frames, args.warmup);
+    say!("scene      {name}");
+    say!("adapter    {adapter}");
+    say!("size       {}x{}   frames {} (+{} warm-up)", args.size.0, args.size.1, args.frames, args.warmup);
     for s in &args.sets {
-        println!("set        {s}");
+        say!("set        {s}");
     }
     if timestamps {
-        println!("{:<28} {:>12} {:>8}", "pass", "GPU median", "samples");
+        say!("{:<28} {:>12} {:>8}", "pass", "GPU median", "samples");
         for t in renderer.runtime().timings() {
-            println!("{:<28} {:>9.3} ms {:>8}", t.name, t.median_ms, t.samples);
+            say!("{:<28} {:>9.3} ms {:>8}", t.name, t.median_ms, t.samples);
         }
         if let Some(ms) = renderer.runtime().frame_gpu_median_ms() {
-            println!("{:<28} {:>9.3} ms", "all passes (GPU)", ms);
+            say!("{:<28} {:>9.3} ms", "all passes (GPU)", ms);
         }
     } else {
-        println!("(this adapter has no TIMESTAMP_QUERY_INSIDE_ENCODERS: wall-clock only)");
+        say!("(this adapter has no TIMESTAMP_QUERY_INSIDE_ENCODERS: wall-clock only)");
     }
-    println!("{:<28} {:>9.3} ms  ({:.1} fps)", "frame wall time (median)", wall_median, 1e3 / wall_median.max(1e-9));
+    say!("{:<28} {:>9.3} ms  ({:.1} fps)", "frame wall time (median)", wall_median, 1e3 / wall_median.max(1e-9));
     if let Some(s) = stats {
-        println!(
+        say!(
             "graph      passes {}/{} executed, transient {} KiB requested / {} KiB allocated, compile {:.1} µs",
             s.passes_executed,
             s.passes_declared,

@@ -136,3 +136,31 @@ fn broken_shader_fails_with_location_and_device_survives() {
     assert_eq!(kernel.workgroups([17, 9, 1]), [3, 3, 1], "dispatch sizes come from the shader's workgroup size");
     assert!(gpu.take_uncaptured_errors().is_empty());
 }
+
+#[test]
+fn persistent_ping_pong_state_is_written_even_if_nothing_reads_it() {
+    let gpu = common::gpu();
+    let mut runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
+    let mut state = indra::graph::PingPong::new(&gpu.device, "test.state", (8, 8), FMT);
+    for (step, colour) in [(0, wgpu::Color::RED), (1, wgpu::Color::BLUE)] {
+        let mut graph = FrameGraph::new((8, 8));
+        let (write, history) = state.write_and_history();
+        let next = graph.import_texture("state.next", write);
+        let _prev = graph.import_texture("state.prev", history);
+        let out = graph.create_texture("out", TextureDesc::full(FMT));
+        // Writes only persistent state: must not be culled although the output never reads it.
+        graph.add_pass("simulate").render_target(next).record(move |ctx| clear(ctx, next, colour));
+        graph.add_pass("show").render_target(out).record(move |ctx| clear(ctx, out, wgpu::Color::BLACK));
+        graph.set_output(out);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let frame = runtime.execute(&gpu.device, &gpu.queue, graph, &mut encoder).unwrap();
+        gpu.queue.submit([encoder.finish()]);
+        assert_eq!(frame.stats.passes_executed, 2, "step {step}");
+        state.swap();
+    }
+    // After two steps the current state holds the second write, the other the first.
+    let current = read_texture_rgba8(&gpu.device, &gpu.queue, &state.current().texture);
+    assert_eq!(&current[..4], &[0, 0, 255, 255]);
+    let (other, _) = state.write_and_history();
+    assert_eq!(&read_texture_rgba8(&gpu.device, &gpu.queue, &other.texture)[..4], &[255, 0, 0, 255]);
+}

@@ -72,7 +72,7 @@ pub struct PersistentTexture {
 }
 
 impl PersistentTexture {
-    /// Creates a texture usable as storage, sampled and copy source/destination.
+    /// Creates a texture usable as storage, sampled, render target and copy source/destination.
     pub fn new(device: &wgpu::Device, label: &str, size: (u32, u32), format: wgpu::TextureFormat) -> Self {
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),
@@ -84,7 +84,8 @@ impl PersistentTexture {
             usage: wgpu::TextureUsages::STORAGE_BINDING
                 | wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::COPY_DST,
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::RENDER_ATTACHMENT,
             view_formats: &[],
         });
         let view = texture.create_view(&Default::default());

@@ -142,6 +142,21 @@ impl ParamValue {
     }
 }
 
+impl fmt::Display for ParamValue {
+    /// As a scene file would write it: `1.9`, `50`, `true`, `(1.98795, 0.005859)`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ParamValue::Int(i) => write!(f, "{i}"),
+            ParamValue::Bool(b) => write!(f, "{b}"),
+            ParamValue::Float(x) => write!(f, "{x}"),
+            other => {
+                let parts: Vec<String> = other.components().iter().map(|c| c.to_string()).collect();
+                write!(f, "({})", parts.join(", "))
+            }
+        }
+    }
+}
+
 /// A parameter a technique exposes: name, type, default, range, unit and meaning.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ParamDecl {
@@ -187,6 +202,13 @@ mod tests {
         assert_eq!(ParamType::Vec2.value_from(&[1.0]), None);
         assert_eq!(ParamType::Color.value_from(&[1.0, 0.5, 0.0]), Some(ParamValue::Color([1.0, 0.5, 0.0, 1.0])));
         assert_eq!(ParamType::Bool.value_from(&[2.0]), None);
+    }
+
+    #[test]
+    fn display_is_scene_syntax() {
+        assert_eq!(ParamValue::Vec2([1.5, 0.25]).to_string(), "(1.5, 0.25)");
+        assert_eq!(ParamValue::Int(50).to_string(), "50");
+        assert_eq!(ParamValue::Bool(true).to_string(), "true");
     }
 
     #[test]

@@ -9,13 +9,18 @@ fn wrap(x: f32, width: f32, left: f32) -> f32 {
 
 /// The escape-time test of `shaders/kleinian.wgsl::in_limit_set`.
 pub fn in_limit_set(start: [f32; 2], t: [f32; 2], iterations: u32) -> bool {
+    classify(start, t, iterations).0
+}
+
+/// (hit, loop iterations run) — the second is the sample's cost on the GPU.
+pub fn classify(start: [f32; 2], t: [f32; 2], iterations: u32) -> (bool, u32) {
     let [u, v] = t;
     let [mut x, mut y] = start;
     if y < 0.0 || y > u {
-        return false;
+        return (false, 0);
     }
     let (mut lz, mut llz) = ([x + 1.0, y + 1.0], [x - 1.0, y - 1.0]);
-    for _ in 0..iterations {
+    for i in 0..iterations {
         let shear = v / u * y;
         x = wrap(x + shear, 2.0, -1.0) - shear;
         let d = x + v * 0.5;
@@ -29,15 +34,15 @@ pub fn in_limit_set(start: [f32; 2], t: [f32; 2], iterations: u32) -> bool {
         let r2 = x * x + y * y;
         (x, y) = (x / r2 - v, -y / r2 + u);
         if y < 0.0 {
-            return true;
+            return (true, i + 1);
         }
         if ((x - llz[0]).powi(2) + (y - llz[1]).powi(2)).sqrt() < 1e-6 {
-            return false;
+            return (false, i + 1);
         }
         llz = lz;
         lz = [x, y];
     }
-    false
+    (false, iterations)
 }
 
 /// The fractal-plane point at the centre of pixel (px, py) (y down) of a `height`-tall image.
