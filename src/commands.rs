@@ -199,7 +199,7 @@ pub fn list(assets: &Assets) -> Result<(), String> {
                             node.id,
                             decl.name,
                             decl.ty(),
-                            node.params.value_at(p),
+                            decl.format(&node.params.value_at(p)),
                             if animated { "  (animated)" } else { "" }
                         );
                     }

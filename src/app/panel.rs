@@ -103,6 +103,16 @@ fn param_widget(ui: &mut egui::Ui, decl: &ParamDecl, value: &mut ParamValue) -> 
         }
         ParamValue::Int(i) => ui.add(egui::Slider::new(i, lo as i32..=hi as i32)).changed(),
         ParamValue::Bool(b) => ui.checkbox(b, "").changed(),
+        ParamValue::Enum(i) => {
+            let before = *i;
+            let shown = decl.format(&ParamValue::Enum(*i));
+            egui::ComboBox::from_id_salt(&decl.name).selected_text(shown).show_ui(ui, |ui| {
+                for (k, option) in decl.options.iter().enumerate() {
+                    ui.selectable_value(i, k as u32, option);
+                }
+            });
+            *i != before
+        }
         ParamValue::Vec2(v) => {
             let pad = vec2_pad(ui, v, (lo, hi));
             let a = ui.add(egui::DragValue::new(&mut v[0]).speed(0.001).range(lo..=hi)).changed();

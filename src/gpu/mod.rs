@@ -11,5 +11,5 @@ mod shader;
 pub use blit::{Blit, BlitTarget, DISPLAY_FORMAT};
 pub use compute::ComputeKernel;
 pub use context::{BackendChoice, Gpu, GpuError, GpuOptions, instance_descriptor};
-pub use readback::read_texture_rgba8;
+pub use readback::{read_texture_bytes, read_texture_rgba8};
 pub use shader::{ShaderError, compile_wgsl, validate_wgsl};

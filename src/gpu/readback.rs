@@ -1,10 +1,12 @@
 //! Copying a texture back to the CPU.
 
-/// Reads an `Rgba8Unorm` (or `Bgra8Unorm`, returned as stored) texture into tightly packed rows.
-/// Blocks until the GPU is done; for tests, exports and screenshots, not for the frame loop.
-pub fn read_texture_rgba8(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) -> Vec<u8> {
+/// Reads any single-plane colour texture into tightly packed rows of its texel bytes (e.g. 8
+/// bytes per texel for `Rgba16Float`). Blocks until the GPU is done; for tests, exports and
+/// screenshots, not for the frame loop.
+pub fn read_texture_bytes(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) -> Vec<u8> {
     let (width, height) = (texture.width(), texture.height());
-    let tight = width * 4;
+    let texel = texture.format().block_copy_size(None).expect("a colour format with a fixed texel size");
+    let tight = width * texel;
     let padded = tight.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback_buffer"),
@@ -36,4 +38,10 @@ pub fn read_texture_rgba8(device: &wgpu::Device, queue: &wgpu::Queue, texture: &
         out.extend_from_slice(&row[..tight as usize]);
     }
     out
+}
+
+/// Reads an `Rgba8Unorm` (or `Bgra8Unorm`, returned as stored) texture into tightly packed rows.
+pub fn read_texture_rgba8(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) -> Vec<u8> {
+    debug_assert_eq!(texture.format().block_copy_size(None), Some(4));
+    read_texture_bytes(device, queue, texture)
 }

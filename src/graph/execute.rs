@@ -95,10 +95,11 @@ impl GraphRuntime {
                 if life.is_some_and(|(first, _)| first == position) {
                     let (resolved, pooled) = self.resolve_texture(device, &graph, t, usages[t]);
                     if let Some(i) = pooled {
-                        stats.transient_bytes_requested += texture_bytes(size_of(&resolved), resolved.texture.format());
+                        let bytes = texture_bytes(size_of(&resolved), resolved.texture.format())
+                            * u64::from(resolved.texture.depth_or_array_layers());
+                        stats.transient_bytes_requested += bytes;
                         if used_pool_entries.insert(i) {
-                            stats.transient_bytes_allocated +=
-                                texture_bytes(size_of(&resolved), resolved.texture.format());
+                            stats.transient_bytes_allocated += bytes;
                         }
                     }
                     textures[t] = Some(resolved);
@@ -200,7 +201,12 @@ impl GraphRuntime {
                 (ResolvedTexture { texture: texture.clone(), view: view.clone(), id: *id }, None)
             }
             TextureOrigin::Transient(desc) => {
-                let key = PoolKey { size: desc.extent.resolve(graph.output_size), format: desc.format, usage };
+                let key = PoolKey {
+                    size: desc.extent.resolve(graph.output_size),
+                    format: desc.format,
+                    usage,
+                    layers: desc.layers,
+                };
                 let (index, resolved) = self.pool.acquire(device, key);
                 (resolved, Some(index))
             }

@@ -14,6 +14,8 @@ pub struct PoolKey {
     pub format: wgpu::TextureFormat,
     /// Usage flags the user needs.
     pub usage: wgpu::TextureUsages,
+    /// Array layers (`None`: plain 2-D).
+    pub layers: Option<u32>,
 }
 
 struct Entry {
@@ -43,13 +45,21 @@ impl TexturePool {
     /// A free texture matching `key` (same size and format, at least the usage), or a new one.
     pub(crate) fn acquire(&mut self, device: &wgpu::Device, key: PoolKey) -> (usize, ResolvedTexture) {
         let found = self.entries.iter().position(|e| {
-            !e.in_use && e.key.size == key.size && e.key.format == key.format && e.key.usage.contains(key.usage)
+            !e.in_use
+                && e.key.size == key.size
+                && e.key.format == key.format
+                && e.key.layers == key.layers
+                && e.key.usage.contains(key.usage)
         });
         let index = found.unwrap_or_else(|| {
             self.created_this_frame += 1;
             let texture = device.create_texture(&wgpu::TextureDescriptor {
                 label: Some("graph_transient"),
-                size: wgpu::Extent3d { width: key.size.0, height: key.size.1, depth_or_array_layers: 1 },
+                size: wgpu::Extent3d {
+                    width: key.size.0,
+                    height: key.size.1,
+                    depth_or_array_layers: key.layers.unwrap_or(1),
+                },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -57,7 +67,8 @@ impl TexturePool {
                 usage: key.usage,
                 view_formats: &[],
             });
-            let view = texture.create_view(&Default::default());
+            let dimension = key.layers.map(|_| wgpu::TextureViewDimension::D2Array);
+            let view = texture.create_view(&wgpu::TextureViewDescriptor { dimension, ..Default::default() });
             let resolved = ResolvedTexture { texture, view, id: next_resource_id() };
             self.entries.push(Entry { key, resolved, in_use: false, last_frame: self.frame });
             self.entries.len() - 1
@@ -101,7 +112,10 @@ impl TexturePool {
 
     /// Bytes of all pooled textures.
     pub fn bytes(&self) -> u64 {
-        self.entries.iter().map(|e| texture_bytes(e.key.size, e.key.format)).sum()
+        self.entries
+            .iter()
+            .map(|e| texture_bytes(e.key.size, e.key.format) * u64::from(e.key.layers.unwrap_or(1)))
+            .sum()
     }
 }
 

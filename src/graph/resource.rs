@@ -31,17 +31,26 @@ pub struct TextureDesc {
     pub extent: Extent,
     /// Texel format.
     pub format: wgpu::TextureFormat,
+    /// `None`: a plain 2-D texture. `Some(n)`: a 2-D array of `n` layers, viewed as `D2Array`
+    /// even when `n` is 1 (so shaders declaring arrays bind it whatever `n` is).
+    pub layers: Option<u32>,
 }
 
 impl TextureDesc {
     /// A texture the size of the output.
     pub fn full(format: wgpu::TextureFormat) -> Self {
-        Self { extent: Extent::Relative(1, 1), format }
+        Self { extent: Extent::Relative(1, 1), format, layers: None }
     }
 
     /// A texture `num/den` of the output size.
     pub fn scaled(format: wgpu::TextureFormat, num: u32, den: u32) -> Self {
-        Self { extent: Extent::Relative(num, den), format }
+        Self { extent: Extent::Relative(num, den), format, layers: None }
+    }
+
+    /// The same size and format as a 2-D array of `layers` layers.
+    #[must_use]
+    pub fn with_layers(self, layers: u32) -> Self {
+        Self { layers: Some(layers.max(1)), ..self }
     }
 }
 

@@ -71,6 +71,14 @@ impl ParamSet {
         }
     }
 
+    /// An enum parameter's option index.
+    pub fn choice(&self, name: &str) -> u32 {
+        match self.get(name) {
+            ParamValue::Enum(i) => i,
+            other => other.components()[0].max(0.0) as u32,
+        }
+    }
+
     /// A bool parameter.
     pub fn bool(&self, name: &str) -> bool {
         self.get(name).components()[0] >= 0.5

@@ -19,13 +19,15 @@ pub enum ParamType {
     Vec4,
     /// RGBA, sRGB-encoded as a colour picker shows it (colour picker).
     Color,
+    /// One of the declaration's named options (drop-down).
+    Enum,
 }
 
 impl ParamType {
     /// Number of float components.
     pub fn components(self) -> usize {
         match self {
-            ParamType::Float | ParamType::Int | ParamType::Bool => 1,
+            ParamType::Float | ParamType::Int | ParamType::Bool | ParamType::Enum => 1,
             ParamType::Vec2 => 2,
             ParamType::Vec3 => 3,
             ParamType::Vec4 | ParamType::Color => 4,
@@ -42,6 +44,7 @@ impl ParamType {
             ParamType::Vec3 => "vec3",
             ParamType::Vec4 => "vec4",
             ParamType::Color => "color",
+            ParamType::Enum => "enum",
         }
     }
 
@@ -61,6 +64,9 @@ impl ParamType {
             ParamType::Vec4 if exact => ParamValue::Vec4([f(0), f(1), f(2), f(3)]),
             ParamType::Color if exact => ParamValue::Color([f(0), f(1), f(2), f(3)]),
             ParamType::Color if numbers.len() == 3 => ParamValue::Color([f(0), f(1), f(2), 1.0]),
+            ParamType::Enum if exact && numbers[0].fract() == 0.0 && (0.0..65536.0).contains(&numbers[0]) => {
+                ParamValue::Enum(numbers[0] as u32)
+            }
             _ => return None,
         })
     }
@@ -89,6 +95,8 @@ pub enum ParamValue {
     Vec4([f32; 4]),
     /// See [`ParamType::Color`].
     Color([f32; 4]),
+    /// See [`ParamType::Enum`]: the index of the chosen option.
+    Enum(u32),
 }
 
 impl ParamValue {
@@ -102,6 +110,7 @@ impl ParamValue {
             ParamValue::Vec3(_) => ParamType::Vec3,
             ParamValue::Vec4(_) => ParamType::Vec4,
             ParamValue::Color(_) => ParamType::Color,
+            ParamValue::Enum(_) => ParamType::Enum,
         }
     }
 
@@ -114,6 +123,7 @@ impl ParamValue {
             ParamValue::Vec2(v) => v.to_vec(),
             ParamValue::Vec3(v) => v.to_vec(),
             ParamValue::Vec4(v) | ParamValue::Color(v) => v.to_vec(),
+            ParamValue::Enum(i) => vec![i as f32],
         }
     }
 
@@ -128,6 +138,7 @@ impl ParamValue {
             ParamType::Vec3 => ParamValue::Vec3([at(0), at(1), at(2)]),
             ParamType::Vec4 => ParamValue::Vec4([at(0), at(1), at(2), at(3)]),
             ParamType::Color => ParamValue::Color([at(0), at(1), at(2), at(3)]),
+            ParamType::Enum => ParamValue::Enum(at(0).round().max(0.0) as u32),
         }
     }
 
@@ -147,6 +158,7 @@ impl fmt::Display for ParamValue {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             ParamValue::Int(i) => write!(f, "{i}"),
+            ParamValue::Enum(i) => write!(f, "#{i}"),
             ParamValue::Bool(b) => write!(f, "{b}"),
             ParamValue::Float(x) => write!(f, "{x}"),
             other => {
@@ -170,12 +182,35 @@ pub struct ParamDecl {
     pub unit: String,
     /// One sentence on what it does.
     pub doc: String,
+    /// Option names of an enum parameter (empty otherwise).
+    pub options: Vec<String>,
 }
 
 impl ParamDecl {
     /// A declaration; `range` bounds each component.
     pub fn new(name: &str, default: ParamValue, range: Option<(f32, f32)>, doc: &str) -> Self {
-        Self { name: name.into(), default, range, unit: String::new(), doc: doc.into() }
+        Self { name: name.into(), default, range, unit: String::new(), doc: doc.into(), options: Vec::new() }
+    }
+
+    /// An enum parameter choosing one of `options` (default: option `default`).
+    pub fn choice(name: &str, options: &[&str], default: u32, doc: &str) -> Self {
+        let last = options.len().saturating_sub(1) as f32;
+        let mut decl = Self::new(name, ParamValue::Enum(default), Some((0.0, last)), doc);
+        decl.options = options.iter().map(|o| o.to_string()).collect();
+        decl
+    }
+
+    /// The option index named `name` (case-insensitive), for enum parameters.
+    pub fn option_index(&self, name: &str) -> Option<u32> {
+        self.options.iter().position(|o| o.eq_ignore_ascii_case(name)).map(|i| i as u32)
+    }
+
+    /// A value as text: option names for enums, scene syntax otherwise.
+    pub fn format(&self, value: &ParamValue) -> String {
+        match value {
+            ParamValue::Enum(i) => self.options.get(*i as usize).cloned().unwrap_or_else(|| value.to_string()),
+            other => other.to_string(),
+        }
     }
 
     /// The same declaration with a unit.

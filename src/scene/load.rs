@@ -5,7 +5,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use super::error::{SceneError, SceneErrors, locate};
 use super::schema::{RawValue, SceneFile};
 use crate::assets::{AssetKind, Assets};
-use crate::params::{Key, ParamSet, ParamType, ParamValue, Track};
+use crate::params::{Key, ParamDecl, ParamSet, ParamType, ParamValue, Track};
 use crate::techniques::{self, TechniqueInfo};
 
 /// A validated scene: every name resolved, every value typed.
@@ -87,18 +87,19 @@ impl Scene {
             let names: Vec<&str> = params.decls().iter().map(|d| d.name.as_str()).collect();
             format!("node '{node_id}' has no parameter '{param}' (parameters: {})", names.join(", "))
         })?;
-        let ty = params.decls()[index].ty();
-        let typed = parse_value_override(value, ty)?;
+        let typed = parse_value_override(value, &params.decls()[index])?;
         params.set_at(index, typed);
         Ok(())
     }
 }
 
-/// Parses a command-line value (`1.5`, `2,0`, `true`) as a value of type `ty`.
-pub fn parse_value_override(text: &str, ty: ParamType) -> Result<ParamValue, String> {
+/// Parses a command-line value (`1.5`, `2,0`, `true`, an enum option name) for `decl`.
+pub fn parse_value_override(text: &str, decl: &ParamDecl) -> Result<ParamValue, String> {
+    let ty = decl.ty();
     let raw = match text.trim() {
         "true" => RawValue::Bool(true),
         "false" => RawValue::Bool(false),
+        name if ty == ParamType::Enum && decl.option_index(name).is_some() => RawValue::Text(name.into()),
         list => RawValue::List(
             list.split(',')
                 .map(|x| x.trim().parse::<f64>().map_err(|_| format!("'{x}' is not a number")))
@@ -109,7 +110,10 @@ pub fn parse_value_override(text: &str, ty: ParamType) -> Result<ParamValue, Str
         RawValue::List(v) if v.len() == 1 => RawValue::Number(v[0]),
         other => other,
     };
-    coerce(&raw, ty).ok_or_else(|| format!("'{text}' is not a {ty}"))
+    coerce(&raw, ty, &decl.options).ok_or_else(|| match ty {
+        ParamType::Enum => format!("'{text}' is not one of {}", decl.options.join(", ")),
+        _ => format!("'{text}' is not a {ty}"),
+    })
 }
 
 /// Loads a scene by name or path: an existing file path is read directly, anything else is
@@ -238,10 +242,8 @@ impl Validator<'_> {
                 self.error(&[anchor, "params", &key], unknown_param(technique, name, &names));
                 continue;
             };
-            match coerce(raw, d.ty()) {
-                None => {
-                    self.error(&[anchor, "params", &key], format!("'{name}' is a {}, not {}", d.ty(), describe(raw)))
-                }
+            match coerce(raw, d.ty(), &d.options) {
+                None => self.error(&[anchor, "params", &key], mismatch(name, d, raw)),
                 Some(v) if v.clamped(d.range) != v => self.error(
                     &[anchor, "params", &key],
                     format!("'{name}' = {} is outside its range {:?}", describe(raw), d.range.unwrap_or_default()),
@@ -334,13 +336,14 @@ impl Validator<'_> {
                 }
             };
             let key_type = if component.is_some() { ParamType::Float } else { ty };
+            let options = params.decls()[pi].options.clone();
             if t.keys.is_empty() || t.time_scale.is_nan() || t.time_scale <= 0.0 {
                 self.error(&anchors, format!("track '{}' needs at least one key and a positive time_scale", t.target));
                 continue;
             }
             let mut keys = Vec::new();
             for (time, raw) in &t.keys {
-                match coerce(raw, key_type) {
+                match coerce(raw, key_type, &options) {
                     Some(value) => keys.push(Key { time: *time, value }),
                     None => self.error(
                         &anchors,
@@ -370,12 +373,24 @@ fn component_index(c: &str, ty: ParamType) -> Option<usize> {
     (ty.components() > 1 && i < ty.components()).then_some(i)
 }
 
-/// A file value as a typed value: bools only for bool parameters, numbers for the rest.
-fn coerce(raw: &RawValue, ty: ParamType) -> Option<ParamValue> {
+/// A file value as a typed value: bools only for bool parameters, option names (or indices)
+/// for enums, numbers for the rest.
+fn coerce(raw: &RawValue, ty: ParamType, options: &[String]) -> Option<ParamValue> {
     match (raw, ty) {
         (RawValue::Bool(b), ParamType::Bool) => Some(ParamValue::Bool(*b)),
-        (RawValue::Bool(_), _) | (_, ParamType::Bool) => None,
+        (RawValue::Text(name), ParamType::Enum) => {
+            options.iter().position(|o| o.eq_ignore_ascii_case(name)).map(|i| ParamValue::Enum(i as u32))
+        }
+        (RawValue::Number(i), ParamType::Enum) if (*i as usize) < options.len() => ty.value_from(&[*i]),
+        (RawValue::Bool(_) | RawValue::Text(_), _) | (_, ParamType::Bool | ParamType::Enum) => None,
         (raw, ty) => ty.value_from(&raw.numbers()),
+    }
+}
+
+fn mismatch(name: &str, decl: &ParamDecl, raw: &RawValue) -> String {
+    match decl.ty() {
+        ParamType::Enum => format!("'{name}' is one of {}, not {}", decl.options.join(", "), describe(raw)),
+        ty => format!("'{name}' is a {ty}, not {}", describe(raw)),
     }
 }
 
@@ -384,6 +399,7 @@ fn describe(raw: &RawValue) -> String {
         RawValue::Bool(b) => format!("the bool {b}"),
         RawValue::Number(x) => format!("the number {x}"),
         RawValue::List(v) => format!("a list of {} numbers", v.len()),
+        RawValue::Text(t) => format!("the text \"{t}\""),
     }
 }
 

@@ -108,6 +108,8 @@ pub enum RawValue {
     Number(f64),
     /// `(1.0, 0.5)` or `[1.0, 0.5]`.
     List(Vec<f64>),
+    /// `"Additive"`: an enum option by name.
+    Text(String),
 }
 
 impl RawValue {
@@ -117,6 +119,7 @@ impl RawValue {
             RawValue::Bool(b) => vec![if *b { 1.0 } else { 0.0 }],
             RawValue::Number(x) => vec![*x],
             RawValue::List(v) => v.clone(),
+            RawValue::Text(_) => Vec::new(),
         }
     }
 }

@@ -5,7 +5,9 @@
 //! To add a technique: write `src/techniques/<name>/`, `shaders/<name>.wgsl` and
 //! `scenes/<name>.ron`, then add its `INFO` to [`REGISTRY`]. Nothing else.
 
+pub mod cube_field;
 pub mod kleinian;
+pub mod star_glow;
 
 use crate::assets::{AssetKind, Assets};
 use crate::gpu::{Gpu, ShaderError};
@@ -14,7 +16,7 @@ use crate::params::{ParamDecl, ParamSet};
 use crate::time::FrameTime;
 
 /// Every technique indra knows, by scene name.
-pub const REGISTRY: &[TechniqueInfo] = &[kleinian::INFO];
+pub const REGISTRY: &[TechniqueInfo] = &[kleinian::INFO, star_glow::INFO, cube_field::INFO];
 
 /// Finds a technique by the name scenes use.
 pub fn find(name: &str) -> Option<&'static TechniqueInfo> {

@@ -1,0 +1,241 @@
+//! A field of small white cubes emitted from a rectangle, drifting towards the camera and
+//! spinning, lit by a directional light with Blinn-Phong so that specular glints exceed 1.0 —
+//! the HDR source of the book's StarGlow demo.
+//!
+//! Book: [UGP4 ch.4] sample scene (a Unity particle system; seed-reference §4). Here the particles
+//! are a pure function of time and seed (no simulation state), so any frame renders alone and
+//! identically. Shader: `shaders/cube_field.wgsl`.
+
+mod particles;
+
+use crate::gpu::ShaderError;
+use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
+use crate::params::{ParamDecl, ParamSet, ParamValue};
+use crate::time::FrameTime;
+
+pub use particles::{CubeInstance, MAX_CUBES, cubes_at};
+
+use super::{NodeSetup, Technique, TechniqueInfo, srgb_to_linear};
+
+/// The registry entry.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "cube_field",
+    chapter: "4: StarGlow (demo scene)",
+    summary: "instanced spinning cubes with HDR specular glints",
+    params,
+    inputs: &[],
+    shaders: &["cube_field.wgsl"],
+    create,
+};
+
+/// Colour target format: linear HDR.
+pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Parameters; defaults follow the sample's particle system (seed-reference §4), scaled by its
+/// 0.1 transform and ×2 simulation speed into world units.
+pub fn params() -> Vec<ParamDecl> {
+    use ParamValue::*;
+    vec![
+        ParamDecl::new("rate", Float(100.0), Some((0.0, 400.0)), "cubes emitted per second").with_unit("/s"),
+        ParamDecl::new("life", Float(10.0), Some((0.1, 30.0)), "seconds each cube lives").with_unit("s"),
+        ParamDecl::new("speed", Float(1.0), Some((0.0, 10.0)), "drift towards the camera").with_unit("u/s"),
+        ParamDecl::new("spin", Float(100.0), Some((0.0, 720.0)), "rotation about each axis").with_unit("°/s"),
+        ParamDecl::new("cube_size", Float(0.1), Some((0.01, 1.0)), "edge length").with_unit("u"),
+        ParamDecl::new(
+            "emitter_size",
+            Vec2([5.0, 10.0]),
+            Some((0.1, 50.0)),
+            "width and height of the emitting rectangle",
+        ),
+        ParamDecl::new(
+            "emitter_distance",
+            Float(12.0),
+            Some((1.0, 50.0)),
+            "distance of the emitter in front of the camera",
+        ),
+        ParamDecl::new("fov", Float(30.0), Some((5.0, 120.0)), "vertical field of view").with_unit("°"),
+        ParamDecl::new("light_dir", Vec3([-0.4, 0.5, -0.75]), Some((-1.0, 1.0)), "direction towards the light"),
+        ParamDecl::new("light_intensity", Float(0.87), Some((0.0, 10.0)), "light intensity"),
+        ParamDecl::new("specular", Float(4.0), Some((0.0, 20.0)), "specular strength; above ~1.2 glints exceed 1.0"),
+        ParamDecl::new("shininess", Float(64.0), Some((1.0, 512.0)), "Blinn-Phong exponent"),
+        ParamDecl::new("color", Color([1.0, 1.0, 1.0, 1.0]), None, "cube colour"),
+    ]
+}
+
+/// The shader's uniform block.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct CubeFieldUniforms {
+    /// Projection × view.
+    pub view_proj: [[f32; 4]; 4],
+    /// Towards the light, unit.
+    pub light_dir: [f32; 4],
+    /// Linear light colour × intensity.
+    pub light_color: [f32; 4],
+    /// Linear albedo.
+    pub albedo: [f32; 4],
+    /// Constant fill light.
+    pub ambient: f32,
+    /// Specular strength.
+    pub specular: f32,
+    /// Blinn-Phong exponent.
+    pub shininess: f32,
+    /// Padding.
+    pub _pad: f32,
+}
+
+impl CubeFieldUniforms {
+    /// Camera at the origin looking down +z, y up, wgpu's [0, 1] depth.
+    pub fn from_params(p: &ParamSet, aspect: f32) -> Self {
+        // wgpu's clip space is DirectX's: z in [0, 1], y up.
+        let proj = glam::camera::lh::proj::directx::perspective(p.float("fov").to_radians(), aspect, 0.1, 100.0);
+        let view = glam::camera::lh::view::look_to_mat4(glam::Vec3::ZERO, glam::Vec3::Z, glam::Vec3::Y);
+        let l = p.get("light_dir").components();
+        let light = glam::Vec3::new(l[0], l[1], l[2]).normalize_or(glam::Vec3::NEG_Z);
+        let c = p.color("color");
+        let i = p.float("light_intensity");
+        Self {
+            view_proj: (proj * view).to_cols_array_2d(),
+            light_dir: [light.x, light.y, light.z, 0.0],
+            light_color: [i, i, i, 1.0],
+            albedo: [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), 1.0],
+            ambient: 0.08,
+            specular: p.float("specular"),
+            shininess: p.float("shininess"),
+            _pad: 0.0,
+        }
+    }
+}
+
+/// A cube field node.
+pub struct CubeField {
+    pipeline: wgpu::RenderPipeline,
+    uniforms: wgpu::Buffer,
+    instances: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    scratch: Vec<CubeInstance>,
+}
+
+fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
+    let device = &setup.gpu.device;
+    let (origin, source) = setup.shader_source("cube_field.wgsl")?;
+    let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("cube_field_layout"),
+        entries: &[wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: wgpu::BufferSize::new(size_of::<CubeFieldUniforms>() as u64),
+            },
+            count: None,
+        }],
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("cube_field_pipeline_layout"),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("cube_field_pipeline"),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: size_of::<CubeInstance>() as u64,
+                step_mode: wgpu::VertexStepMode::Instance,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4],
+            })],
+        },
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(FORMAT.into())],
+        }),
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: wgpu::MultisampleState::default(),
+        multiview_mask: None,
+        cache: None,
+    });
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(ShaderError { origin, line: 1, column: 1, message: e.to_string() });
+    }
+    let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("cube_field_uniforms"),
+        size: size_of::<CubeFieldUniforms>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let instances = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("cube_field_instances"),
+        size: (MAX_CUBES * size_of::<CubeInstance>()) as u64,
+        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("cube_field_bind_group"),
+        layout: &layout,
+        entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() }],
+    });
+    Ok(Box::new(CubeField { pipeline, uniforms, instances, bind_group, scratch: Vec::with_capacity(MAX_CUBES) }))
+}
+
+impl Technique for CubeField {
+    fn add_passes<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        params: &ParamSet,
+        time: &FrameTime,
+        _inputs: &[TextureHandle],
+    ) -> TextureHandle {
+        let color = graph.create_texture("cube_field/image", TextureDesc::full(FORMAT));
+        let depth = graph.create_texture("cube_field/depth", TextureDesc::full(DEPTH));
+        let (w, h) = graph.texture_size(color);
+        let uniforms = CubeFieldUniforms::from_params(params, w as f32 / h as f32);
+        cubes_at(params, time, &mut self.scratch);
+        let count = self.scratch.len() as u32;
+        let this: &'r CubeField = self;
+        graph.add_pass("cube_field/draw").render_target(color).render_target(depth).record(move |ctx| {
+            ctx.queue.write_buffer(&this.uniforms, 0, bytemuck::bytes_of(&uniforms));
+            ctx.queue.write_buffer(&this.instances, 0, bytemuck::cast_slice(&this.scratch));
+            let (color_view, depth_view) = (ctx.view(color).clone(), ctx.view(depth).clone());
+            let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("cube_field/draw"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &color_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth_view,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                    stencil_ops: None,
+                }),
+                ..Default::default()
+            });
+            pass.set_pipeline(&this.pipeline);
+            pass.set_bind_group(0, &this.bind_group, &[]);
+            pass.set_vertex_buffer(0, this.instances.slice(..));
+            pass.draw(0..36, 0..count);
+        });
+        color
+    }
+}

@@ -1,0 +1,282 @@
+//! StarGlow: Kawase's streak post effect — bright pass, directional 4-tap cascades, screen
+//! accumulation and a final composite — as a node that takes any HDR texture and can end any
+//! scene.
+//!
+//! Book: [UGP4 ch.4] "StarGlow" (xjine); [Kawase 2003] "Frame Buffer Postprocessing Effects in
+//! DOUBLE-S.T.E.A.L", GDC. Shader: `shaders/star_glow.wgsl`. Goldens: `tests/golden/star_glow*.png`.
+//!
+//! Differences from the sample (seed-reference §9 item 17), on purpose: the accumulation target
+//! starts black every frame; nothing is clamped to 1 (HDR stays HDR until the display encode);
+//! the threshold leaves alpha alone; the bright pass max-pools its whole footprint instead of
+//! taking one bilinear sample, so a one-pixel glint neither vanishes nor flickers as it moves;
+//! and by default streaks keep their length relative to the image at any output size (the
+//! sample's grow with resolution), matching the book exactly at 1080p.
+
+mod passes;
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+
+use crate::gpu::{ComputeKernel, ShaderError};
+use crate::graph::{FrameGraph, TextureHandle};
+use crate::params::{ParamDecl, ParamSet, ParamValue};
+use crate::time::FrameTime;
+
+use super::{NodeSetup, Technique, TechniqueInfo};
+
+/// The registry entry.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "star_glow",
+    chapter: "4: StarGlow",
+    summary: "Kawase streak glow on any HDR input, book layout or fused",
+    params,
+    inputs: &["source"],
+    shaders: &["star_glow.wgsl"],
+    create,
+};
+
+/// Intermediate and output format.
+pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// Composite types, in the order of the `composite` enum parameter.
+pub const COMPOSITE_TYPES: [&str; 5] = ["Additive", "Screen", "ColoredAdditive", "ColoredScreen", "Debug"];
+
+/// Output height at which resolution-independent streaks take the book's texel steps.
+pub const REFERENCE_HEIGHT: f32 = 1080.0;
+
+/// Most passes one frame declares: bright, 16 directions × (5 levels + accumulate), composite.
+pub const MAX_PASSES: usize = 2 + 16 * (5 + 1);
+
+/// Parameters with the sample's C# defaults and ranges (seed-reference §4).
+pub fn params() -> Vec<ParamDecl> {
+    use ParamValue::*;
+    vec![
+        ParamDecl::new(
+            "threshold",
+            Float(1.0),
+            Some((0.0, 10.0)),
+            "brightness subtracted before streaking (HDR: may exceed 1)",
+        ),
+        ParamDecl::new(
+            "intensity",
+            Float(1.0),
+            Some((0.0, 10.0)),
+            "gain of the bright pass; 0 switches the effect off",
+        ),
+        ParamDecl::new("divide", Int(3), Some((1.0, 20.0)), "downsampling factor of the streak textures"),
+        ParamDecl::new("iteration", Int(5), Some((1.0, 5.0)), "cascade levels; a streak reaches 4^iteration texels"),
+        ParamDecl::new("attenuation", Float(1.0), Some((0.0, 1.0)), "weight falloff per texel along a streak"),
+        ParamDecl::new("angle", Float(0.0), Some((0.0, 360.0)), "rotation of the first streak").with_unit("°"),
+        ParamDecl::new("streaks", Int(4), Some((1.0, 16.0)), "number of streak directions"),
+        ParamDecl::choice("composite", &COMPOSITE_TYPES, 0, "how the glow joins the source"),
+        ParamDecl::new("color", Color([1.0, 1.0, 1.0, 1.0]), None, "tint of the coloured composite types"),
+        ParamDecl::choice(
+            "layout",
+            &["Auto", "Book", "Fused"],
+            0,
+            "pass layout; Auto is Fused (same output, fewer passes)",
+        ),
+        ParamDecl::new(
+            "resolution_independent",
+            Bool(true),
+            None,
+            "streak length relative to the image (as the book at 1080p) instead of in texels",
+        ),
+    ]
+}
+
+/// The shader's uniform block; layout checked against naga's reflection in the tests.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct StarGlowUniforms {
+    /// Size of the texture the pass writes.
+    pub dst_size: [u32; 2],
+    /// Bright pass threshold.
+    pub threshold: f32,
+    /// Bright pass gain.
+    pub intensity: f32,
+    /// Streak pass: tap step in texels (y down) × power.
+    pub offset: [f32; 2],
+    /// Tap weight base.
+    pub attenuation: f32,
+    /// Streak level power 4^(n−1).
+    pub power: f32,
+    /// Composite type index.
+    pub composite_type: u32,
+    /// Fused: number of directions.
+    pub directions: u32,
+    /// Accumulate: 1 for the first direction (start from black).
+    pub first: u32,
+    /// Bright pass: source texels per output texel.
+    pub divide: u32,
+    /// Linear tint.
+    pub color: [f32; 4],
+    /// Fused: tap step per direction × power (xy used).
+    pub steps: [[f32; 4]; 16],
+}
+
+/// The unit tap step of streak `i` (1-based, as the sample counts) in texture space (y down):
+/// (0, −1) rotated counter-clockwise by 360°/n·i + angle in the book's y-up uv space.
+pub fn streak_step(i: u32, n: u32, angle_deg: f32) -> [f32; 2] {
+    let theta = (360.0 / n as f32 * i as f32 + angle_deg).to_radians();
+    [theta.sin(), theta.cos()]
+}
+
+/// Which pass layout a frame uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    /// The book's: one pass per streak level per direction plus one accumulation per direction,
+    /// 2 + N (iteration + 1) passes.
+    Book,
+    /// One pass per level for every direction at once (layered textures), the accumulation
+    /// folded into the last level: iteration + 2 passes, the same arithmetic.
+    Fused,
+}
+
+impl Layout {
+    /// The layout the `layout` parameter asks for (`Auto` is `Fused`).
+    pub fn choose(p: &ParamSet) -> Self {
+        if p.choice("layout") == 1 { Layout::Book } else { Layout::Fused }
+    }
+}
+
+/// A StarGlow node.
+pub struct StarGlow {
+    kernels: Kernels,
+    sampler: wgpu::Sampler,
+    /// One uniform buffer per pass slot of a frame (the most a frame can declare), reused.
+    uniforms: Vec<wgpu::Buffer>,
+    /// Bind groups by (slot, texture ids): steady-state frames create none.
+    bind_groups: RefCell<HashMap<(usize, [u64; 4]), wgpu::BindGroup>>,
+}
+
+/// A pipeline and the layout of its one bind group.
+struct Kernel {
+    compute: ComputeKernel,
+    layout: wgpu::BindGroupLayout,
+}
+
+struct Kernels {
+    bright: Kernel,
+    streak: Kernel,
+    accumulate: Kernel,
+    composite: Kernel,
+    level_single: Kernel,
+    level_first: Kernel,
+    level_next: Kernel,
+    level_last: Kernel,
+}
+
+/// The texture bindings of `shaders/star_glow.wgsl` besides the uniform (0) and sampler (1).
+#[derive(Clone, Copy)]
+enum Binding {
+    TexA = 2,
+    TexB = 3,
+    Dst = 4,
+    SrcLayers = 5,
+    DstLayers = 6,
+}
+
+impl Binding {
+    fn entry(self) -> wgpu::BindGroupLayoutEntry {
+        let sampled = |view_dimension| wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension,
+            multisampled: false,
+        };
+        let storage = |view_dimension| wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format: FORMAT,
+            view_dimension,
+        };
+        let ty = match self {
+            Binding::TexA | Binding::TexB => sampled(wgpu::TextureViewDimension::D2),
+            Binding::SrcLayers => sampled(wgpu::TextureViewDimension::D2Array),
+            Binding::Dst => storage(wgpu::TextureViewDimension::D2),
+            Binding::DstLayers => storage(wgpu::TextureViewDimension::D2Array),
+        };
+        wgpu::BindGroupLayoutEntry { binding: self as u32, visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
+    }
+}
+
+fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
+    let device = &setup.gpu.device;
+    let (origin, source) = setup.shader_source("star_glow.wgsl")?;
+    let kernel = |entry: &str, bindings: &[Binding]| -> Result<Kernel, ShaderError> {
+        let mut entries = vec![
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: wgpu::BufferSize::new(size_of::<StarGlowUniforms>() as u64),
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+        ];
+        entries.extend(bindings.iter().map(|b| b.entry()));
+        let label = format!("star_glow_{entry}_layout");
+        let layout = device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(&label), entries: &entries });
+        let compute = ComputeKernel::new(device, &origin, &source, entry, &[&layout])?;
+        Ok(Kernel { compute, layout })
+    };
+    use Binding::*;
+    let kernels = Kernels {
+        bright: kernel("bright", &[TexA, Dst])?,
+        streak: kernel("streak", &[TexA, Dst])?,
+        accumulate: kernel("accumulate", &[TexA, TexB, Dst])?,
+        composite: kernel("composite", &[TexA, TexB, Dst])?,
+        level_single: kernel("level_single", &[TexA, Dst])?,
+        level_first: kernel("level_first", &[TexA, DstLayers])?,
+        level_next: kernel("level_next", &[SrcLayers, DstLayers])?,
+        level_last: kernel("level_last", &[SrcLayers, Dst])?,
+    };
+    // Clamp to edge, as Unity's render textures: streaks smear the border texel, never wrap.
+    let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("star_glow_sampler"),
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        ..Default::default()
+    });
+    let uniforms = (0..MAX_PASSES)
+        .map(|_| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("star_glow_uniforms"),
+                size: size_of::<StarGlowUniforms>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        })
+        .collect();
+    Ok(Box::new(StarGlow { kernels, sampler, uniforms, bind_groups: RefCell::new(HashMap::new()) }))
+}
+
+impl Technique for StarGlow {
+    fn add_passes<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        params: &ParamSet,
+        _time: &FrameTime,
+        inputs: &[TextureHandle],
+    ) -> TextureHandle {
+        let source = inputs[0];
+        // A zero-effect setting adds no passes: the source goes straight through.
+        if params.float("intensity") <= 0.0 {
+            return source;
+        }
+        let plan = passes::Plan::new(params, Layout::choose(params));
+        let this: &'r StarGlow = self;
+        plan.declare(this, graph, source)
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,262 @@
+//! Declaring StarGlow's passes: every intermediate is a transient texture sized relative to the
+//! output, so the frame graph's pool reuses them (a book-layout frame of N streaks needs a handful
+//! of physical textures, not N × iteration).
+
+use super::{Binding, FORMAT, Kernel, Layout, StarGlow, StarGlowUniforms, streak_step};
+use crate::graph::{Extent, FrameGraph, PassContext, TextureDesc, TextureHandle};
+use crate::params::ParamSet;
+use crate::techniques::srgb_to_linear;
+
+/// One frame's worth of StarGlow work, decided from the parameters.
+pub(super) struct Plan {
+    layout: Layout,
+    base: StarGlowUniforms,
+    streaks: u32,
+    iteration: u32,
+    angle: f32,
+    resolution_independent: bool,
+    /// Multiplies every tap step: output height / 1080 when resolution independent, else 1.
+    step_scale: f32,
+}
+
+/// A pass to declare: its kernel, what it reads and writes at which binding, and how many
+/// invocations (x, y, directions) it runs.
+struct PassSpec<'k> {
+    name: String,
+    kernel: &'k Kernel,
+    reads: Vec<(Binding, TextureHandle)>,
+    write: (Binding, TextureHandle),
+    uniforms: StarGlowUniforms,
+    layers: u32,
+}
+
+impl Plan {
+    pub fn new(p: &ParamSet, layout: Layout) -> Self {
+        let c = p.color("color");
+        let base = StarGlowUniforms {
+            dst_size: [0; 2],
+            threshold: p.float("threshold"),
+            intensity: p.float("intensity"),
+            offset: [0.0; 2],
+            attenuation: p.float("attenuation"),
+            power: 1.0,
+            composite_type: p.choice("composite"),
+            directions: p.int("streaks").clamp(1, 16) as u32,
+            first: 0,
+            divide: p.int("divide").clamp(1, 20) as u32,
+            color: [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3]],
+            steps: [[0.0; 4]; 16],
+        };
+        Self {
+            layout,
+            base,
+            streaks: base.directions,
+            iteration: p.int("iteration").clamp(1, 5) as u32,
+            angle: p.float("angle"),
+            resolution_independent: p.bool("resolution_independent"),
+            step_scale: 1.0,
+        }
+    }
+
+    /// Declares the passes; returns the composited output.
+    pub fn declare<'r>(
+        mut self,
+        node: &'r StarGlow,
+        graph: &mut FrameGraph<'r>,
+        source: TextureHandle,
+    ) -> TextureHandle {
+        if self.resolution_independent {
+            self.step_scale = graph.output_size().1 as f32 / super::REFERENCE_HEIGHT;
+        }
+        let small = TextureDesc { extent: Extent::Relative(1, self.base.divide), format: FORMAT, layers: None };
+        let mut passes = Vec::new();
+        let k = &node.kernels;
+        let bright = graph.create_texture("star_glow/bright", small);
+        passes.push(self.spec("star_glow/bright", &k.bright, &[(Binding::TexA, source)], (Binding::Dst, bright), 1.0));
+        let glow = match self.layout {
+            Layout::Book => self.book(node, graph, small, bright, &mut passes),
+            Layout::Fused => self.fused(node, graph, small, bright, &mut passes),
+        };
+        let out = graph.create_texture("star_glow/image", TextureDesc::full(FORMAT));
+        let reads = [(Binding::TexA, source), (Binding::TexB, glow)];
+        passes.push(self.spec("star_glow/composite", &k.composite, &reads, (Binding::Dst, out), 1.0));
+        for (slot, pass) in passes.into_iter().enumerate() {
+            declare(graph, node, slot, pass);
+        }
+        out
+    }
+
+    /// Per direction: `iteration` streak passes, then a screen accumulation.
+    fn book<'k>(
+        &self,
+        node: &'k StarGlow,
+        graph: &mut FrameGraph<'_>,
+        small: TextureDesc,
+        bright: TextureHandle,
+        passes: &mut Vec<PassSpec<'k>>,
+    ) -> TextureHandle {
+        let k = &node.kernels;
+        let mut acc: Option<TextureHandle> = None;
+        for i in 1..=self.streaks {
+            let [x, y] = streak_step(i, self.streaks, self.angle);
+            let step = [x * self.step_scale, y * self.step_scale];
+            let mut level = bright;
+            for n in 1..=self.iteration {
+                let power = 4f32.powi(n as i32 - 1);
+                let out = graph.create_texture("star_glow/streak", small);
+                let mut spec = self.spec(
+                    &format!("star_glow/streak{i}.{n}"),
+                    &k.streak,
+                    &[(Binding::TexA, level)],
+                    (Binding::Dst, out),
+                    power,
+                );
+                spec.uniforms.offset = [step[0] * power, step[1] * power];
+                passes.push(spec);
+                level = out;
+            }
+            let next = graph.create_texture("star_glow/accumulation", small);
+            let reads = [(Binding::TexA, acc.unwrap_or(level)), (Binding::TexB, level)];
+            let mut spec =
+                self.spec(&format!("star_glow/accumulate{i}"), &k.accumulate, &reads, (Binding::Dst, next), 1.0);
+            spec.uniforms.first = u32::from(acc.is_none());
+            passes.push(spec);
+            acc = Some(next);
+        }
+        acc.expect("at least one streak")
+    }
+
+    /// Per level: every direction at once on layered textures; the last level accumulates.
+    fn fused<'k>(
+        &self,
+        node: &'k StarGlow,
+        graph: &mut FrameGraph<'_>,
+        small: TextureDesc,
+        bright: TextureHandle,
+        passes: &mut Vec<PassSpec<'k>>,
+    ) -> TextureHandle {
+        let k = &node.kernels;
+        let glow = graph.create_texture("star_glow/glow", small);
+        if self.iteration == 1 {
+            passes.push(self.spec(
+                "star_glow/level1",
+                &k.level_single,
+                &[(Binding::TexA, bright)],
+                (Binding::Dst, glow),
+                1.0,
+            ));
+            return glow;
+        }
+        let layered = small.with_layers(self.streaks);
+        let mut previous = bright;
+        for n in 1..=self.iteration {
+            let power = 4f32.powi(n as i32 - 1);
+            let name = format!("star_glow/level{n}");
+            let spec = if n == 1 {
+                let out = graph.create_texture("star_glow/levels", layered);
+                let mut s =
+                    self.spec(&name, &k.level_first, &[(Binding::TexA, previous)], (Binding::DstLayers, out), power);
+                s.layers = self.streaks;
+                previous = out;
+                s
+            } else if n < self.iteration {
+                let out = graph.create_texture("star_glow/levels", layered);
+                let mut s = self.spec(
+                    &name,
+                    &k.level_next,
+                    &[(Binding::SrcLayers, previous)],
+                    (Binding::DstLayers, out),
+                    power,
+                );
+                s.layers = self.streaks;
+                previous = out;
+                s
+            } else {
+                self.spec(&name, &k.level_last, &[(Binding::SrcLayers, previous)], (Binding::Dst, glow), power)
+            };
+            passes.push(spec);
+        }
+        glow
+    }
+
+    /// A pass spec with this plan's uniforms at level `power` (per-direction steps × power).
+    fn spec<'k>(
+        &self,
+        name: &str,
+        kernel: &'k Kernel,
+        reads: &[(Binding, TextureHandle)],
+        write: (Binding, TextureHandle),
+        power: f32,
+    ) -> PassSpec<'k> {
+        let mut uniforms = StarGlowUniforms { power, ..self.base };
+        for i in 0..self.streaks {
+            let [x, y] = streak_step(i + 1, self.streaks, self.angle);
+            let s = power * self.step_scale;
+            uniforms.steps[i as usize] = [x * s, y * s, 0.0, 0.0];
+        }
+        PassSpec { name: name.into(), kernel, reads: reads.to_vec(), write, uniforms, layers: 1 }
+    }
+}
+
+/// Declares one compute pass of `spec` using uniform slot `slot`.
+fn declare<'r>(graph: &mut FrameGraph<'r>, node: &'r StarGlow, slot: usize, spec: PassSpec<'r>) {
+    let (w, h) = graph.texture_size(spec.write.1);
+    let mut uniforms = spec.uniforms;
+    uniforms.dst_size = [w, h];
+    let mut pass = graph.add_pass(spec.name);
+    for &(_, t) in &spec.reads {
+        pass = pass.read(t);
+    }
+    let (kernel, reads, write, layers) = (spec.kernel, spec.reads, spec.write, spec.layers);
+    pass.write(write.1).record(move |ctx| {
+        ctx.queue.write_buffer(&node.uniforms[slot], 0, bytemuck::bytes_of(&uniforms));
+        let bind_group = node.bind_group(ctx, kernel, slot, &reads, write);
+        let mut compute = ctx
+            .encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("star_glow"), timestamp_writes: None });
+        kernel.compute.dispatch(&mut compute, &[&bind_group], [w, h, layers]);
+    });
+}
+
+impl StarGlow {
+    /// The cached bind group for a pass slot and its resolved textures.
+    fn bind_group(
+        &self,
+        ctx: &PassContext<'_>,
+        kernel: &Kernel,
+        slot: usize,
+        reads: &[(Binding, TextureHandle)],
+        write: (Binding, TextureHandle),
+    ) -> wgpu::BindGroup {
+        // The kernel is part of the key: a slot changes kernels when the layout parameter flips.
+        let mut ids = [kernel as *const Kernel as u64, 0, 0, 0];
+        for (i, (_, t)) in reads.iter().chain([&write]).enumerate() {
+            ids[i + 1] = ctx.texture_id(*t);
+        }
+        let mut cache = self.bind_groups.borrow_mut();
+        // Old entries would keep evicted pool textures alive after resizes.
+        if cache.len() > 4 * super::MAX_PASSES && !cache.contains_key(&(slot, ids)) {
+            cache.clear();
+        }
+        cache
+            .entry((slot, ids))
+            .or_insert_with(|| {
+                let mut entries = vec![
+                    wgpu::BindGroupEntry { binding: 0, resource: self.uniforms[slot].as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                ];
+                for &(binding, t) in reads.iter().chain([&write]) {
+                    entries.push(wgpu::BindGroupEntry {
+                        binding: binding as u32,
+                        resource: wgpu::BindingResource::TextureView(ctx.view(t)),
+                    });
+                }
+                ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("star_glow_bind_group"),
+                    layout: &kernel.layout,
+                    entries: &entries,
+                })
+            })
+            .clone()
+    }
+}

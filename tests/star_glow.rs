@@ -1,0 +1,222 @@
+//! Chapter 4, StarGlow: the streak cascade's analytic weights, the composite formulas on known
+//! pixels, book vs fused layouts, transient reuse in the frame graph, and golden renders.
+
+mod common;
+
+use common::{assets, golden, gpu, render_scene};
+use half::f16;
+use indra::gpu::{Gpu, read_texture_bytes};
+use indra::graph::{FrameGraph, GraphRuntime, PersistentTexture};
+use indra::params::ParamSet;
+use indra::scene::load_scene;
+use indra::techniques::{NodeSetup, star_glow};
+use indra::time::FrameTime;
+
+const SIZE: (u32, u32) = (64, 64);
+
+/// Runs one StarGlow node over `source` (RGBA f32 per texel) and returns its RGBA output.
+fn glow(gpu: &Gpu, source: &[[f32; 4]], settings: &[(&str, &str)]) -> Vec<[f32; 4]> {
+    let assets = assets();
+    let mut node =
+        (star_glow::INFO.create)(&NodeSetup { gpu, assets: &assets, id: "glow", output_size: SIZE }).unwrap();
+    let mut params = ParamSet::new(star_glow::params());
+    for (name, value) in settings {
+        let i = params.index(name).unwrap();
+        params.set_at(i, indra::scene::parse_value_override(value, &params.decls()[i]).unwrap());
+    }
+    let texture = PersistentTexture::new(&gpu.device, "test_source", SIZE, star_glow::FORMAT);
+    let bytes: Vec<u8> = source.iter().flatten().flat_map(|&x| f16::from_f32(x).to_le_bytes()).collect();
+    gpu.queue.write_texture(
+        texture.texture.as_image_copy(),
+        &bytes,
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(SIZE.0 * 8), rows_per_image: Some(SIZE.1) },
+        texture.texture.size(),
+    );
+    let mut runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
+    let mut graph = FrameGraph::new(SIZE);
+    let input = graph.import_texture("source", &texture);
+    let time = FrameTime { frame: 0, seconds: 0.0, dt: 1.0 / 60.0, seed: 0 };
+    let output = node.add_passes(&mut graph, &params, &time, &[input]);
+    graph.set_output(output);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let frame = runtime.execute(&gpu.device, &gpu.queue, graph, &mut encoder).unwrap();
+    gpu.queue.submit([encoder.finish()]);
+    read_texture_bytes(&gpu.device, &gpu.queue, &frame.texture)
+        .chunks_exact(8)
+        .map(|t| std::array::from_fn(|c| f16::from_le_bytes([t[2 * c], t[2 * c + 1]]).to_f32()))
+        .collect()
+}
+
+fn single_texel(at: (u32, u32), value: f32) -> Vec<[f32; 4]> {
+    (0..SIZE.0 * SIZE.1)
+        .map(|i| if (i % SIZE.0, i / SIZE.0) == at { [value, value, value, 1.0] } else { [0.0, 0.0, 0.0, 1.0] })
+        .collect()
+}
+
+const STREAK_ONLY: [(&str, &str); 8] = [
+    ("resolution_independent", "false"),
+    ("threshold", "0"),
+    ("intensity", "1"),
+    ("divide", "1"),
+    ("attenuation", "0.5"),
+    ("streaks", "1"),
+    ("composite", "Debug"),
+    ("iteration", "2"),
+];
+
+/// One bright texel of value 2 at (32, 40): after `iteration` levels the streak holds 2·att^k at
+/// k texels *opposite* to the tap direction, for k < 4^iteration, and nothing elsewhere.
+fn check_cascade(layout: &str, angle: &str, along: impl Fn(u32) -> (u32, u32)) {
+    let gpu = gpu();
+    let mut settings = STREAK_ONLY.to_vec();
+    settings.extend([("layout", layout), ("angle", angle)]);
+    let out = glow(&gpu, &single_texel((32, 40), 2.0), &settings);
+    let mut expected = vec![0.0f32; out.len()];
+    for k in 0..16 {
+        let (x, y) = along(k);
+        expected[(y * SIZE.0 + x) as usize] = 2.0 * 0.5f32.powi(k as i32);
+    }
+    for (i, (o, e)) in out.iter().zip(&expected).enumerate() {
+        let (x, y) = (i as u32 % SIZE.0, i as u32 / SIZE.0);
+        assert!(
+            (o[0] - e).abs() <= 2e-3 * e.max(1.0),
+            "{layout}, angle {angle}: texel ({x}, {y}) = {} expected {e}",
+            o[0]
+        );
+    }
+}
+
+#[test]
+fn a_bright_texel_streaks_with_weights_att_pow_k_opposite_to_the_offset() {
+    // Angle 0: taps step down (+y), so the streak extends upwards from the texel.
+    check_cascade("Book", "0", |k| (32, 40 - k));
+    check_cascade("Fused", "0", |k| (32, 40 - k));
+    // Angle 270: (0, -1) turned by 630° steps left (-x), so the streak extends to the right.
+    check_cascade("Book", "270", |k| (32 + k, 40));
+    check_cascade("Fused", "270", |k| (32 + k, 40));
+    // Three streaks over three levels (64 taps each): both layouts agree texel for texel.
+    let gpu = gpu();
+    let image = single_texel((20, 30), 3.0);
+    let run = |layout| {
+        let mut s = STREAK_ONLY.to_vec();
+        s.extend([
+            ("layout", layout),
+            ("streaks", "3"),
+            ("iteration", "3"),
+            ("angle", "17"),
+            ("composite", "Additive"),
+        ]);
+        glow(&gpu, &image, &s)
+    };
+    let (book, fused) = (run("Book"), run("Fused"));
+    for (b, f) in book.iter().zip(&fused) {
+        assert!((b[0] - f[0]).abs() <= 2e-3 * b[0].abs().max(1.0), "book {} vs fused {}", b[0], f[0]);
+    }
+}
+
+#[test]
+fn composite_formulas_on_known_pixels() {
+    let gpu = gpu();
+    let s = [0.5f32, 0.25, 0.125];
+    let source: Vec<[f32; 4]> = vec![[s[0], s[1], s[2], 1.0]; (SIZE.0 * SIZE.1) as usize];
+    // Attenuation 0 and one level: the glow equals the source exactly.
+    let base = [
+        ("resolution_independent", "false"),
+        ("threshold", "0"),
+        ("intensity", "1"),
+        ("divide", "1"),
+        ("attenuation", "0"),
+        ("streaks", "1"),
+        ("iteration", "1"),
+        ("color", "1,0,0"),
+    ];
+    let mean = (s[0] + s[1] + s[2]) / 3.0;
+    let cases: [(&str, [f32; 3]); 5] = [
+        ("Additive", [1.0, 0.5, 0.25]),
+        ("Screen", [s[0] + s[0] * (1.0 - s[0]), s[1] + s[1] * (1.0 - s[1]), s[2] + s[2] * (1.0 - s[2])]),
+        ("ColoredAdditive", [s[0] + mean, s[1], s[2]]),
+        ("ColoredScreen", [s[0] + mean * (1.0 - s[0]), s[1], s[2]]),
+        ("Debug", s),
+    ];
+    for (kind, want) in cases {
+        let mut settings = base.to_vec();
+        settings.push(("composite", kind));
+        let out = glow(&gpu, &source, &settings);
+        let px = out[(20 * SIZE.0 + 20) as usize];
+        for c in 0..3 {
+            assert!((px[c] - want[c]).abs() < 2e-3, "{kind}: channel {c} = {} expected {}", px[c], want[c]);
+        }
+    }
+}
+
+#[test]
+fn hdr_values_are_not_clamped() {
+    let gpu = gpu();
+    let mut settings = STREAK_ONLY.to_vec();
+    settings.push(("layout", "Book"));
+    let out = glow(&gpu, &single_texel((10, 10), 6.0), &settings);
+    assert!((out[(10 * SIZE.0 + 10) as usize][0] - 6.0).abs() < 1e-2, "the glow keeps its HDR value");
+}
+
+fn render_star_glow(sets: &[&str], frame: u64) -> indra::offscreen::RenderedFrame {
+    let mut scene = load_scene(&assets(), "star_glow").unwrap();
+    for s in sets {
+        scene.set_from_str(s).unwrap();
+    }
+    render_scene(scene, (256, 256), frame)
+}
+
+#[test]
+fn fused_layout_matches_the_book_layout() {
+    for iteration in ["1", "2", "3"] {
+        let set = format!("glow.iteration={iteration}");
+        let book = render_star_glow(&[&set, "glow.layout=Book"], 60);
+        let fused = render_star_glow(&[&set, "glow.layout=Fused"], 60);
+        let levels: usize = iteration.parse().unwrap();
+        assert_eq!(fused.stats.passes_executed, 1 + 2 + levels, "cube draw + bright, one pass per level, composite");
+        assert_eq!(book.stats.passes_executed, 1 + 2 + 5 * (levels + 1), "5 streaks: level passes and accumulations");
+        let (score, _) = indra::offscreen::flip_score(&book.rgba, &fused.rgba, (256, 256), 0.99);
+        // Only f16 rounding differs: the book layout stores each streak before accumulating it.
+        assert!(score.mean < 0.005 && score.percentile < 0.05, "iteration {iteration}: {score:?}");
+    }
+}
+
+#[test]
+fn book_layout_reuses_transient_textures() {
+    // The sample's defaults: 4 streaks × 5 levels → 26 StarGlow passes.
+    let f = render_star_glow(&["glow.layout=Book", "glow.streaks=4", "glow.iteration=5", "glow.divide=3"], 0);
+    let s = &f.stats;
+    assert_eq!((s.passes_declared, s.passes_executed), (27, 27));
+    let (full, depth, small) = (256 * 256 * 8, 256 * 256 * 4, 86 * 86 * 8);
+    // Cube colour + depth + output, and 25 small textures (bright, 20 levels, 4 accumulations).
+    assert_eq!(s.transient_bytes_requested, 2 * full + depth + 25 * small);
+    // At most four small textures are alive at once: bright, the level being read, the level
+    // being written (or the accumulation read), the accumulation written.
+    assert_eq!(s.transient_bytes_allocated, 2 * full + depth + 4 * small);
+}
+
+#[test]
+fn zero_intensity_adds_no_passes() {
+    let off = render_star_glow(&["glow.intensity=0"], 30);
+    assert_eq!(off.stats.passes_executed, 1, "only the cube draw runs");
+    let on = render_star_glow(&[], 30);
+    assert_ne!(off.rgba, on.rgba);
+}
+
+#[test]
+fn golden_star_glow_at_two_times() {
+    for frame in [0, 90] {
+        let f = render_star_glow(&[], frame);
+        golden().check(&format!("star_glow_f{frame:04}"), (256, 256), &f.rgba).unwrap_or_else(|e| panic!("{e}"));
+    }
+}
+
+#[test]
+fn golden_kleinian_star_glow_at_two_times() {
+    for frame in [0, 240] {
+        let f = common::render_named("kleinian_star_glow", (256, 256), frame);
+        golden()
+            .check(&format!("kleinian_star_glow_f{frame:04}"), (256, 256), &f.rgba)
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
+}
