@@ -251,6 +251,17 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         for t in renderer.runtime().timings() {
             say!("{:<28} {:>9.3} ms {:>8}", t.name, t.median_ms, t.samples);
         }
+        // Per technique: the sum of its passes' medians (the book layout has up to ~100 passes).
+        let mut totals: std::collections::BTreeMap<String, (f64, usize)> = Default::default();
+        for t in renderer.runtime().timings() {
+            let technique = t.name.split('/').next().unwrap_or(&t.name).to_string();
+            let entry = totals.entry(technique).or_default();
+            entry.0 += t.median_ms;
+            entry.1 += 1;
+        }
+        for (technique, (ms, passes)) in totals {
+            say!("{:<28} {:>9.3} ms  ({passes} passes)", format!("total {technique}"), ms);
+        }
         if let Some(ms) = renderer.runtime().frame_gpu_median_ms() {
             say!("{:<28} {:>9.3} ms", "all passes (GPU)", ms);
         }
