@@ -2,8 +2,8 @@
 //! list, and the error overlay.
 
 use crate::graph::{FrameStats, PassTiming};
-use crate::params::{ParamDecl, ParamValue};
-use crate::scene::SceneInstance;
+use crate::params::{ParamDecl, ParamValue, ParamWrite, Source};
+use crate::scene::{ControlEvent, SceneInstance};
 use crate::time::FrameTime;
 
 /// What the overlay shows besides parameters.
@@ -37,15 +37,30 @@ impl Overlay {
     }
 }
 
-/// Draws the whole overlay for one frame.
-pub fn draw_ui(ui: &mut egui::Ui, instance: &mut SceneInstance, overlay: &mut Overlay, time: FrameTime) {
+/// Draws the whole overlay for one frame; returns the control events the performer made.
+pub fn draw_ui(
+    ui: &mut egui::Ui,
+    instance: &mut SceneInstance,
+    overlay: &mut Overlay,
+    time: FrameTime,
+) -> Vec<ControlEvent> {
+    let mut events = Vec::new();
     if overlay.panel_visible {
         egui::Panel::left("indra_params").resizable(true).default_size(300.0).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
                 ui.heading(&instance.scene().name);
                 ui.label(format!("t = {:.2} s   frame {}", time.seconds, time.frame));
-                ui.checkbox(&mut instance.animate, "play animation tracks");
-                param_panel(ui, instance);
+                ui.horizontal(|ui| {
+                    ui.checkbox(&mut instance.animate, "play animation tracks");
+                    if ui
+                        .button("resume tracks")
+                        .on_hover_text("give taken-over parameters back to their tracks")
+                        .clicked()
+                    {
+                        events.push(ControlEvent::ResumeTracks);
+                    }
+                });
+                events.extend(param_panel(ui, instance).into_iter().map(ControlEvent::Write));
                 ui.separator();
                 timing_panel(ui, overlay);
                 ui.small("F1: hide panel · F11: fullscreen · Esc: leave fullscreen");
@@ -65,32 +80,36 @@ pub fn draw_ui(ui: &mut egui::Ui, instance: &mut SceneInstance, overlay: &mut Ov
             overlay.errors.clear();
         }
     }
+    events
 }
 
-fn param_panel(ui: &mut egui::Ui, instance: &mut SceneInstance) {
+/// The parameter panel; returns the writes the performer made this frame.
+fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance) -> Vec<ParamWrite> {
+    let mut writes = Vec::new();
     for node in 0..instance.scene().nodes.len() {
         let header = format!("{} ({})", instance.scene().nodes[node].id, instance.scene().nodes[node].technique.name);
         egui::CollapsingHeader::new(header).default_open(true).show(ui, |ui| {
-            let count = instance.params(node).decls().len();
-            for p in 0..count {
+            for (p, decl) in instance.params(node).decls().iter().enumerate() {
                 let animated = instance.is_animated(node, p);
-                let decl = instance.params(node).decls()[p].clone();
-                let mut value = instance.params(node).value_at(p);
+                let mut value = instance.params(node).target_at(p);
                 let changed = ui
-                    .add_enabled_ui(!animated, |ui| {
-                        ui.horizontal(|ui| {
-                            ui.label(&decl.name).on_hover_text(&decl.doc);
-                            param_widget(ui, &decl, &mut value)
-                        })
-                        .inner
+                    .horizontal(|ui| {
+                        let label = ui.label(&decl.name).on_hover_text(&decl.doc);
+                        if animated {
+                            label.on_hover_text("driven by a track: moving it takes over until 'resume tracks'");
+                        } else if instance.is_overridden(node, p) {
+                            ui.small("(live)");
+                        }
+                        param_widget(ui, decl, &mut value)
                     })
                     .inner;
                 if changed {
-                    instance.params_mut(node).set_at(p, value);
+                    writes.push(ParamWrite { node, param: p, component: None, value, source: Source::Ui });
                 }
             }
         });
     }
+    writes
 }
 
 /// One widget per parameter type; returns whether the value changed.
@@ -103,6 +122,10 @@ fn param_widget(ui: &mut egui::Ui, decl: &ParamDecl, value: &mut ParamValue) -> 
         }
         ParamValue::Int(i) => ui.add(egui::Slider::new(i, lo as i32..=hi as i32)).changed(),
         ParamValue::Bool(b) => ui.checkbox(b, "").changed(),
+        ParamValue::Trigger(fired) => {
+            *fired = ui.button("fire").clicked();
+            *fired
+        }
         ParamValue::Enum(i) => {
             let before = *i;
             let shown = decl.format(&ParamValue::Enum(*i));

@@ -31,6 +31,10 @@ struct Running {
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
     overlay: Overlay,
+    /// The time of the last step run (what the next frame shows).
+    last_time: crate::time::FrameTime,
+    /// Panel events of the last frame, applied before the next step.
+    ui_events: Vec<crate::scene::ControlEvent>,
 }
 
 /// The winit handler; creates the window on `resumed`, as winit 0.30 asks.
@@ -92,6 +96,7 @@ impl WindowApp {
             log::info!("monitor {i}: {}", m.name().unwrap_or_default());
         }
         let clock = FixedClock::new(scene.dt, scene.seed);
+        let last_time = clock.now();
         let instance = SceneInstance::new(&gpu, &self.assets, scene, (config.width, config.height))
             .map_err(|e| format!("the scene's shaders do not compile: {e}"))?;
         let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
@@ -120,6 +125,8 @@ impl WindowApp {
             egui_state,
             egui_renderer,
             overlay: Overlay::default(),
+            last_time,
+            ui_events: Vec::new(),
         })
     }
 }
@@ -193,8 +200,12 @@ impl Running {
         let now = Instant::now();
         let steps = self.clock.accumulate((now - self.last).as_secs_f64());
         self.last = now;
+        let events = std::mem::take(&mut self.ui_events);
+        self.instance.apply(&events);
         for _ in 0..steps {
-            self.instance.step(&self.clock.now());
+            let now = self.clock.now();
+            self.instance.advance(&now);
+            self.last_time = now;
             self.clock.step();
         }
         let frame = match self.surface.get_current_texture() {
@@ -212,7 +223,7 @@ impl Running {
         let size = (self.config.width, self.config.height);
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("window_frame") });
-        let time = self.clock.now();
+        let time = self.last_time;
         match self.instance.encode(&self.gpu, &mut self.runtime, &mut encoder, size, &time) {
             Ok(output) => {
                 self.blit.record(
@@ -247,7 +258,9 @@ impl Running {
         let input = self.egui_state.take_egui_input(&self.window);
         let ctx = self.egui_state.egui_ctx().clone();
         let (instance, overlay, clock) = (&mut self.instance, &mut self.overlay, &self.clock);
-        let mut output = ctx.run_ui(input, |ui| draw_ui(ui, instance, overlay, clock.now()));
+        let mut events = Vec::new();
+        let mut output = ctx.run_ui(input, |ui| events = draw_ui(ui, instance, overlay, clock.now()));
+        self.ui_events.extend(events);
         self.egui_state.handle_platform_output(&self.window, output.platform_output);
         let primitives = ctx.tessellate(output.shapes, output.pixels_per_point);
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);

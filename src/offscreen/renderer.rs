@@ -1,11 +1,12 @@
 //! Rendering a scene frame by frame without a window.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use crate::assets::Assets;
 use crate::gpu::{Blit, BlitTarget, DISPLAY_FORMAT, Gpu, read_texture_rgba8};
 use crate::graph::{FrameStats, GraphRuntime};
-use crate::scene::{Scene, SceneInstance};
+use crate::scene::{ControlEvent, Scene, SceneInstance};
 use crate::time::{FixedClock, FrameTime};
 
 /// One rendered frame, read back as sRGB-encoded RGBA8 rows.
@@ -29,6 +30,7 @@ pub struct OffscreenRenderer {
     clock: FixedClock,
     size: (u32, u32),
     target: wgpu::Texture,
+    script: BTreeMap<u64, Vec<ControlEvent>>,
 }
 
 impl OffscreenRenderer {
@@ -56,7 +58,7 @@ impl OffscreenRenderer {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        Ok(Self { gpu, instance, runtime, blit, clock, size, target })
+        Ok(Self { gpu, instance, runtime, blit, clock, size, target, script: BTreeMap::new() })
     }
 
     /// The live scene (to change parameters between frames).
@@ -80,10 +82,19 @@ impl OffscreenRenderer {
         self.clock.seek(frame);
     }
 
+    /// Schedules control events to apply just before frame `frame` steps (a replayed control
+    /// stream, or a test's script). Events for frames already rendered are ignored.
+    pub fn schedule(&mut self, frame: u64, events: Vec<ControlEvent>) {
+        self.script.entry(frame).or_default().extend(events);
+    }
+
     /// Records and submits one frame, without reading it back (benchmarks).
     pub fn render_only(&mut self) -> Result<(FrameTime, FrameStats), crate::graph::GraphError> {
         let time = self.clock.now();
-        self.instance.step(&time);
+        if let Some(events) = self.script.remove(&time.frame) {
+            self.instance.apply(&events);
+        }
+        self.instance.advance(&time);
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("offscreen_frame") });
         let output = self.instance.encode(&self.gpu, &mut self.runtime, &mut encoder, self.size, &time)?;

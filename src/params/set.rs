@@ -2,18 +2,20 @@
 
 use super::value::{ParamDecl, ParamValue};
 
-/// The declared parameters of one node and their current values.
+/// The declared parameters of one node: the target each source last set, and the current value
+/// techniques read, which glides towards the target when the parameter has a smoothing time.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ParamSet {
     decls: Vec<ParamDecl>,
+    targets: Vec<ParamValue>,
     values: Vec<ParamValue>,
 }
 
 impl ParamSet {
     /// All parameters at their defaults.
     pub fn new(decls: Vec<ParamDecl>) -> Self {
-        let values = decls.iter().map(|d| d.default).collect();
-        Self { decls, values }
+        let values: Vec<ParamValue> = decls.iter().map(|d| d.default).collect();
+        Self { decls, targets: values.clone(), values }
     }
 
     /// The declarations, in declaration order.
@@ -26,26 +28,63 @@ impl ParamSet {
         self.decls.iter().position(|d| d.name == name)
     }
 
-    /// The current value of parameter `i`.
+    /// The current (smoothed) value of parameter `i`.
     pub fn value_at(&self, i: usize) -> ParamValue {
         self.values[i]
     }
 
-    /// Sets parameter `i`, converting to its type and clamping to its range.
+    /// The value parameter `i` is heading to (what the last source set).
+    pub fn target_at(&self, i: usize) -> ParamValue {
+        self.targets[i]
+    }
+
+    /// Sets parameter `i`'s target, converting to its type and clamping to its range. Without
+    /// smoothing (or for discrete types) the value follows at once.
     pub fn set_at(&mut self, i: usize, value: ParamValue) {
         let decl = &self.decls[i];
         let typed =
             if value.ty() == decl.ty() { value } else { ParamValue::from_components(decl.ty(), &value.components()) };
-        self.values[i] = typed.clamped(decl.range);
+        self.targets[i] = typed.clamped(decl.range);
+        if decl.smoothing <= 0.0 || !decl.is_smoothable() {
+            self.values[i] = self.targets[i];
+        }
     }
 
-    /// Sets one float component of parameter `i` (for tracks on `t.x` and the like).
+    /// Sets one float component of parameter `i`'s target (tracks on `t.x`, OSC on `/t/x`).
     pub fn set_component(&mut self, i: usize, component: usize, x: f32) {
-        let mut c = self.values[i].components();
+        let mut c = self.targets[i].components();
         if let Some(slot) = c.get_mut(component) {
             *slot = x;
         }
         self.set_at(i, ParamValue::from_components(self.decls[i].ty(), &c));
+    }
+
+    /// Moves smoothed values towards their targets over `dt` seconds: an exponential approach
+    /// with each parameter's time constant, so the glide is the same at any frame rate.
+    pub fn advance(&mut self, dt: f32) {
+        for (i, decl) in self.decls.iter().enumerate() {
+            if decl.smoothing <= 0.0 || !decl.is_smoothable() {
+                self.values[i] = self.targets[i];
+                continue;
+            }
+            let k = 1.0 - (-dt / decl.smoothing).exp();
+            self.values[i] = super::track::mix(self.values[i], self.targets[i], k);
+        }
+    }
+
+    /// Jumps every value to its target (after loading, or recalling a preset instantly).
+    pub fn snap(&mut self) {
+        self.values.clone_from(&self.targets);
+    }
+
+    /// Clears triggers that fired: called once the frame that saw them has been built.
+    pub fn end_frame(&mut self) {
+        for (t, v) in self.targets.iter_mut().zip(self.values.iter_mut()) {
+            if matches!(t, ParamValue::Trigger(true)) {
+                *t = ParamValue::Trigger(false);
+                *v = ParamValue::Trigger(false);
+            }
+        }
     }
 
     /// The value of `name`.
@@ -79,6 +118,11 @@ impl ParamSet {
         }
     }
 
+    /// Whether a trigger parameter fired this frame.
+    pub fn fired(&self, name: &str) -> bool {
+        matches!(self.get(name), ParamValue::Trigger(true))
+    }
+
     /// A bool parameter.
     pub fn bool(&self, name: &str) -> bool {
         self.get(name).components()[0] >= 0.5
@@ -94,5 +138,54 @@ impl ParamSet {
     pub fn color(&self, name: &str) -> [f32; 4] {
         let c = self.get(name).components();
         std::array::from_fn(|i| c.get(i).copied().unwrap_or(1.0))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn set(smoothing: f32) -> ParamSet {
+        ParamSet::new(vec![
+            ParamDecl::new("x", ParamValue::Float(0.0), Some((0.0, 10.0)), "").with_smoothing(smoothing),
+            ParamDecl::new("n", ParamValue::Int(0), Some((0.0, 10.0)), "").with_smoothing(smoothing),
+            ParamDecl::trigger("go", ""),
+        ])
+    }
+
+    #[test]
+    fn smoothing_is_frame_rate_independent() {
+        let (mut at_30, mut at_240) = (set(0.1), set(0.1));
+        at_30.set_at(0, ParamValue::Float(10.0));
+        at_240.set_at(0, ParamValue::Float(10.0));
+        for _ in 0..3 {
+            at_30.advance(1.0 / 30.0);
+        }
+        for _ in 0..24 {
+            at_240.advance(1.0 / 240.0);
+        }
+        let (a, b) = (at_30.float("x"), at_240.float("x"));
+        // After 0.1 s (one time constant) both are at 1 − 1/e of the way.
+        assert!((a - b).abs() < 1e-4 && (a - 6.3212).abs() < 1e-3, "{a} {b}");
+        assert_eq!(at_30.target_at(0), ParamValue::Float(10.0));
+    }
+
+    #[test]
+    fn discrete_values_and_unsmoothed_params_jump() {
+        let mut p = set(0.5);
+        p.set_at(1, ParamValue::Int(7));
+        assert_eq!(p.int("n"), 7, "ints are never smoothed");
+        let mut q = set(0.0);
+        q.set_at(0, ParamValue::Float(4.0));
+        assert_eq!(q.float("x"), 4.0);
+    }
+
+    #[test]
+    fn a_trigger_fires_for_one_frame() {
+        let mut p = set(0.0);
+        p.set_at(2, ParamValue::Trigger(true));
+        assert!(p.fired("go"));
+        p.end_frame();
+        assert!(!p.fired("go"));
     }
 }

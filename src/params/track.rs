@@ -96,9 +96,9 @@ impl Track {
     }
 }
 
-/// Component-wise blend of two values of the same type (`w` = 0 gives `a`).
-fn mix(a: ParamValue, b: ParamValue, w: f32) -> ParamValue {
-    if matches!(a.ty(), ParamType::Bool | ParamType::Enum) {
+/// Component-wise blend (`w` = 0 gives `a`); discrete types switch only at `w` = 1.
+pub fn mix(a: ParamValue, b: ParamValue, w: f32) -> ParamValue {
+    if matches!(a.ty(), ParamType::Bool | ParamType::Enum | ParamType::Trigger) {
         return if w >= 1.0 { b } else { a };
     }
     let c: Vec<f32> = a.components().iter().zip(b.components()).map(|(x, y)| x + (y - x) * w).collect();

@@ -21,13 +21,15 @@ pub enum ParamType {
     Color,
     /// One of the declaration's named options (drop-down).
     Enum,
+    /// A momentary event (button): true for the one frame it fires in, never smoothed.
+    Trigger,
 }
 
 impl ParamType {
     /// Number of float components.
     pub fn components(self) -> usize {
         match self {
-            ParamType::Float | ParamType::Int | ParamType::Bool | ParamType::Enum => 1,
+            ParamType::Float | ParamType::Int | ParamType::Bool | ParamType::Enum | ParamType::Trigger => 1,
             ParamType::Vec2 => 2,
             ParamType::Vec3 => 3,
             ParamType::Vec4 | ParamType::Color => 4,
@@ -45,6 +47,7 @@ impl ParamType {
             ParamType::Vec4 => "vec4",
             ParamType::Color => "color",
             ParamType::Enum => "enum",
+            ParamType::Trigger => "trigger",
         }
     }
 
@@ -64,6 +67,7 @@ impl ParamType {
             ParamType::Vec4 if exact => ParamValue::Vec4([f(0), f(1), f(2), f(3)]),
             ParamType::Color if exact => ParamValue::Color([f(0), f(1), f(2), f(3)]),
             ParamType::Color if numbers.len() == 3 => ParamValue::Color([f(0), f(1), f(2), 1.0]),
+            ParamType::Trigger if numbers.len() <= 1 => ParamValue::Trigger(numbers.first().is_none_or(|&x| x != 0.0)),
             ParamType::Enum if exact && numbers[0].fract() == 0.0 && (0.0..65536.0).contains(&numbers[0]) => {
                 ParamValue::Enum(numbers[0] as u32)
             }
@@ -97,6 +101,8 @@ pub enum ParamValue {
     Color([f32; 4]),
     /// See [`ParamType::Enum`]: the index of the chosen option.
     Enum(u32),
+    /// See [`ParamType::Trigger`]: whether it fired this frame.
+    Trigger(bool),
 }
 
 impl ParamValue {
@@ -111,6 +117,7 @@ impl ParamValue {
             ParamValue::Vec4(_) => ParamType::Vec4,
             ParamValue::Color(_) => ParamType::Color,
             ParamValue::Enum(_) => ParamType::Enum,
+            ParamValue::Trigger(_) => ParamType::Trigger,
         }
     }
 
@@ -124,6 +131,7 @@ impl ParamValue {
             ParamValue::Vec3(v) => v.to_vec(),
             ParamValue::Vec4(v) | ParamValue::Color(v) => v.to_vec(),
             ParamValue::Enum(i) => vec![i as f32],
+            ParamValue::Trigger(b) => vec![if b { 1.0 } else { 0.0 }],
         }
     }
 
@@ -139,13 +147,14 @@ impl ParamValue {
             ParamType::Vec4 => ParamValue::Vec4([at(0), at(1), at(2), at(3)]),
             ParamType::Color => ParamValue::Color([at(0), at(1), at(2), at(3)]),
             ParamType::Enum => ParamValue::Enum(at(0).round().max(0.0) as u32),
+            ParamType::Trigger => ParamValue::Trigger(at(0) >= 0.5),
         }
     }
 
     /// Clamps every component into `range` (colours are not clamped by a range; they keep [0, ∞)).
     pub fn clamped(&self, range: Option<(f32, f32)>) -> ParamValue {
         let Some((lo, hi)) = range else { return *self };
-        if matches!(self, ParamValue::Bool(_)) {
+        if matches!(self, ParamValue::Bool(_) | ParamValue::Trigger(_)) {
             return *self;
         }
         let c: Vec<f32> = self.components().iter().map(|x| x.clamp(lo, hi)).collect();
@@ -159,7 +168,7 @@ impl fmt::Display for ParamValue {
         match self {
             ParamValue::Int(i) => write!(f, "{i}"),
             ParamValue::Enum(i) => write!(f, "#{i}"),
-            ParamValue::Bool(b) => write!(f, "{b}"),
+            ParamValue::Bool(b) | ParamValue::Trigger(b) => write!(f, "{b}"),
             ParamValue::Float(x) => write!(f, "{x}"),
             other => {
                 let parts: Vec<String> = other.components().iter().map(|c| c.to_string()).collect();
@@ -184,12 +193,23 @@ pub struct ParamDecl {
     pub doc: String,
     /// Option names of an enum parameter (empty otherwise).
     pub options: Vec<String>,
+    /// Smoothing time constant in seconds (0: changes apply at once). Only continuous types
+    /// (float, vectors, colours) are smoothed.
+    pub smoothing: f32,
 }
 
 impl ParamDecl {
     /// A declaration; `range` bounds each component.
     pub fn new(name: &str, default: ParamValue, range: Option<(f32, f32)>, doc: &str) -> Self {
-        Self { name: name.into(), default, range, unit: String::new(), doc: doc.into(), options: Vec::new() }
+        Self {
+            name: name.into(),
+            default,
+            range,
+            unit: String::new(),
+            doc: doc.into(),
+            options: Vec::new(),
+            smoothing: 0.0,
+        }
     }
 
     /// An enum parameter choosing one of `options` (default: option `default`).
@@ -198,6 +218,23 @@ impl ParamDecl {
         let mut decl = Self::new(name, ParamValue::Enum(default), Some((0.0, last)), doc);
         decl.options = options.iter().map(|o| o.to_string()).collect();
         decl
+    }
+
+    /// A trigger (momentary button) parameter.
+    pub fn trigger(name: &str, doc: &str) -> Self {
+        Self::new(name, ParamValue::Trigger(false), None, doc)
+    }
+
+    /// The same declaration with a smoothing time constant (seconds).
+    #[must_use]
+    pub fn with_smoothing(mut self, seconds: f32) -> Self {
+        self.smoothing = seconds.max(0.0);
+        self
+    }
+
+    /// Whether values of this type glide when smoothed (continuous types only).
+    pub fn is_smoothable(&self) -> bool {
+        matches!(self.ty(), ParamType::Float | ParamType::Vec2 | ParamType::Vec3 | ParamType::Vec4 | ParamType::Color)
     }
 
     /// The option index named `name` (case-insensitive), for enum parameters.

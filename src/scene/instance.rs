@@ -1,21 +1,48 @@
 //! A scene made live: one technique instance per node, current parameter values, and the
-//! per-frame work of applying tracks, stepping simulations and declaring the frame graph.
+//! per-step work of applying control events, tracks, preset morphs and smoothing.
+//!
+//! Order within one fixed step (documented precedence): control events that arrived since the
+//! last step, in arrival order (the last write to a parameter wins) → animation tracks, except on
+//! parameters a live source has taken over → a running preset morph → smoothing → simulation.
+//! A live write (UI, OSC, MIDI) to a parameter a track drives stops that track for that parameter
+//! until `resume_tracks`, so a performer's fader is never yanked back by automation.
+
+use std::collections::BTreeSet;
 
 use super::load::Scene;
 use crate::assets::Assets;
 use crate::gpu::{Gpu, ShaderError};
 use crate::graph::{FrameGraph, FrameOutput, GraphError, GraphRuntime};
-use crate::params::ParamSet;
+use crate::params::{Morph, ParamSet, ParamValue, ParamWrite, Source};
 use crate::techniques::{NodeSetup, Technique};
 use crate::time::FrameTime;
+
+/// Something a controller, the UI or a replay asks of the running scene.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ControlEvent {
+    /// Set one parameter (or component).
+    Write(ParamWrite),
+    /// Move to these values over `seconds` (0: at once) — a preset recall.
+    Morph {
+        /// (node, param, value).
+        values: Vec<(usize, usize, ParamValue)>,
+        /// Morph duration.
+        seconds: f64,
+    },
+    /// Give every parameter a live source took over back to its track.
+    ResumeTracks,
+}
 
 /// The running form of a [`Scene`].
 pub struct SceneInstance {
     scene: Scene,
     params: Vec<ParamSet>,
     nodes: Vec<Box<dyn Technique>>,
-    /// When false, tracks leave parameters alone (the performer has taken over).
+    /// When false, tracks leave parameters alone (the performer has taken over everything).
     pub animate: bool,
+    overridden: BTreeSet<(usize, usize)>,
+    morph: Option<Morph>,
+    pending_morph: Option<(Vec<(usize, usize, ParamValue)>, f64)>,
 }
 
 impl SceneInstance {
@@ -27,7 +54,7 @@ impl SceneInstance {
             .map(|n| (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size }))
             .collect::<Result<Vec<_>, _>>()?;
         let params = scene.nodes.iter().map(|n| n.params.clone()).collect();
-        Ok(Self { scene, params, nodes, animate: true })
+        Ok(Self { scene, params, nodes, animate: true, overridden: BTreeSet::new(), morph: None, pending_morph: None })
     }
 
     /// The validated scene.
@@ -40,33 +67,84 @@ impl SceneInstance {
         &self.params[node]
     }
 
-    /// Mutable parameters of node `i` (UI, control input).
-    pub fn params_mut(&mut self, node: usize) -> &mut ParamSet {
-        &mut self.params[node]
+    /// Every node's parameters.
+    pub fn all_params(&self) -> &[ParamSet] {
+        &self.params
     }
 
-    /// Whether a track drives parameter `param` of node `node`.
+    /// Whether a track currently drives parameter `param` of node `node`.
     pub fn is_animated(&self, node: usize, param: usize) -> bool {
-        self.animate && self.scene.tracks.iter().any(|t| t.node == node && t.param == param)
+        self.animate && !self.overridden.contains(&(node, param)) && self.has_track(node, param)
     }
 
-    /// Sets every tracked parameter to its value at `time`.
-    pub fn apply_tracks(&mut self, time: &FrameTime) {
-        if !self.animate {
-            return;
-        }
-        for bound in &self.scene.tracks {
-            let value = bound.track.sample(time.seconds);
-            let params = &mut self.params[bound.node];
-            match bound.component {
-                Some(c) => params.set_component(bound.param, c, value.components()[0]),
-                None => params.set_at(bound.param, value),
+    /// Whether a live source took parameter `param` of `node` over from its track.
+    pub fn is_overridden(&self, node: usize, param: usize) -> bool {
+        self.overridden.contains(&(node, param))
+    }
+
+    fn has_track(&self, node: usize, param: usize) -> bool {
+        self.scene.tracks.iter().any(|t| t.node == node && t.param == param)
+    }
+
+    /// Applies control events in order; they take effect from the next step.
+    pub fn apply(&mut self, events: &[ControlEvent]) {
+        for event in events {
+            match event {
+                ControlEvent::Write(w) => self.write(w),
+                ControlEvent::Morph { values, seconds } => self.pending_morph = Some((values.clone(), *seconds)),
+                ControlEvent::ResumeTracks => self.overridden.clear(),
             }
         }
     }
 
-    /// Advances every node's simulation by one fixed step.
-    pub fn step(&mut self, time: &FrameTime) {
+    fn write(&mut self, w: &ParamWrite) {
+        let Some(params) = self.params.get_mut(w.node) else { return };
+        if w.param >= params.decls().len() {
+            return;
+        }
+        match w.component {
+            Some(c) => params.set_component(w.param, c, w.value.components()[0]),
+            None => params.set_at(w.param, w.value),
+        }
+        let live = matches!(w.source, Source::Ui | Source::Osc | Source::Midi | Source::Replay);
+        if live && self.has_track(w.node, w.param) {
+            self.overridden.insert((w.node, w.param));
+        }
+    }
+
+    /// Runs one fixed step at `time`: tracks, preset morph, smoothing, simulation.
+    pub fn advance(&mut self, time: &FrameTime) {
+        if self.animate {
+            for bound in &self.scene.tracks {
+                if self.overridden.contains(&(bound.node, bound.param)) {
+                    continue;
+                }
+                let value = bound.track.sample(time.seconds);
+                let params = &mut self.params[bound.node];
+                match bound.component {
+                    Some(c) => params.set_component(bound.param, c, value.components()[0]),
+                    None => params.set_at(bound.param, value),
+                }
+            }
+        }
+        if let Some((values, seconds)) = self.pending_morph.take() {
+            let entries = values.iter().map(|&(n, p, to)| (n, p, self.params[n].target_at(p), to)).collect();
+            self.morph = Some(Morph { entries, start: time.seconds, duration: seconds });
+        }
+        if let Some(morph) = &self.morph {
+            let (values, done) = morph.sample(time.seconds);
+            for (n, p, v) in values {
+                self.params[n].set_at(p, v);
+                // A recalled value replaces what a track or a live source had.
+                self.overridden.remove(&(n, p));
+            }
+            if done {
+                self.morph = None;
+            }
+        }
+        for params in &mut self.params {
+            params.advance(time.dt);
+        }
         for (node, params) in self.nodes.iter_mut().zip(&self.params) {
             node.step(params, time);
         }
@@ -84,8 +162,8 @@ impl SceneInstance {
         graph
     }
 
-    /// Applies tracks, builds and records the frame into `encoder`; the caller encodes the
-    /// output for display and submits.
+    /// Builds and records the frame into `encoder`; the caller encodes the output for display
+    /// and submits. Triggers that fired are cleared afterwards.
     pub fn encode(
         &mut self,
         gpu: &Gpu,
@@ -94,8 +172,11 @@ impl SceneInstance {
         output_size: (u32, u32),
         time: &FrameTime,
     ) -> Result<FrameOutput, GraphError> {
-        self.apply_tracks(time);
         let graph = self.build_graph(output_size, time);
-        runtime.execute(&gpu.device, &gpu.queue, graph, encoder)
+        let result = runtime.execute(&gpu.device, &gpu.queue, graph, encoder);
+        for params in &mut self.params {
+            params.end_frame();
+        }
+        result
     }
 }

@@ -3,7 +3,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use super::error::{SceneError, SceneErrors, locate};
-use super::schema::{RawValue, SceneFile};
+use super::schema::{MidiMapping, RawValue, SceneFile};
 use crate::assets::{AssetKind, Assets};
 use crate::params::{Key, ParamDecl, ParamSet, ParamType, ParamValue, Track};
 use crate::techniques::{self, TechniqueInfo};
@@ -29,6 +29,45 @@ pub struct Scene {
     pub output: usize,
     /// Tracks bound to node parameters.
     pub tracks: Vec<BoundTrack>,
+    /// OSC addresses declared in the scene's `controls`, besides `/indra/<node>/<param>`.
+    pub osc_aliases: Vec<(String, Target)>,
+    /// MIDI mappings declared in the scene's `controls`.
+    pub midi: Vec<(MidiMapping, Target)>,
+}
+
+/// A parameter, or one float component of it, of a scene node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Target {
+    /// Node index.
+    pub node: usize,
+    /// Parameter index in the node.
+    pub param: usize,
+    /// Component (`t.x` → 0), if any.
+    pub component: Option<usize>,
+}
+
+/// Resolves `node.param` or `node.param.<x|y|z|w|r|g|b|a>` against validated nodes.
+pub fn resolve_target(nodes: &[SceneNode], target: &str) -> Result<Target, String> {
+    let mut parts = target.split('.');
+    let (node_id, param, component) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""), parts.next());
+    if parts.next().is_some() {
+        return Err(format!("'{target}' is not node.param or node.param.component"));
+    }
+    let node = nodes.iter().position(|n| n.id == node_id).ok_or_else(|| {
+        let ids: Vec<&str> = nodes.iter().map(|n| n.id.as_str()).collect();
+        format!("no node '{node_id}' (nodes: {})", ids.join(", "))
+    })?;
+    let params = &nodes[node].params;
+    let index = params.index(param).ok_or_else(|| {
+        let names: Vec<String> = params.decls().iter().map(|d| d.name.clone()).collect();
+        unknown_param(nodes[node].technique, param, &names)
+    })?;
+    let ty = params.decls()[index].ty();
+    let component = match component {
+        None => None,
+        Some(c) => Some(component_index(c, ty).ok_or_else(|| format!("'{target}': a {ty} has no component '{c}'"))?),
+    };
+    Ok(Target { node, param: index, component })
 }
 
 /// One technique instance of a validated scene.
@@ -76,19 +115,19 @@ impl Scene {
     pub fn set_from_str(&mut self, assignment: &str) -> Result<(), String> {
         let (target, value) =
             assignment.split_once('=').ok_or_else(|| format!("'{assignment}' is not of the form node.param=value"))?;
-        let (node_id, param) =
-            target.split_once('.').ok_or_else(|| format!("'{target}' is not of the form node.param"))?;
-        let node = self.node_index(node_id).ok_or_else(|| {
-            let ids: Vec<&str> = self.nodes.iter().map(|n| n.id.as_str()).collect();
-            format!("scene '{}' has no node '{node_id}' (nodes: {})", self.name, ids.join(", "))
-        })?;
-        let params = &mut self.nodes[node].params;
-        let index = params.index(param).ok_or_else(|| {
-            let names: Vec<&str> = params.decls().iter().map(|d| d.name.as_str()).collect();
-            format!("node '{node_id}' has no parameter '{param}' (parameters: {})", names.join(", "))
-        })?;
-        let typed = parse_value_override(value, &params.decls()[index])?;
-        params.set_at(index, typed);
+        let t = resolve_target(&self.nodes, target).map_err(|e| format!("scene '{}': {e}", self.name))?;
+        let params = &mut self.nodes[t.node].params;
+        match t.component {
+            Some(c) => {
+                let x = value.trim().parse::<f32>().map_err(|_| format!("'{value}' is not a number"))?;
+                params.set_component(t.param, c, x);
+            }
+            None => {
+                let typed = parse_value_override(value, &params.decls()[t.param])?;
+                params.set_at(t.param, typed);
+            }
+        }
+        params.snap();
         Ok(())
     }
 }
@@ -196,6 +235,7 @@ impl Validator<'_> {
         }
         let output = position[&output.expect("checked above")];
         let tracks = self.tracks(&file, &ordered);
+        let (osc_aliases, midi) = self.controls(&file, &ordered);
         if !self.errors.is_empty() {
             return Err(SceneErrors(self.errors));
         }
@@ -209,7 +249,48 @@ impl Validator<'_> {
             nodes: ordered,
             output,
             tracks,
+            osc_aliases,
+            midi,
         })
+    }
+
+    /// Resolves OSC aliases and MIDI mappings to parameters.
+    fn controls(
+        &mut self,
+        file: &SceneFile,
+        nodes: &[SceneNode],
+    ) -> (Vec<(String, Target)>, Vec<(MidiMapping, Target)>) {
+        let mut aliases = Vec::new();
+        for (address, target) in &file.controls.osc {
+            let anchor = format!("\"{address}\"");
+            if !address.starts_with('/') {
+                self.error(&["controls", &anchor], format!("OSC address '{address}' must start with '/'"));
+                continue;
+            }
+            match resolve_target(nodes, target) {
+                Ok(t) => aliases.push((address.clone(), t)),
+                Err(e) => self.error(&["controls", &anchor], format!("OSC alias '{address}': {e}")),
+            }
+        }
+        let mut midi = Vec::new();
+        for m in &file.controls.midi {
+            let anchors = ["controls", "midi", m.target.as_str()];
+            let problem = match (m.cc, m.note) {
+                _ if m.channel.is_some_and(|c| !(1..=16).contains(&c)) => Some("channel must be 1–16".to_string()),
+                (Some(_), Some(_)) | (None, None) => Some("give exactly one of cc and note".into()),
+                (Some(cc), None) if cc > 127 || (m.fine && cc > 31) => {
+                    Some(format!("cc {cc} out of range (0–127, or 0–31 for a 14-bit pair)"))
+                }
+                (None, Some(n)) if n > 127 => Some(format!("note {n} out of range (0–127)")),
+                _ => None,
+            };
+            match (problem, resolve_target(nodes, &m.target)) {
+                (Some(p), _) => self.error(&anchors, format!("MIDI mapping to '{}': {p}", m.target)),
+                (None, Err(e)) => self.error(&anchors, format!("MIDI mapping: {e}")),
+                (None, Ok(t)) => midi.push((m.clone(), t)),
+            }
+        }
+        (aliases, midi)
     }
 
     /// Checks one node's technique, params, ranges and input names; input indices refer to the
@@ -234,6 +315,17 @@ impl Validator<'_> {
                     self.error(&[anchor, "ranges", &key], format!("range of '{name}' is empty: ({lo}, {hi})"))
                 }
                 Some(d) => d.range = Some((*lo, *hi)),
+            }
+        }
+        for (name, seconds) in &node.smoothing {
+            let key = format!("\"{name}\"");
+            match decls.iter_mut().find(|d| &d.name == name) {
+                None => self.error(&[anchor, "smoothing", &key], unknown_param(technique, name, &names)),
+                Some(_) if !(0.0..=60.0).contains(seconds) => self.error(
+                    &[anchor, "smoothing", &key],
+                    format!("smoothing of '{name}' must be 0–60 s, not {seconds}"),
+                ),
+                Some(d) => d.smoothing = *seconds,
             }
         }
         for (name, raw) in &node.params {
@@ -311,30 +403,15 @@ impl Validator<'_> {
         for t in &file.tracks {
             let anchor = format!("\"{}\"", t.target);
             let anchors = ["tracks", anchor.as_str()];
-            let mut parts = t.target.split('.');
-            let (node_id, param, component) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""), parts.next());
-            let Some(node) = nodes.iter().position(|n| n.id == node_id) else {
-                self.error(&anchors, format!("track target '{}': no node '{node_id}'", t.target));
-                continue;
-            };
-            let params = &nodes[node].params;
-            let Some(pi) = params.index(param) else {
-                let names: Vec<String> = params.decls().iter().map(|d| d.name.clone()).collect();
-                self.error(&anchors, unknown_param(nodes[node].technique, param, &names));
-                continue;
-            };
-            let ty = params.decls()[pi].ty();
-            let component = match component.map(|c| component_index(c, ty)) {
-                None => None,
-                Some(Some(c)) => Some(c),
-                Some(None) => {
-                    self.error(
-                        &anchors,
-                        format!("track target '{}': a {ty} has no component '{}'", t.target, component.unwrap_or("")),
-                    );
+            let Target { node, param: pi, component } = match resolve_target(nodes, &t.target) {
+                Ok(target) => target,
+                Err(e) => {
+                    self.error(&anchors, format!("track target {e}"));
                     continue;
                 }
             };
+            let params = &nodes[node].params;
+            let ty = params.decls()[pi].ty();
             let key_type = if component.is_some() { ParamType::Float } else { ty };
             let options = params.decls()[pi].options.clone();
             if t.keys.is_empty() || t.time_scale.is_nan() || t.time_scale <= 0.0 {

@@ -7,6 +7,6 @@ mod load;
 mod schema;
 
 pub use error::{SceneError, SceneErrors};
-pub use instance::SceneInstance;
-pub use load::{BoundTrack, Scene, SceneNode, load_scene, parse_scene, parse_value_override};
-pub use schema::{NodeFile, RawValue, SceneFile, TrackFile};
+pub use instance::{ControlEvent, SceneInstance};
+pub use load::{BoundTrack, Scene, SceneNode, Target, load_scene, parse_scene, parse_value_override, resolve_target};
+pub use schema::{ControlsFile, MidiCurve, MidiMapping, NodeFile, RawValue, SceneFile, TrackFile};

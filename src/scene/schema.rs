@@ -47,9 +47,63 @@ pub struct SceneFile {
     pub nodes: Vec<NodeFile>,
     /// The node whose texture is shown.
     pub output: String,
+    /// OSC aliases and MIDI mappings.
+    #[serde(default)]
+    pub controls: ControlsFile,
     /// Animation tracks.
     #[serde(default)]
     pub tracks: Vec<TrackFile>,
+}
+
+/// How controllers reach parameters, besides the default `/indra/<node>/<param>` addresses.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControlsFile {
+    /// OSC address → `node.param[.component]` (e.g. `"/1/fader1": "limit_set.scale"`).
+    #[serde(default)]
+    pub osc: BTreeMap<String, String>,
+    /// MIDI controls bound to parameters.
+    #[serde(default)]
+    pub midi: Vec<MidiMapping>,
+}
+
+/// A MIDI control change (7-bit, or 14-bit when `fine`) or note bound to a parameter.
+#[derive(Clone, Debug, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MidiMapping {
+    /// MIDI channel 1–16; absent = any channel.
+    #[serde(default)]
+    pub channel: Option<u8>,
+    /// Controller number 0–127 (0–31 for 14-bit pairs).
+    #[serde(default)]
+    pub cc: Option<u8>,
+    /// Note number 0–127: note-on fires triggers / sets bools, velocity drives numbers.
+    #[serde(default)]
+    pub note: Option<u8>,
+    /// `node.param[.component]`.
+    pub target: String,
+    /// Value range the control sweeps (default: the parameter's range).
+    #[serde(default)]
+    pub range: Option<(f32, f32)>,
+    /// Linear or Exponential response.
+    #[serde(default)]
+    pub curve: MidiCurve,
+    /// Reverse the direction.
+    #[serde(default)]
+    pub invert: bool,
+    /// 14-bit: the controller's LSB comes on `cc + 32`.
+    #[serde(default)]
+    pub fine: bool,
+}
+
+/// How a 0–1 control position maps onto a range.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
+pub enum MidiCurve {
+    /// Even steps.
+    #[default]
+    Linear,
+    /// Fine control at the low end (for zoom, speed, frequency).
+    Exponential,
 }
 
 fn default_dt() -> f32 {
@@ -74,6 +128,9 @@ pub struct NodeFile {
     /// Narrower (or wider) slider ranges than the technique declares.
     #[serde(default)]
     pub ranges: BTreeMap<String, (f32, f32)>,
+    /// Smoothing time constants in seconds (so a 20 Hz fader glides).
+    #[serde(default)]
+    pub smoothing: BTreeMap<String, f32>,
     /// Input slot → upstream node id.
     #[serde(default)]
     pub inputs: BTreeMap<String, String>,
