@@ -22,7 +22,7 @@ macro_rules! say {
 pub const DEFAULT_SCENE: &str = "kleinian";
 
 /// `indra run`.
-#[derive(Args, Clone, Default)]
+#[derive(Args, Clone)]
 pub struct RunArgs {
     /// Scene name (from scenes/) or path to a .ron file.
     #[arg(default_value = DEFAULT_SCENE)]
@@ -36,6 +36,61 @@ pub struct RunArgs {
     /// Set a parameter at start: node.param=value (repeatable).
     #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
     pub sets: Vec<String>,
+    /// OSC listen address; loopback by default, 0.0.0.0:9000 opens it to the network.
+    #[arg(long, default_value = DEFAULT_OSC)]
+    pub osc: String,
+    /// No OSC input.
+    #[arg(long)]
+    pub no_osc: bool,
+    /// Send every parameter change to this OSC destination (host:port), so faders follow.
+    #[arg(long)]
+    pub osc_out: Option<String>,
+    /// Serve the OSCQuery address tree over HTTP here (e.g. 127.0.0.1:9001).
+    #[arg(long)]
+    pub oscquery: Option<String>,
+    /// Only MIDI input ports whose name contains this (default: all ports).
+    #[arg(long)]
+    pub midi: Option<String>,
+    /// No MIDI input.
+    #[arg(long)]
+    pub no_midi: bool,
+    /// Record every control event with its frame to this file (replay with `render --replay`).
+    #[arg(long)]
+    pub record_controls: Option<PathBuf>,
+    /// Folder of presets.
+    #[arg(long, default_value = "presets")]
+    pub presets: PathBuf,
+    /// File of MIDI-learned mappings.
+    #[arg(long, default_value = "midi-learn.ron")]
+    pub midi_learn: PathBuf,
+    /// Do not watch shaders/ and scenes/ for edits.
+    #[arg(long)]
+    pub no_watch: bool,
+}
+
+/// Where OSC listens unless told otherwise: loopback, so nothing on the network can reach it.
+pub const DEFAULT_OSC: &str = "127.0.0.1:9000";
+
+impl Default for RunArgs {
+    /// What `indra` with no arguments does (the same defaults as `indra run`).
+    fn default() -> Self {
+        Self {
+            scene: DEFAULT_SCENE.into(),
+            fullscreen: false,
+            monitor: None,
+            sets: Vec::new(),
+            osc: DEFAULT_OSC.into(),
+            no_osc: false,
+            osc_out: None,
+            oscquery: None,
+            midi: None,
+            no_midi: false,
+            record_controls: None,
+            presets: "presets".into(),
+            midi_learn: "midi-learn.ron".into(),
+            no_watch: false,
+        }
+    }
 }
 
 /// `indra render`.
@@ -64,6 +119,9 @@ pub struct RenderArgs {
     /// Set a parameter: node.param=value (repeatable).
     #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
     pub sets: Vec<String>,
+    /// Replay a control stream recorded with `run --record-controls`, frame-exactly.
+    #[arg(long)]
+    pub replay: Option<PathBuf>,
 }
 
 /// `indra bench`.
@@ -106,16 +164,42 @@ fn scene_with_sets(assets: &Assets, name: &str, sets: &[String]) -> Result<Scene
     Ok(scene)
 }
 
-/// Opens the scene in a window.
+/// Opens the scene in a window. A scene file that is broken on disk falls back to its built-in
+/// copy (with the error shown) so the show starts; the fix is picked up on save.
 pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), String> {
-    let scene = scene_with_sets(assets, &args.scene, &args.sets)?;
-    let options = indra::app::WindowOptions { fullscreen: args.fullscreen, monitor: args.monitor };
-    indra::app::run(assets.clone(), gpu.clone(), scene, options)
+    let mut notices = Vec::new();
+    let scene = match scene_with_sets(assets, &args.scene, &args.sets) {
+        Ok(scene) => scene,
+        Err(e) => match scene_with_sets(&Assets::new(None), &args.scene, &args.sets) {
+            Ok(builtin) => {
+                notices.push(format!("{e}\n(running the built-in copy until the file is fixed)"));
+                builtin
+            }
+            Err(_) => return Err(e),
+        },
+    };
+    let options =
+        indra::app::WindowOptions { fullscreen: args.fullscreen, monitor: args.monitor, watch: !args.no_watch };
+    let control = indra::control::ControlOptions {
+        osc: (!args.no_osc).then(|| args.osc.clone()),
+        osc_out: args.osc_out.clone(),
+        oscquery: args.oscquery.clone(),
+        midi: !args.no_midi,
+        midi_filter: args.midi.clone(),
+        record: args.record_controls.clone(),
+        presets_dir: args.presets.clone(),
+        learn_file: args.midi_learn.clone(),
+    };
+    indra::app::run(assets.clone(), gpu.clone(), scene, options, control, notices)
 }
 
 /// Renders a PNG sequence.
 pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<(), String> {
     let scene = scene_with_sets(assets, &args.scene, &args.sets)?;
+    let script = match &args.replay {
+        Some(path) => indra::control::record::read_replay(path, &scene)?,
+        None => Default::default(),
+    };
     let stem = Path::new(&args.scene).file_stem().map_or("frame".into(), |s| s.to_string_lossy().into_owned());
     std::fs::create_dir_all(&args.out).map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
@@ -123,6 +207,10 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     let mut renderer =
         OffscreenRenderer::new(device, assets, scene, args.size, args.dt, args.seed).map_err(|e| e.to_string())?;
     renderer.seek(args.start);
+    // Events from before the first rendered frame apply at once, in order, before it.
+    for (frame, events) in script {
+        renderer.schedule(frame.max(args.start), events);
+    }
     let bar = indicatif::ProgressBar::new(args.frames);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}")

@@ -9,9 +9,11 @@
 
 pub mod app;
 pub mod assets;
+pub mod control;
 
 pub mod gpu;
 pub mod graph;
+pub mod live;
 pub mod offscreen;
 pub mod params;
 pub mod scene;

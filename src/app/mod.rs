@@ -1,31 +1,42 @@
 //! The windowed runtime: a winit event loop, a wgpu surface, the scene drawn full-window on a
 //! fixed-step clock, and an egui overlay with the generated parameter panel, pass timings and
-//! errors. F11 toggles fullscreen, Esc leaves it (never the show), F1 hides the panel.
+//! errors. F11 toggles fullscreen, Esc leaves it (never the show), F1 hides the panel, F2 gives
+//! taken-over parameters back to their tracks, 1–9 recall presets.
 
 mod panel;
 mod window;
 
 use crate::assets::Assets;
+use crate::control::ControlOptions;
 use crate::gpu::GpuOptions;
 use crate::scene::Scene;
 
 /// How the window opens.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 pub struct WindowOptions {
     /// Start in borderless fullscreen.
     pub fullscreen: bool,
     /// Monitor index to go fullscreen on (default: the window's current one).
     pub monitor: Option<usize>,
+    /// Watch `shaders/` and `scenes/` and reload edits.
+    pub watch: bool,
 }
 
 /// Opens `scene` in a window and runs until the window is closed.
-pub fn run(assets: Assets, gpu: GpuOptions, scene: Scene, options: WindowOptions) -> Result<(), String> {
+pub fn run(
+    assets: Assets,
+    gpu: GpuOptions,
+    scene: Scene,
+    options: WindowOptions,
+    control: ControlOptions,
+    notices: Vec<String>,
+) -> Result<(), String> {
     let event_loop = winit::event_loop::EventLoop::new().map_err(|e| {
         format!(
             "cannot open a window ({e}); on a machine without a display use `indra render`, or run under `xvfb-run`"
         )
     })?;
-    let mut app = window::WindowApp::new(assets, gpu, scene, options);
+    let mut app = window::WindowApp::new(assets, gpu, scene, options, control, notices);
     event_loop.run_app(&mut app).map_err(|e| format!("the window's event loop failed: {e}"))?;
     app.into_result()
 }

@@ -1,9 +1,10 @@
 //! The egui overlay: a parameter panel generated from the scene's declarations, the pass timing
 //! list, and the error overlay.
 
+use crate::control::ControlHub;
 use crate::graph::{FrameStats, PassTiming};
 use crate::params::{ParamDecl, ParamValue, ParamWrite, Source};
-use crate::scene::{ControlEvent, SceneInstance};
+use crate::scene::{ControlEvent, SceneInstance, Target};
 use crate::time::FrameTime;
 
 /// What the overlay shows besides parameters.
@@ -16,15 +17,31 @@ pub struct Overlay {
     pub timings: Vec<PassTiming>,
     /// Distinct errors with how often each happened; each is logged once.
     errors: Vec<(String, u32)>,
+    /// Name typed for saving a preset.
+    pub preset_name: String,
+    /// Seconds a preset recall morphs over (0: instant).
+    pub morph_seconds: f32,
 }
 
 impl Default for Overlay {
     fn default() -> Self {
-        Self { panel_visible: true, stats: None, timings: Vec::new(), errors: Vec::new() }
+        Self {
+            panel_visible: true,
+            stats: None,
+            timings: Vec::new(),
+            errors: Vec::new(),
+            preset_name: "preset-1".into(),
+            morph_seconds: 0.0,
+        }
     }
 }
 
 impl Overlay {
+    /// Forgets shown errors (after a fix was picked up).
+    pub fn clear_errors(&mut self) {
+        self.errors.clear();
+    }
+
     /// Records an error: logged the first time, counted after that, shown until dismissed.
     pub fn report(&mut self, message: String) {
         match self.errors.iter_mut().find(|(m, _)| *m == message) {
@@ -42,6 +59,7 @@ pub fn draw_ui(
     ui: &mut egui::Ui,
     instance: &mut SceneInstance,
     overlay: &mut Overlay,
+    hub: &mut ControlHub,
     time: FrameTime,
 ) -> Vec<ControlEvent> {
     let mut events = Vec::new();
@@ -60,10 +78,13 @@ pub fn draw_ui(
                         events.push(ControlEvent::ResumeTracks);
                     }
                 });
-                events.extend(param_panel(ui, instance).into_iter().map(ControlEvent::Write));
+                ui.small(hub.status());
+                events.extend(param_panel(ui, instance, hub).into_iter().map(ControlEvent::Write));
+                ui.separator();
+                events.extend(preset_panel(ui, instance, overlay, hub));
                 ui.separator();
                 timing_panel(ui, overlay);
-                ui.small("F1: hide panel · F11: fullscreen · Esc: leave fullscreen");
+                ui.small("F1: hide panel · F2: resume tracks · 1–9: presets · F11: fullscreen · Esc: leave fullscreen");
             });
         });
     }
@@ -83,8 +104,37 @@ pub fn draw_ui(
     events
 }
 
-/// The parameter panel; returns the writes the performer made this frame.
-fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance) -> Vec<ParamWrite> {
+/// Save the current values under a name; recall saved presets (1–9 on the keyboard too).
+fn preset_panel(
+    ui: &mut egui::Ui,
+    instance: &SceneInstance,
+    overlay: &mut Overlay,
+    hub: &mut ControlHub,
+) -> Vec<ControlEvent> {
+    let mut events = Vec::new();
+    ui.label("presets");
+    ui.horizontal(|ui| {
+        ui.text_edit_singleline(&mut overlay.preset_name);
+        if ui.button("save").clicked() {
+            let name = overlay.preset_name.clone();
+            hub.save_preset(&name, instance);
+        }
+    });
+    ui.add(egui::Slider::new(&mut overlay.morph_seconds, 0.0..=10.0).text("morph s"));
+    ui.horizontal_wrapped(|ui| {
+        for (i, name) in hub.presets.names().iter().enumerate() {
+            let label = if i < 9 { format!("{} {name}", i + 1) } else { name.clone() };
+            if ui.button(label).clicked() {
+                events.extend(hub.recall(name, f64::from(overlay.morph_seconds), instance.scene()));
+            }
+        }
+    });
+    events
+}
+
+/// The parameter panel; returns the writes the performer made this frame. Each parameter has a
+/// MIDI learn button: click it, move a control; right-click unlearns.
+fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub) -> Vec<ParamWrite> {
     let mut writes = Vec::new();
     for node in 0..instance.scene().nodes.len() {
         let header = format!("{} ({})", instance.scene().nodes[node].id, instance.scene().nodes[node].technique.name);
@@ -94,6 +144,23 @@ fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance) -> Vec<ParamWrite> {
                 let mut value = instance.params(node).target_at(p);
                 let changed = ui
                     .horizontal(|ui| {
+                        let target = Target { node, param: p, component: None };
+                        let learning = hub.mapper.learning == Some(target);
+                        let mark = if learning {
+                            "…"
+                        } else if hub.mapper.is_mapped(node, p) {
+                            "●"
+                        } else {
+                            "○"
+                        };
+                        let hint = "MIDI learn: click, then move a control; right-click to unlearn";
+                        let learn = ui.small_button(mark).on_hover_text(hint);
+                        if learn.clicked() {
+                            hub.learn(target);
+                        }
+                        if learn.secondary_clicked() {
+                            hub.unlearn(node, p, instance.scene());
+                        }
                         let label = ui.label(&decl.name).on_hover_text(&decl.doc);
                         if animated {
                             label.on_hover_text("driven by a track: moving it takes over until 'resume tracks'");

@@ -12,8 +12,11 @@ use winit::window::{Fullscreen, Window, WindowId};
 use super::WindowOptions;
 use super::panel::{Overlay, draw_ui};
 use crate::assets::Assets;
+use crate::control::{ControlHub, ControlOptions};
 use crate::gpu::{Blit, BlitTarget, Gpu, GpuOptions};
 use crate::graph::GraphRuntime;
+use crate::live::LiveReload;
+use crate::scene::ControlEvent;
 use crate::scene::{Scene, SceneInstance};
 use crate::time::FixedClock;
 
@@ -31,6 +34,8 @@ struct Running {
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
     overlay: Overlay,
+    hub: ControlHub,
+    live: Option<LiveReload>,
     /// The time of the last step run (what the next frame shows).
     last_time: crate::time::FrameTime,
     /// Panel events of the last frame, applied before the next step.
@@ -43,14 +48,24 @@ pub struct WindowApp {
     gpu_options: GpuOptions,
     scene: Option<Scene>,
     options: WindowOptions,
+    control: ControlOptions,
+    notices: Vec<String>,
     running: Option<Running>,
     failure: Option<String>,
 }
 
 impl WindowApp {
-    /// A handler that will show `scene`.
-    pub fn new(assets: Assets, gpu_options: GpuOptions, scene: Scene, options: WindowOptions) -> Self {
-        Self { assets, gpu_options, scene: Some(scene), options, running: None, failure: None }
+    /// A handler that will show `scene`, controlled as `control` says; `notices` are shown in
+    /// the overlay from the first frame (e.g. a scene file that was broken at start-up).
+    pub fn new(
+        assets: Assets,
+        gpu_options: GpuOptions,
+        scene: Scene,
+        options: WindowOptions,
+        control: ControlOptions,
+        notices: Vec<String>,
+    ) -> Self {
+        Self { assets, gpu_options, scene: Some(scene), options, control, notices, running: None, failure: None }
     }
 
     /// Ok when the window was closed normally, or why it could not run.
@@ -97,8 +112,27 @@ impl WindowApp {
         }
         let clock = FixedClock::new(scene.dt, scene.seed);
         let last_time = clock.now();
-        let instance = SceneInstance::new(&gpu, &self.assets, scene, (config.width, config.height))
-            .map_err(|e| format!("the scene's shaders do not compile: {e}"))?;
+        let size = (config.width, config.height);
+        let mut overlay = Overlay::default();
+        for n in self.notices.drain(..) {
+            overlay.report(n);
+        }
+        let mut live =
+            if self.options.watch { LiveReload::new(&self.assets).map_err(|e| overlay.report(e)).ok() } else { None };
+        // A shader broken on disk at start-up: run the built-in copy, show the error, and pick the
+        // file up once it is fixed.
+        let instance = match SceneInstance::new(&gpu, &self.assets, scene.clone(), size) {
+            Ok(instance) => instance,
+            Err(e) => {
+                overlay.report(format!("{e} — running the built-in copy until the file is fixed"));
+                if let Some(live) = live.as_mut() {
+                    live.mark_broken(e.origin.clone().into(), e.to_string());
+                }
+                SceneInstance::new(&gpu, &Assets::new(None), scene, size)
+                    .map_err(|e| format!("the scene's shaders do not compile: {e}"))?
+            }
+        };
+        let hub = ControlHub::start(&self.control, instance.scene());
         let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
         let blit = Blit::new(&gpu.device);
         let egui_ctx = egui::Context::default();
@@ -124,7 +158,9 @@ impl WindowApp {
             last: Instant::now(),
             egui_state,
             egui_renderer,
-            overlay: Overlay::default(),
+            overlay,
+            hub,
+            live,
             last_time,
             ui_events: Vec::new(),
         })
@@ -181,10 +217,24 @@ impl ApplicationHandler for WindowApp {
                     r.window.set_fullscreen(next);
                 }
                 NamedKey::F1 => r.overlay.panel_visible = !r.overlay.panel_visible,
+                NamedKey::F2 => r.ui_events.push(ControlEvent::ResumeTracks),
                 // Esc leaves fullscreen and nothing else: a stray key must not end a show.
                 NamedKey::Escape if !consumed => r.window.set_fullscreen(None),
                 _ => {}
             },
+            // Number keys 1–9 recall the presets in name order (morphing as set in the panel).
+            WindowEvent::KeyboardInput {
+                event: KeyEvent { logical_key: Key::Character(c), state: ElementState::Pressed, repeat: false, .. },
+                ..
+            } if !consumed => {
+                if let Some(i) = c.parse::<usize>().ok().filter(|i| (1..=9).contains(i))
+                    && let Some(name) = r.hub.presets.names().get(i - 1).cloned()
+                {
+                    let seconds = f64::from(r.overlay.morph_seconds);
+                    let scene = r.instance.scene().clone();
+                    r.ui_events.extend(r.hub.recall(&name, seconds, &scene));
+                }
+            }
             WindowEvent::RedrawRequested => {
                 r.frame();
                 r.window.request_redraw();
@@ -200,7 +250,10 @@ impl Running {
         let now = Instant::now();
         let steps = self.clock.accumulate((now - self.last).as_secs_f64());
         self.last = now;
-        let events = std::mem::take(&mut self.ui_events);
+        self.reload();
+        let mut events = std::mem::take(&mut self.ui_events);
+        events.extend(self.hub.poll(&self.instance, self.last_time.seconds));
+        self.hub.record(self.clock.now().frame, &events, self.instance.scene());
         self.instance.apply(&events);
         for _ in 0..steps {
             let now = self.clock.now();
@@ -246,6 +299,30 @@ impl Running {
         self.runtime.after_submit();
         self.window.pre_present_notify();
         self.gpu.queue.present(frame);
+        self.hub.after_frame(&self.instance);
+        for n in std::mem::take(&mut self.hub.notices) {
+            self.overlay.report(n);
+        }
+    }
+
+    /// Applies edited shader and scene files; errors go to the overlay, once each.
+    fn reload(&mut self) {
+        let Some(live) = self.live.as_mut() else { return };
+        let size = (self.config.width, self.config.height);
+        let report = live.poll(&mut self.instance, &self.gpu, size);
+        for e in report.errors {
+            self.overlay.report(e);
+        }
+        for f in &report.applied {
+            log::info!("reloaded {f}");
+        }
+        if !report.fixed.is_empty() {
+            self.overlay.clear_errors();
+        }
+        if report.scene_changed {
+            self.hub.set_scene(self.instance.scene());
+            self.window.set_title(&format!("indra — {}", self.instance.scene().name));
+        }
     }
 
     /// Runs the egui frame and records its draw on top of the scene.
@@ -259,7 +336,8 @@ impl Running {
         let ctx = self.egui_state.egui_ctx().clone();
         let (instance, overlay, clock) = (&mut self.instance, &mut self.overlay, &self.clock);
         let mut events = Vec::new();
-        let mut output = ctx.run_ui(input, |ui| events = draw_ui(ui, instance, overlay, clock.now()));
+        let hub = &mut self.hub;
+        let mut output = ctx.run_ui(input, |ui| events = draw_ui(ui, instance, overlay, hub, clock.now()));
         self.ui_events.extend(events);
         self.egui_state.handle_platform_output(&self.window, output.platform_output);
         let primitives = ctx.tessellate(output.shapes, output.pixels_per_point);

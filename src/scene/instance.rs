@@ -150,6 +150,78 @@ impl SceneInstance {
         }
     }
 
+    /// Recreates every node whose technique loads shader file `name` (after an edit). Either all
+    /// of them build and are swapped in, or none is and the error is returned. Returns whether
+    /// any node uses the shader. (Stateless techniques lose nothing; stateful ones restart.)
+    pub fn rebuild_nodes_using(
+        &mut self,
+        name: &str,
+        gpu: &Gpu,
+        assets: &Assets,
+        output_size: (u32, u32),
+    ) -> Result<bool, ShaderError> {
+        let using: Vec<usize> =
+            (0..self.nodes.len()).filter(|&i| self.scene.nodes[i].technique.shaders.contains(&name)).collect();
+        let rebuilt = using
+            .iter()
+            .map(|&i| {
+                let n = &self.scene.nodes[i];
+                (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        for (i, node) in using.iter().zip(rebuilt) {
+            self.nodes[*i] = node;
+        }
+        Ok(!using.is_empty())
+    }
+
+    /// Switches to an edited version of the scene. Nodes whose id and technique are unchanged
+    /// keep their instance (and simulation state); parameters keep their live values unless the
+    /// file changed their default; new nodes are created. If any new node fails to build, the
+    /// running scene stays as it was.
+    pub fn replace_scene(
+        &mut self,
+        scene: Scene,
+        gpu: &Gpu,
+        assets: &Assets,
+        output_size: (u32, u32),
+    ) -> Result<(), ShaderError> {
+        let kept = |n: &super::SceneNode| {
+            self.scene.nodes.iter().position(|o| o.id == n.id && o.technique.name == n.technique.name)
+        };
+        let mut fresh: Vec<Option<Box<dyn Technique>>> = Vec::with_capacity(scene.nodes.len());
+        for n in &scene.nodes {
+            fresh.push(match kept(n) {
+                Some(_) => None,
+                None => Some((n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size })?),
+            });
+        }
+        let mut old_nodes: Vec<Option<Box<dyn Technique>>> = self.nodes.drain(..).map(Some).collect();
+        let mut params = Vec::with_capacity(scene.nodes.len());
+        for (n, new) in scene.nodes.iter().zip(fresh.iter_mut()) {
+            let mut set = n.params.clone();
+            if let Some(old) = kept(n) {
+                let (old_decls, old_set) = (&self.scene.nodes[old].params, &self.params[old]);
+                for (p, decl) in set.decls().to_vec().iter().enumerate() {
+                    let Some(op) = old_decls.index(&decl.name) else { continue };
+                    let unchanged = old_decls.decls()[op].default == decl.default;
+                    if unchanged && old_set.decls()[op].ty() == decl.ty() {
+                        set.set_at(p, old_set.target_at(op));
+                    }
+                }
+                set.snap();
+                *new = old_nodes[old].take();
+            }
+            params.push(set);
+        }
+        self.nodes = fresh.into_iter().map(|n| n.expect("every node kept or created")).collect();
+        self.params = params;
+        self.scene = scene;
+        self.overridden.clear();
+        self.morph = None;
+        Ok(())
+    }
+
     /// Declares this frame: every node adds its passes, the output node's texture is the output.
     pub fn build_graph(&mut self, output_size: (u32, u32), time: &FrameTime) -> FrameGraph<'_> {
         let mut graph = FrameGraph::new(output_size);

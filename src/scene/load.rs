@@ -450,16 +450,35 @@ fn component_index(c: &str, ty: ParamType) -> Option<usize> {
     (ty.components() > 1 && i < ty.components()).then_some(i)
 }
 
+/// A value as a file, preset or recording writes it for `decl` (enums by option name).
+pub fn raw_from_value(value: &ParamValue, decl: &ParamDecl) -> RawValue {
+    match value {
+        ParamValue::Bool(b) | ParamValue::Trigger(b) => RawValue::Bool(*b),
+        ParamValue::Enum(i) => RawValue::Text(decl.options.get(*i as usize).cloned().unwrap_or_default()),
+        ParamValue::Float(x) => RawValue::Number(f64::from(*x)),
+        ParamValue::Int(i) => RawValue::Number(f64::from(*i)),
+        other => RawValue::List(other.components().iter().map(|&c| f64::from(c)).collect()),
+    }
+}
+
+/// A file, preset or recording value as a value of `decl`'s type, if it fits.
+pub fn value_from_raw(raw: &RawValue, decl: &ParamDecl) -> Option<ParamValue> {
+    coerce(raw, decl.ty(), &decl.options)
+}
+
 /// A file value as a typed value: bools only for bool parameters, option names (or indices)
 /// for enums, numbers for the rest.
 fn coerce(raw: &RawValue, ty: ParamType, options: &[String]) -> Option<ParamValue> {
     match (raw, ty) {
         (RawValue::Bool(b), ParamType::Bool) => Some(ParamValue::Bool(*b)),
+        (RawValue::Bool(b), ParamType::Trigger) => Some(ParamValue::Trigger(*b)),
         (RawValue::Text(name), ParamType::Enum) => {
             options.iter().position(|o| o.eq_ignore_ascii_case(name)).map(|i| ParamValue::Enum(i as u32))
         }
         (RawValue::Number(i), ParamType::Enum) if (*i as usize) < options.len() => ty.value_from(&[*i]),
-        (RawValue::Bool(_) | RawValue::Text(_), _) | (_, ParamType::Bool | ParamType::Enum) => None,
+        (RawValue::Bool(_) | RawValue::Text(_), _) | (_, ParamType::Bool | ParamType::Enum | ParamType::Trigger) => {
+            None
+        }
         (raw, ty) => ty.value_from(&raw.numbers()),
     }
 }

@@ -8,5 +8,8 @@ mod schema;
 
 pub use error::{SceneError, SceneErrors};
 pub use instance::{ControlEvent, SceneInstance};
-pub use load::{BoundTrack, Scene, SceneNode, Target, load_scene, parse_scene, parse_value_override, resolve_target};
+pub use load::{
+    BoundTrack, Scene, SceneNode, Target, load_scene, parse_scene, parse_value_override, raw_from_value,
+    resolve_target, value_from_raw,
+};
 pub use schema::{ControlsFile, MidiCurve, MidiMapping, NodeFile, RawValue, SceneFile, TrackFile};

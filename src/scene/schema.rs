@@ -156,7 +156,7 @@ pub struct TrackFile {
 }
 
 /// A value as written in a file, before the declared type gives it meaning.
-#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, serde::Serialize)]
 #[serde(untagged)]
 pub enum RawValue {
     /// `true` / `false`.

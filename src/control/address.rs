@@ -1,0 +1,85 @@
+//! Where an OSC address leads: a parameter (or one component of it) or an engine command.
+//! Every parameter answers at `/indra/<node>/<param>`, vector components at
+//! `/indra/<node>/<param>/<x|y|z|w>` (colours also `r g b a`), plus the scene's aliases.
+
+use std::collections::HashMap;
+
+use crate::params::ParamType;
+use crate::scene::{Scene, Target};
+
+/// Engine commands with fixed addresses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Command {
+    /// `/indra/preset/recall s [f]`: recall preset `s`, morphing over `f` seconds.
+    PresetRecall,
+    /// `/indra/preset/save s`: save the current values as preset `s`.
+    PresetSave,
+    /// `/indra/resume`: give taken-over parameters back to their tracks.
+    Resume,
+}
+
+/// What an address resolves to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Route {
+    /// A parameter or component.
+    Param(Target),
+    /// An engine command.
+    Command(Command),
+}
+
+/// The address tree of one scene.
+#[derive(Clone, Debug, Default)]
+pub struct AddressMap {
+    routes: HashMap<String, Route>,
+}
+
+impl AddressMap {
+    /// Every default address of `scene`, its aliases and the engine commands.
+    pub fn new(scene: &Scene) -> Self {
+        let mut routes = HashMap::new();
+        for (n, node) in scene.nodes.iter().enumerate() {
+            for (p, decl) in node.params.decls().iter().enumerate() {
+                let base = param_address(&node.id, &decl.name);
+                routes.insert(base.clone(), Route::Param(Target { node: n, param: p, component: None }));
+                let names: &[&str] = match decl.ty() {
+                    ParamType::Color => &["r", "g", "b", "a"],
+                    ty if ty.components() > 1 => &["x", "y", "z", "w"],
+                    _ => &[],
+                };
+                for (c, name) in names.iter().enumerate().take(decl.ty().components()) {
+                    routes.insert(
+                        format!("{base}/{name}"),
+                        Route::Param(Target { node: n, param: p, component: Some(c) }),
+                    );
+                }
+            }
+        }
+        for (address, target) in &scene.osc_aliases {
+            routes.insert(address.clone(), Route::Param(*target));
+        }
+        routes.insert("/indra/preset/recall".into(), Route::Command(Command::PresetRecall));
+        routes.insert("/indra/preset/save".into(), Route::Command(Command::PresetSave));
+        routes.insert("/indra/resume".into(), Route::Command(Command::Resume));
+        Self { routes }
+    }
+
+    /// The route of `address`, if any.
+    pub fn route(&self, address: &str) -> Option<Route> {
+        self.routes.get(address).copied()
+    }
+
+    /// Number of addresses.
+    pub fn len(&self) -> usize {
+        self.routes.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.routes.is_empty()
+    }
+}
+
+/// `/indra/<node>/<param>`.
+pub fn param_address(node: &str, param: &str) -> String {
+    format!("/indra/{node}/{param}")
+}

@@ -1,0 +1,65 @@
+//! OSC out: after each frame, every parameter whose value changed (from any source — UI, MIDI,
+//! tracks, presets) is sent to the controller, so its faders follow.
+
+use std::collections::HashMap;
+use std::net::{SocketAddr, ToSocketAddrs, UdpSocket};
+
+use rosc::{OscMessage, OscPacket, OscType};
+
+use super::address::param_address;
+use crate::params::ParamValue;
+use crate::scene::SceneInstance;
+
+/// Sends parameter changes to one OSC destination.
+pub struct OscFeedback {
+    socket: UdpSocket,
+    target: SocketAddr,
+    last: HashMap<(usize, usize), ParamValue>,
+}
+
+impl OscFeedback {
+    /// Sends to `target` (`host:port`).
+    pub fn connect(target: &str) -> Result<Self, String> {
+        let target = target
+            .to_socket_addrs()
+            .map_err(|e| format!("cannot resolve OSC output {target}: {e}"))?
+            .next()
+            .ok_or_else(|| format!("OSC output {target} resolves to no address"))?;
+        let bind = if target.is_ipv4() { "0.0.0.0:0" } else { "[::]:0" };
+        let socket = UdpSocket::bind(bind).map_err(|e| format!("cannot open a UDP socket for OSC output: {e}"))?;
+        Ok(Self { socket, target, last: HashMap::new() })
+    }
+
+    /// Forgets what was sent (after a scene change: everything is sent again).
+    pub fn reset(&mut self) {
+        self.last.clear();
+    }
+
+    /// Sends every parameter whose value differs from the last one sent; returns how many.
+    pub fn send_changes(&mut self, instance: &SceneInstance) -> usize {
+        let mut sent = 0;
+        for (n, node) in instance.scene().nodes.iter().enumerate() {
+            let params = instance.params(n);
+            for (p, decl) in params.decls().iter().enumerate() {
+                let value = params.target_at(p);
+                if matches!(value, ParamValue::Trigger(_)) || self.last.get(&(n, p)) == Some(&value) {
+                    continue;
+                }
+                let args = match value {
+                    ParamValue::Int(i) => vec![OscType::Int(i)],
+                    ParamValue::Bool(b) => vec![OscType::Bool(b)],
+                    ParamValue::Enum(i) => vec![OscType::String(decl.format(&ParamValue::Enum(i)))],
+                    other => other.components().into_iter().map(OscType::Float).collect(),
+                };
+                let packet = OscPacket::Message(OscMessage { addr: param_address(&node.id, &decl.name), args });
+                if let Ok(bytes) = rosc::encoder::encode(&packet)
+                    && self.socket.send_to(&bytes, self.target).is_ok()
+                {
+                    sent += 1;
+                }
+                self.last.insert((n, p), value);
+            }
+        }
+        sent
+    }
+}

@@ -1,0 +1,258 @@
+//! Everything live control needs for one running scene, polled once per frame: OSC and MIDI
+//! in, presets, OSC feedback out, the OSCQuery tree, and the control-stream recorder. A source
+//! that cannot start (port in use, no MIDI system) is reported once and the show goes on.
+
+use std::path::PathBuf;
+use std::time::SystemTime;
+
+use super::feedback::OscFeedback;
+use super::midi::{LearnStore, MidiInput, MidiMapper, MidiParser};
+use super::osc::{OscReceiver, OscRouter, Routed};
+use super::oscquery::OscQueryServer;
+use super::presets::PresetStore;
+use super::record::Recorder;
+use crate::scene::{ControlEvent, Scene, SceneInstance, Target};
+
+/// Which control sources to open.
+#[derive(Clone, Debug)]
+pub struct ControlOptions {
+    /// OSC listen address (`None`: no OSC input).
+    pub osc: Option<String>,
+    /// OSC feedback destination `host:port`.
+    pub osc_out: Option<String>,
+    /// OSCQuery HTTP listen address.
+    pub oscquery: Option<String>,
+    /// Open MIDI inputs.
+    pub midi: bool,
+    /// Only MIDI ports whose name contains this.
+    pub midi_filter: Option<String>,
+    /// Record the control stream to this file.
+    pub record: Option<PathBuf>,
+    /// Folder of presets.
+    pub presets_dir: PathBuf,
+    /// File of learned MIDI mappings.
+    pub learn_file: PathBuf,
+}
+
+impl Default for ControlOptions {
+    fn default() -> Self {
+        Self {
+            osc: Some("127.0.0.1:9000".into()),
+            osc_out: None,
+            oscquery: None,
+            midi: true,
+            midi_filter: None,
+            record: None,
+            presets_dir: "presets".into(),
+            learn_file: "midi-learn.ron".into(),
+        }
+    }
+}
+
+/// The live control of one running scene.
+pub struct ControlHub {
+    /// OSC input, if open.
+    pub osc: Option<OscReceiver>,
+    router: OscRouter,
+    feedback: Option<OscFeedback>,
+    /// OSCQuery server, if open.
+    pub oscquery: Option<OscQueryServer>,
+    midi: Option<MidiInput>,
+    parser: MidiParser,
+    /// MIDI mappings, learn state and clock.
+    pub mapper: MidiMapper,
+    learn: LearnStore,
+    /// The preset folder.
+    pub presets: PresetStore,
+    recorder: Option<Recorder>,
+    /// Things to tell the performer (shown in the overlay, logged once there).
+    pub notices: Vec<String>,
+    frame_count: u64,
+}
+
+impl ControlHub {
+    /// Opens what `options` asks for against `scene`.
+    pub fn start(options: &ControlOptions, scene: &Scene) -> Self {
+        let mut notices = Vec::new();
+        let mut report = |r: Result<(), String>| {
+            if let Err(e) = r {
+                log::warn!("{e}");
+                notices.push(e);
+            }
+        };
+        let osc = options.osc.as_deref().and_then(|a| OscReceiver::bind(a).map_err(|e| report(Err(e))).ok());
+        let feedback =
+            options.osc_out.as_deref().and_then(|a| OscFeedback::connect(a).map_err(|e| report(Err(e))).ok());
+        let osc_port = osc.as_ref().map_or(0, |o| o.local_addr().port());
+        let oscquery = options
+            .oscquery
+            .as_deref()
+            .and_then(|a| OscQueryServer::start(a, osc_port).map_err(|e| report(Err(e))).ok());
+        let midi = if options.midi {
+            MidiInput::open(options.midi_filter.as_deref()).map_err(|e| log::info!("{e}")).ok()
+        } else {
+            None
+        };
+        let recorder = options.record.as_deref().and_then(|p| Recorder::create(p).map_err(|e| report(Err(e))).ok());
+        let learn = LearnStore { path: options.learn_file.clone() };
+        let mapper = MidiMapper::new(scene, &learn.load());
+        Self {
+            osc,
+            router: OscRouter::new(scene),
+            feedback,
+            oscquery,
+            midi,
+            parser: MidiParser::default(),
+            mapper,
+            learn,
+            presets: PresetStore { dir: options.presets_dir.clone() },
+            recorder,
+            notices,
+            frame_count: 0,
+        }
+    }
+
+    /// Rebuilds address and MIDI maps after the scene changed (learned mappings stay).
+    pub fn set_scene(&mut self, scene: &Scene) {
+        self.router = OscRouter::new(scene);
+        let learning = self.mapper.learning.take();
+        self.mapper = MidiMapper::new(scene, &self.learn.load());
+        self.mapper.learning = learning.filter(|t| t.node < scene.nodes.len());
+        if let Some(f) = self.feedback.as_mut() {
+            f.reset();
+        }
+    }
+
+    /// Everything that arrived since the last frame, as control events, in arrival order per
+    /// source (OSC before MIDI). `seconds` is the clock time (for MIDI tempo and morphs).
+    pub fn poll(&mut self, instance: &SceneInstance, seconds: f64) -> Vec<ControlEvent> {
+        let mut events = Vec::new();
+        let scene = instance.scene();
+        let batches = self.osc.as_mut().map(|o| o.drain(SystemTime::now())).unwrap_or_default();
+        for batch in batches {
+            for msg in &batch.messages {
+                let Some(osc) = self.osc.as_ref() else { break };
+                match self.router.route(msg, scene, osc) {
+                    Some(Routed::Event(e)) => events.push(e),
+                    Some(Routed::SavePreset(name)) => self.save_preset(&name, instance),
+                    Some(Routed::RecallPreset(name, s)) => events.extend(self.recall(&name, s, scene)),
+                    None => {}
+                }
+            }
+        }
+        let messages = self.midi.as_ref().map(MidiInput::drain).unwrap_or_default();
+        for bytes in messages {
+            events.extend(self.midi_bytes(&bytes, scene, seconds));
+        }
+        events
+    }
+
+    /// Feeds raw MIDI bytes (from a port, or a test) through the parser and mappings.
+    pub fn midi_bytes(&mut self, bytes: &[u8], scene: &Scene, seconds: f64) -> Vec<ControlEvent> {
+        let mut events = Vec::new();
+        let was_learning = self.mapper.learning.is_some();
+        for e in self.parser.feed(bytes) {
+            let (writes, program) = self.mapper.handle(e, scene, seconds);
+            events.extend(writes.into_iter().map(ControlEvent::Write));
+            if let Some(p) = program
+                && let Some(name) = self.presets.names().get(usize::from(p)).cloned()
+            {
+                events.extend(self.recall(&name, 0.0, scene));
+            }
+        }
+        if was_learning && self.mapper.learning.is_none() {
+            self.persist_learned(scene);
+        }
+        events
+    }
+
+    /// The event that recalls preset `name` over `seconds`, or nothing (with a notice).
+    pub fn recall(&mut self, name: &str, seconds: f64, scene: &Scene) -> Option<ControlEvent> {
+        match self.presets.load(name, scene) {
+            Ok((values, warnings)) => {
+                for w in warnings {
+                    self.notice(w);
+                }
+                Some(ControlEvent::Morph { values, seconds })
+            }
+            Err(e) => {
+                self.notice(e);
+                None
+            }
+        }
+    }
+
+    /// Saves the current values as preset `name`.
+    pub fn save_preset(&mut self, name: &str, instance: &SceneInstance) {
+        match self.presets.save(name, instance) {
+            Ok(path) => log::info!("saved preset {}", path.display()),
+            Err(e) => self.notice(e),
+        }
+    }
+
+    /// Starts MIDI learn for `target`: the next control moved is bound to it.
+    pub fn learn(&mut self, target: Target) {
+        self.mapper.learning = Some(target);
+    }
+
+    /// Removes a parameter's MIDI bindings and saves the learn file.
+    pub fn unlearn(&mut self, node: usize, param: usize, scene: &Scene) {
+        self.mapper.unlearn(node, param);
+        self.persist_learned(scene);
+    }
+
+    fn persist_learned(&mut self, scene: &Scene) {
+        if let Err(e) = self.learn.save(&self.mapper, scene) {
+            self.notice(e);
+        }
+    }
+
+    /// Writes the events applied before `frame` to the recording, if one is open.
+    pub fn record(&mut self, frame: u64, events: &[ControlEvent], scene: &Scene) {
+        if let Some(r) = self.recorder.as_mut()
+            && let Err(e) = r.record(frame, events, scene)
+        {
+            self.recorder = None;
+            self.notice(format!("recording stopped: {e}"));
+        }
+    }
+
+    /// After a frame: sends changed values to the OSC feedback target and refreshes the OSCQuery
+    /// tree (every 6th frame: clients poll far slower than that).
+    pub fn after_frame(&mut self, instance: &SceneInstance) {
+        if let Some(f) = self.feedback.as_mut() {
+            f.send_changes(instance);
+        }
+        if let Some(q) = self.oscquery.as_ref()
+            && self.frame_count.is_multiple_of(6)
+        {
+            q.publish(instance);
+        }
+        self.frame_count += 1;
+    }
+
+    /// One line of input counters for the overlay.
+    pub fn status(&self) -> String {
+        let mut parts = Vec::new();
+        if let Some(o) = &self.osc {
+            let [packets, _, malformed, unknown, bad, applied] = o.counters().snapshot();
+            parts.push(format!(
+                "OSC {}: {packets} packets, {applied} applied, {malformed} malformed, {unknown} unknown address, {bad} bad args",
+                o.local_addr()
+            ));
+        }
+        match &self.midi {
+            Some(m) if !m.ports.is_empty() => parts.push(format!("MIDI: {}", m.ports.join(", "))),
+            _ => parts.push("MIDI: none".into()),
+        }
+        if let Some(bpm) = self.mapper.clock.bpm() {
+            parts.push(format!("clock {bpm:.1} BPM{}", if self.mapper.clock.playing { " ▶" } else { "" }));
+        }
+        parts.join(" · ")
+    }
+
+    fn notice(&mut self, message: String) {
+        log::warn!("{message}");
+        self.notices.push(message);
+    }
+}

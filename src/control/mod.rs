@@ -1,0 +1,17 @@
+//! Live control: OSC in and out (with OSCQuery discovery), MIDI with learn, presets, and the
+//! recording and replay of control streams. Everything becomes [`ControlEvent`]s that the
+//! running scene applies before its next fixed step. Knows nothing of rendering.
+//!
+//! [`ControlEvent`]: crate::scene::ControlEvent
+
+pub mod address;
+pub mod feedback;
+pub mod hub;
+pub mod midi;
+pub mod osc;
+pub mod oscquery;
+pub mod presets;
+pub mod record;
+
+pub use address::{AddressMap, Route};
+pub use hub::{ControlHub, ControlOptions};

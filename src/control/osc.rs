@@ -1,0 +1,303 @@
+//! OSC input: a UDP receiver on its own thread decodes packets (rosc) into batches — a bundle is
+//! one batch, applied in one frame — that the render loop drains once per frame without ever
+//! blocking. Bundles time-tagged in the future wait until due. Malformed packets, unknown
+//! addresses and wrong arguments are counted and logged once per kind, never a panic.
+
+use std::collections::HashSet;
+use std::net::{SocketAddr, UdpSocket};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, SystemTime};
+
+use rosc::{OscMessage, OscPacket, OscType};
+
+use super::address::{AddressMap, Command, Route};
+use crate::params::{ParamDecl, ParamType, ParamValue, ParamWrite, Source};
+use crate::scene::{ControlEvent, Scene};
+
+/// What went in and what was rejected, shared between the receiver thread and the render loop.
+#[derive(Debug, Default)]
+pub struct OscCounters {
+    /// UDP packets received.
+    pub packets: AtomicU64,
+    /// Messages decoded (inside bundles too).
+    pub messages: AtomicU64,
+    /// Packets that did not decode.
+    pub malformed: AtomicU64,
+    /// Messages to addresses nothing answers to.
+    pub unknown_address: AtomicU64,
+    /// Messages whose arguments do not fit the parameter.
+    pub bad_arguments: AtomicU64,
+    /// Messages applied to parameters or commands.
+    pub applied: AtomicU64,
+}
+
+impl OscCounters {
+    /// (packets, messages, malformed, unknown address, bad arguments, applied).
+    pub fn snapshot(&self) -> [u64; 6] {
+        [&self.packets, &self.messages, &self.malformed, &self.unknown_address, &self.bad_arguments, &self.applied]
+            .map(|c| c.load(Ordering::Relaxed))
+    }
+}
+
+/// Messages that apply together, at `due` (None: at once).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Batch {
+    /// When to apply (a future bundle time tag), if not immediately.
+    pub due: Option<SystemTime>,
+    /// The messages, in packet order.
+    pub messages: Vec<OscMessage>,
+}
+
+/// Decodes one UDP payload into batches: a message is a batch; a bundle (with nested bundles
+/// flattened under the outermost time tag that is in the future) is one batch.
+pub fn decode(bytes: &[u8]) -> Result<Vec<Batch>, String> {
+    let (rest, packet) = rosc::decoder::decode_udp(bytes).map_err(|e| format!("{e:?}"))?;
+    if !rest.is_empty() {
+        return Err(format!("{} trailing bytes after the packet", rest.len()));
+    }
+    let mut batch = Batch { due: None, messages: Vec::new() };
+    flatten(packet, &mut batch);
+    Ok(vec![batch])
+}
+
+fn flatten(packet: OscPacket, batch: &mut Batch) {
+    match packet {
+        OscPacket::Message(m) => batch.messages.push(m),
+        OscPacket::Bundle(b) => {
+            // (0, 1) means "immediately"; anything else is an absolute NTP time.
+            let immediate = b.timetag.seconds == 0 && b.timetag.fractional == 1;
+            if !immediate && batch.due.is_none() {
+                batch.due = Some(SystemTime::from(b.timetag));
+            }
+            for p in b.content {
+                flatten(p, batch);
+            }
+        }
+    }
+}
+
+/// The UDP receiver thread and the queue it fills.
+pub struct OscReceiver {
+    local: SocketAddr,
+    queue: Receiver<Batch>,
+    counters: Arc<OscCounters>,
+    scheduled: Vec<Batch>,
+    stop: Arc<AtomicBool>,
+    thread: Option<JoinHandle<()>>,
+    logged: Arc<Mutex<HashSet<String>>>,
+}
+
+impl OscReceiver {
+    /// Binds `addr` (e.g. `127.0.0.1:9000`; port 0 picks a free one) and starts receiving.
+    pub fn bind(addr: &str) -> Result<Self, String> {
+        let socket = UdpSocket::bind(addr).map_err(|e| format!("cannot listen for OSC on {addr}: {e}"))?;
+        socket.set_read_timeout(Some(Duration::from_millis(50))).map_err(|e| e.to_string())?;
+        let local = socket.local_addr().map_err(|e| e.to_string())?;
+        let (tx, queue) = channel();
+        let counters = Arc::new(OscCounters::default());
+        let stop = Arc::new(AtomicBool::new(false));
+        let logged = Arc::new(Mutex::new(HashSet::new()));
+        let thread = {
+            let (counters, stop, logged) = (counters.clone(), stop.clone(), logged.clone());
+            std::thread::Builder::new()
+                .name("indra-osc".into())
+                .spawn(move || receive_loop(&socket, &tx, &counters, &stop, &logged))
+                .map_err(|e| e.to_string())?
+        };
+        log::info!("OSC listening on {local}");
+        Ok(Self { local, queue, counters, scheduled: Vec::new(), stop, thread: Some(thread), logged })
+    }
+
+    /// The bound address (useful with port 0).
+    pub fn local_addr(&self) -> SocketAddr {
+        self.local
+    }
+
+    /// The shared counters.
+    pub fn counters(&self) -> &Arc<OscCounters> {
+        &self.counters
+    }
+
+    /// Every batch that is due at `now`, in arrival order; later ones wait.
+    pub fn drain(&mut self, now: SystemTime) -> Vec<Batch> {
+        self.scheduled.extend(self.queue.try_iter());
+        let (due, later): (Vec<Batch>, Vec<Batch>) =
+            self.scheduled.drain(..).partition(|b| b.due.is_none_or(|t| t <= now));
+        self.scheduled = later;
+        due
+    }
+
+    /// Logs `message` the first time its `kind` is seen.
+    pub fn log_once(&self, kind: &str, message: &str) {
+        log_once(&self.logged, kind, message);
+    }
+}
+
+impl Drop for OscReceiver {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+fn log_once(logged: &Mutex<HashSet<String>>, kind: &str, message: &str) {
+    if let Ok(mut seen) = logged.lock()
+        && seen.insert(kind.to_string())
+    {
+        log::warn!("OSC: {message} (further ones are only counted)");
+    }
+}
+
+fn receive_loop(
+    socket: &UdpSocket,
+    tx: &Sender<Batch>,
+    counters: &OscCounters,
+    stop: &AtomicBool,
+    logged: &Mutex<HashSet<String>>,
+) {
+    let mut buf = vec![0u8; 65536];
+    while !stop.load(Ordering::Relaxed) {
+        let Ok((len, from)) = socket.recv_from(&mut buf) else { continue };
+        counters.packets.fetch_add(1, Ordering::Relaxed);
+        match decode(&buf[..len]) {
+            Ok(batches) => {
+                for batch in batches {
+                    counters.messages.fetch_add(batch.messages.len() as u64, Ordering::Relaxed);
+                    // Stats are answered here, so a client can ask even while frames are slow.
+                    if batch.messages.iter().any(|m| m.addr == "/indra/stats") {
+                        reply_stats(socket, from, counters);
+                    }
+                    if tx.send(batch).is_err() {
+                        return;
+                    }
+                }
+            }
+            Err(e) => {
+                counters.malformed.fetch_add(1, Ordering::Relaxed);
+                log_once(logged, "malformed", &format!("malformed packet from {from}: {e}"));
+            }
+        }
+    }
+}
+
+fn reply_stats(socket: &UdpSocket, to: SocketAddr, counters: &OscCounters) {
+    let args = counters.snapshot().iter().map(|&c| OscType::Long(c as i64)).collect();
+    let packet = OscPacket::Message(OscMessage { addr: "/indra/stats".into(), args });
+    if let Ok(bytes) = rosc::encoder::encode(&packet) {
+        let _ = socket.send_to(&bytes, to);
+    }
+}
+
+/// An OSC message turned into what it asks for.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Routed {
+    /// Apply to the scene.
+    Event(ControlEvent),
+    /// Save a preset under this name.
+    SavePreset(String),
+    /// Recall a preset, morphing over `seconds`.
+    RecallPreset(String, f64),
+}
+
+/// Translates messages into control events against one scene's address map.
+pub struct OscRouter {
+    map: AddressMap,
+}
+
+impl OscRouter {
+    /// A router for `scene`.
+    pub fn new(scene: &Scene) -> Self {
+        Self { map: AddressMap::new(scene) }
+    }
+
+    /// Routes one message; rejected ones bump a counter and are logged once per kind.
+    pub fn route(&self, msg: &OscMessage, scene: &Scene, rx: &OscReceiver) -> Option<Routed> {
+        let counters = rx.counters();
+        if msg.addr == "/indra/stats" {
+            return None;
+        }
+        let Some(route) = self.map.route(&msg.addr) else {
+            counters.unknown_address.fetch_add(1, Ordering::Relaxed);
+            rx.log_once(&format!("unknown {}", msg.addr), &format!("no parameter answers to {}", msg.addr));
+            return None;
+        };
+        let routed = match route {
+            Route::Command(command) => route_command(command, &msg.args),
+            Route::Param(t) => {
+                let decl = &scene.nodes[t.node].params.decls()[t.param];
+                let value = match t.component {
+                    Some(_) => numbers(&msg.args).filter(|n| n.len() == 1).map(|n| ParamValue::Float(n[0] as f32)),
+                    None => coerce_args(&msg.args, decl),
+                };
+                value.map(|value| {
+                    let write =
+                        ParamWrite { node: t.node, param: t.param, component: t.component, value, source: Source::Osc };
+                    Routed::Event(ControlEvent::Write(write))
+                })
+            }
+        };
+        match &routed {
+            Some(_) => counters.applied.fetch_add(1, Ordering::Relaxed),
+            None => {
+                rx.log_once(
+                    &format!("args {}", msg.addr),
+                    &format!("{} does not take the arguments {:?}", msg.addr, msg.args),
+                );
+                counters.bad_arguments.fetch_add(1, Ordering::Relaxed)
+            }
+        };
+        routed
+    }
+}
+
+fn route_command(command: Command, args: &[OscType]) -> Option<Routed> {
+    let name = match args.first() {
+        Some(OscType::String(s)) => Some(s.clone()),
+        _ => None,
+    };
+    let seconds = numbers(&args[args.len().min(1)..]).and_then(|n| n.first().copied()).unwrap_or(0.0);
+    match command {
+        Command::Resume => Some(Routed::Event(ControlEvent::ResumeTracks)),
+        Command::PresetSave => name.map(Routed::SavePreset),
+        Command::PresetRecall => name.map(|n| Routed::RecallPreset(n, seconds.max(0.0))),
+    }
+}
+
+/// Numeric arguments as f64 (f, d, i, h, T/F); `None` if any is not numeric.
+fn numbers(args: &[OscType]) -> Option<Vec<f64>> {
+    args.iter()
+        .map(|a| match a {
+            OscType::Float(x) => Some(f64::from(*x)),
+            OscType::Double(x) => Some(*x),
+            OscType::Int(i) => Some(f64::from(*i)),
+            OscType::Long(i) => Some(*i as f64),
+            OscType::Bool(b) => Some(if *b { 1.0 } else { 0.0 }),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Arguments as a value of `decl`'s type: N numbers for N components (colours 3 or 4), a
+/// string or index for enums, T/F or 0/1 for bools, anything for triggers. Ranges clamp later.
+pub fn coerce_args(args: &[OscType], decl: &ParamDecl) -> Option<ParamValue> {
+    match decl.ty() {
+        ParamType::Trigger => match numbers(args) {
+            Some(n) if n.len() == 1 && n[0] == 0.0 => None,
+            _ => Some(ParamValue::Trigger(true)),
+        },
+        ParamType::Enum => match args {
+            [OscType::String(name)] => decl.option_index(name).map(ParamValue::Enum),
+            _ => numbers(args)
+                .filter(|n| n.len() == 1 && n[0] >= 0.0 && (n[0] as usize) < decl.options.len())
+                .map(|n| ParamValue::Enum(n[0] as u32)),
+        },
+        ParamType::Bool => numbers(args).filter(|n| n.len() == 1).map(|n| ParamValue::Bool(n[0] != 0.0)),
+        ParamType::Int => numbers(args).filter(|n| n.len() == 1).map(|n| ParamValue::Int(n[0].round() as i32)),
+        ty => numbers(args).and_then(|n| ty.value_from(&n)),
+    }
+}

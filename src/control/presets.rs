@@ -1,0 +1,105 @@
+//! Presets: the current value of every parameter saved as `presets/<name>.ron`, recalled at once
+//! or morphed over seconds (numbers glide, bools and enums switch at the end).
+//!
+//! ```ron
+//! (scene: "Kleinian limit set", values: { "limit_set": { "scale": 1.9, "t": [1.94, 0.02] } })
+//! ```
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use crate::params::{ParamType, ParamValue};
+use crate::scene::{RawValue, Scene, SceneInstance, raw_from_value, value_from_raw};
+
+/// A preset file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PresetFile {
+    /// The scene it was saved from (informational).
+    #[serde(default)]
+    pub scene: String,
+    /// node id → parameter → value.
+    pub values: BTreeMap<String, BTreeMap<String, RawValue>>,
+}
+
+/// The folder of presets.
+#[derive(Clone, Debug)]
+pub struct PresetStore {
+    /// Where the files live.
+    pub dir: PathBuf,
+}
+
+impl PresetStore {
+    /// Saves every parameter's current target as `<name>.ron`; returns the path.
+    pub fn save(&self, name: &str, instance: &SceneInstance) -> Result<PathBuf, String> {
+        check_name(name)?;
+        let mut values = BTreeMap::new();
+        for (n, node) in instance.scene().nodes.iter().enumerate() {
+            let params = instance.params(n);
+            let entries = params
+                .decls()
+                .iter()
+                .enumerate()
+                .filter(|(_, d)| d.ty() != ParamType::Trigger)
+                .map(|(p, d)| (d.name.clone(), raw_from_value(&params.target_at(p), d)))
+                .collect();
+            values.insert(node.id.clone(), entries);
+        }
+        let file = PresetFile { scene: instance.scene().name.clone(), values };
+        let text = ron::ser::to_string_pretty(&file, Default::default()).map_err(|e| e.to_string())?;
+        std::fs::create_dir_all(&self.dir).map_err(|e| format!("cannot create {}: {e}", self.dir.display()))?;
+        let path = self.dir.join(format!("{name}.ron"));
+        std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        Ok(path)
+    }
+
+    /// The values of preset `name` for `scene`. Nodes or parameters the scene no longer has, and
+    /// values that no longer fit, are skipped and named in the returned warnings.
+    pub fn load(&self, name: &str, scene: &Scene) -> Result<(Vec<(usize, usize, ParamValue)>, Vec<String>), String> {
+        check_name(name)?;
+        let path = self.dir.join(format!("{name}.ron"));
+        let text =
+            std::fs::read_to_string(&path).map_err(|e| format!("no preset '{name}' ({}: {e})", path.display()))?;
+        let file: PresetFile = ron::from_str(&text).map_err(|e| format!("{}:{}", path.display(), e))?;
+        let (mut values, mut warnings) = (Vec::new(), Vec::new());
+        for (node_id, params) in &file.values {
+            let Some(n) = scene.node_index(node_id) else {
+                warnings.push(format!("preset '{name}': no node '{node_id}' in this scene"));
+                continue;
+            };
+            for (param, raw) in params {
+                let decls = scene.nodes[n].params.decls();
+                match decls.iter().position(|d| &d.name == param) {
+                    None => warnings.push(format!("preset '{name}': node '{node_id}' has no parameter '{param}'")),
+                    Some(p) => match value_from_raw(raw, &decls[p]) {
+                        Some(v) => values.push((n, p, v)),
+                        None => warnings.push(format!("preset '{name}': {node_id}.{param} = {raw:?} does not fit")),
+                    },
+                }
+            }
+        }
+        Ok((values, warnings))
+    }
+
+    /// Preset names, sorted (MIDI program change n recalls the n-th).
+    pub fn names(&self) -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(&self.dir)
+            .map(|entries| {
+                entries
+                    .flatten()
+                    .filter_map(|e| e.file_name().to_str()?.strip_suffix(".ron").map(str::to_string))
+                    .collect()
+            })
+            .unwrap_or_default();
+        names.sort();
+        names
+    }
+}
+
+/// Preset names become file names: letters, digits, `-` and `_` only.
+fn check_name(name: &str) -> Result<(), String> {
+    let ok = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
+    if ok { Ok(()) } else { Err(format!("preset name '{name}' may use only letters, digits, '-' and '_'")) }
+}

@@ -1,0 +1,127 @@
+//! Applying changed files to the running scene, keeping the last good version on any error.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use super::watcher::{Watcher, read_stable};
+use crate::assets::{AssetKind, Assets};
+use crate::gpu::{Gpu, validate_wgsl};
+use crate::scene::{SceneInstance, parse_scene};
+
+/// What one poll did.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ReloadReport {
+    /// Files applied to the running show.
+    pub applied: Vec<String>,
+    /// New errors (each reported once: a file that stays broken is not reported again).
+    pub errors: Vec<String>,
+    /// Files whose error is gone.
+    pub fixed: Vec<String>,
+    /// Whether the scene's structure changed (control maps must be rebuilt).
+    pub scene_changed: bool,
+}
+
+/// Watches the asset folders and applies changes to a running scene.
+pub struct LiveReload {
+    watcher: Option<Watcher>,
+    assets: Assets,
+    /// File → its current error, while broken.
+    broken: BTreeMap<PathBuf, String>,
+}
+
+impl LiveReload {
+    /// Watches `assets`' `shaders/` and `scenes/` folders (if it has a root on disk).
+    pub fn new(assets: &Assets) -> Result<Self, String> {
+        let dirs: Vec<PathBuf> = [AssetKind::Shader, AssetKind::Scene].iter().filter_map(|k| assets.dir(*k)).collect();
+        let watcher = if dirs.iter().any(|d| d.is_dir()) { Some(Watcher::watch(&dirs)?) } else { None };
+        Ok(Self { watcher, assets: assets.clone(), broken: BTreeMap::new() })
+    }
+
+    /// Marks a file as broken from the start (the show began with the built-in copy).
+    pub fn mark_broken(&mut self, path: PathBuf, error: String) {
+        self.broken.insert(path, error);
+    }
+
+    /// Files currently broken, with their errors.
+    pub fn broken(&self) -> impl Iterator<Item = (&PathBuf, &String)> {
+        self.broken.iter()
+    }
+
+    /// Applies whatever changed on disk since the last poll.
+    pub fn poll(&mut self, instance: &mut SceneInstance, gpu: &Gpu, size: (u32, u32)) -> ReloadReport {
+        let changed = self.watcher.as_ref().map(Watcher::changed).unwrap_or_default();
+        self.apply(&changed, instance, gpu, size)
+    }
+
+    /// Applies the given changed files.
+    pub fn apply(
+        &mut self,
+        files: &[PathBuf],
+        instance: &mut SceneInstance,
+        gpu: &Gpu,
+        size: (u32, u32),
+    ) -> ReloadReport {
+        let mut report = ReloadReport::default();
+        for path in files {
+            let shown = path.display().to_string();
+            let result = match path.extension().and_then(|e| e.to_str()) {
+                Some("wgsl") => self.reload_shader(path, instance, gpu, size),
+                Some("ron") => self.reload_scene(path, instance, gpu, size, &mut report),
+                _ => continue,
+            };
+            match result {
+                Ok(true) => {
+                    report.applied.push(shown.clone());
+                    if self.broken.remove(path).is_some() {
+                        report.fixed.push(shown);
+                    }
+                }
+                Ok(false) => {}
+                Err(e) => {
+                    // Logged once: the same error again (another save, same mistake) stays quiet.
+                    if self.broken.get(path) != Some(&e) {
+                        log::error!("{e}");
+                        report.errors.push(e.clone());
+                    }
+                    self.broken.insert(path.clone(), e);
+                }
+            }
+        }
+        report
+    }
+
+    /// Ok(true) if nodes were rebuilt, Ok(false) if no node uses the shader.
+    fn reload_shader(
+        &self,
+        path: &Path,
+        instance: &mut SceneInstance,
+        gpu: &Gpu,
+        size: (u32, u32),
+    ) -> Result<bool, String> {
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default().to_string();
+        let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        validate_wgsl(&path.display().to_string(), &source).map_err(|e| e.to_string())?;
+        instance.rebuild_nodes_using(&name, gpu, &self.assets, size).map_err(|e| e.to_string())
+    }
+
+    /// Ok(true) if the running scene was replaced by its edited file.
+    fn reload_scene(
+        &self,
+        path: &Path,
+        instance: &mut SceneInstance,
+        gpu: &Gpu,
+        size: (u32, u32),
+        report: &mut ReloadReport,
+    ) -> Result<bool, String> {
+        let running = Path::new(&instance.scene().origin);
+        let same = running.canonicalize().ok().zip(path.canonicalize().ok()).is_some_and(|(a, b)| a == b);
+        if !same {
+            return Ok(false);
+        }
+        let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let scene = parse_scene(&path.display().to_string(), &source).map_err(|e| e.to_string())?;
+        instance.replace_scene(scene, gpu, &self.assets, size).map_err(|e| e.to_string())?;
+        report.scene_changed = true;
+        Ok(true)
+    }
+}
