@@ -146,12 +146,13 @@ fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub
                     .horizontal(|ui| {
                         let target = Target { node, param: p, component: None };
                         let learning = hub.mapper.learning == Some(target);
+                        // ASCII: egui's bundled fonts lack the usual dot glyphs.
                         let mark = if learning {
-                            "…"
+                            "?"
                         } else if hub.mapper.is_mapped(node, p) {
-                            "●"
+                            "M"
                         } else {
-                            "○"
+                            "m"
                         };
                         let hint = "MIDI learn: click, then move a control; right-click to unlearn";
                         let learn = ui.small_button(mark).on_hover_text(hint);

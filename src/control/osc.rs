@@ -70,7 +70,7 @@ fn flatten(packet: OscPacket, batch: &mut Batch) {
             // (0, 1) means "immediately"; anything else is an absolute NTP time.
             let immediate = b.timetag.seconds == 0 && b.timetag.fractional == 1;
             if !immediate && batch.due.is_none() {
-                batch.due = Some(SystemTime::from(b.timetag));
+                batch.due = ntp_to_system(b.timetag);
             }
             for p in b.content {
                 flatten(p, batch);
@@ -78,6 +78,18 @@ fn flatten(packet: OscPacket, batch: &mut Batch) {
         }
     }
 }
+
+/// An OSC (NTP) time tag as a system time; `None` (apply at once) for times before 1970, which
+/// rosc's own conversion would panic on.
+fn ntp_to_system(t: rosc::OscTime) -> Option<SystemTime> {
+    const NTP_TO_UNIX_SECONDS: u64 = 2_208_988_800;
+    let seconds = u64::from(t.seconds).checked_sub(NTP_TO_UNIX_SECONDS)?;
+    let nanos = (u64::from(t.fractional) * 1_000_000_000) >> 32;
+    SystemTime::UNIX_EPOCH.checked_add(Duration::new(seconds, nanos as u32))
+}
+
+/// Requested kernel receive buffer for the OSC socket.
+const RECEIVE_BUFFER_BYTES: usize = 4 << 20;
 
 /// The UDP receiver thread and the queue it fills.
 pub struct OscReceiver {
@@ -94,6 +106,9 @@ impl OscReceiver {
     /// Binds `addr` (e.g. `127.0.0.1:9000`; port 0 picks a free one) and starts receiving.
     pub fn bind(addr: &str) -> Result<Self, String> {
         let socket = UdpSocket::bind(addr).map_err(|e| format!("cannot listen for OSC on {addr}: {e}"))?;
+        // A multi-touch controller sends bursts; a 4 MiB kernel buffer absorbs them while this
+        // thread catches up (the OS may cap it lower; that is not an error).
+        let _ = socket2::SockRef::from(&socket).set_recv_buffer_size(RECEIVE_BUFFER_BYTES);
         socket.set_read_timeout(Some(Duration::from_millis(50))).map_err(|e| e.to_string())?;
         let local = socket.local_addr().map_err(|e| e.to_string())?;
         let (tx, queue) = channel();

@@ -10,8 +10,8 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use crate::params::{ParamType, ParamValue};
-use crate::scene::{RawValue, Scene, SceneInstance, raw_from_value, value_from_raw};
+use crate::params::ParamType;
+use crate::scene::{NodeValues, RawValue, Scene, SceneInstance, raw_from_value, value_from_raw};
 
 /// A preset file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -57,7 +57,7 @@ impl PresetStore {
 
     /// The values of preset `name` for `scene`. Nodes or parameters the scene no longer has, and
     /// values that no longer fit, are skipped and named in the returned warnings.
-    pub fn load(&self, name: &str, scene: &Scene) -> Result<(Vec<(usize, usize, ParamValue)>, Vec<String>), String> {
+    pub fn load(&self, name: &str, scene: &Scene) -> Result<(NodeValues, Vec<String>), String> {
         check_name(name)?;
         let path = self.dir.join(format!("{name}.ron"));
         let text =

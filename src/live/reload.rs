@@ -78,9 +78,9 @@ impl LiveReload {
                 }
                 Ok(false) => {}
                 Err(e) => {
-                    // Logged once: the same error again (another save, same mistake) stays quiet.
+                    // Reported once: the same error again (another save, same mistake) stays quiet.
+                    // The caller shows and logs it.
                     if self.broken.get(path) != Some(&e) {
-                        log::error!("{e}");
                         report.errors.push(e.clone());
                     }
                     self.broken.insert(path.clone(), e);

@@ -6,6 +6,7 @@ use std::path::Path;
 use crate::assets::Assets;
 use crate::gpu::{Blit, BlitTarget, DISPLAY_FORMAT, Gpu, read_texture_rgba8};
 use crate::graph::{FrameStats, GraphRuntime};
+use crate::live::{LiveReload, ReloadReport};
 use crate::scene::{ControlEvent, Scene, SceneInstance};
 use crate::time::{FixedClock, FrameTime};
 
@@ -117,6 +118,11 @@ impl OffscreenRenderer {
         let (time, stats) = self.render_only()?;
         let rgba = read_texture_rgba8(&self.gpu.device, &self.gpu.queue, &self.target);
         Ok(RenderedFrame { time, rgba, size: self.size, stats })
+    }
+
+    /// Applies edited shader and scene files picked up by `live` (hot reload, off-screen).
+    pub fn poll_reload(&mut self, live: &mut LiveReload) -> ReloadReport {
+        live.poll(&mut self.instance, &self.gpu, self.size)
     }
 
     /// Waits for the GPU and folds outstanding pass timings into the medians.

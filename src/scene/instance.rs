@@ -17,6 +17,9 @@ use crate::params::{Morph, ParamSet, ParamValue, ParamWrite, Source};
 use crate::techniques::{NodeSetup, Technique};
 use crate::time::FrameTime;
 
+/// Values for (node, param) pairs: a preset, or a morph's destination.
+pub type NodeValues = Vec<(usize, usize, ParamValue)>;
+
 /// Something a controller, the UI or a replay asks of the running scene.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ControlEvent {
@@ -25,7 +28,7 @@ pub enum ControlEvent {
     /// Move to these values over `seconds` (0: at once) — a preset recall.
     Morph {
         /// (node, param, value).
-        values: Vec<(usize, usize, ParamValue)>,
+        values: NodeValues,
         /// Morph duration.
         seconds: f64,
     },
@@ -42,7 +45,7 @@ pub struct SceneInstance {
     pub animate: bool,
     overridden: BTreeSet<(usize, usize)>,
     morph: Option<Morph>,
-    pending_morph: Option<(Vec<(usize, usize, ParamValue)>, f64)>,
+    pending_morph: Option<(NodeValues, f64)>,
 }
 
 impl SceneInstance {

@@ -35,6 +35,9 @@ pub struct Scene {
     pub midi: Vec<(MidiMapping, Target)>,
 }
 
+/// A scene's OSC aliases and MIDI mappings, resolved.
+type ControlMaps = (Vec<(String, Target)>, Vec<(MidiMapping, Target)>);
+
 /// A parameter, or one float component of it, of a scene node.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Target {
@@ -176,7 +179,9 @@ fn one_error(origin: &str, message: String) -> SceneErrors {
 
 /// Parses and validates scene text; `origin` names it in errors.
 pub fn parse_scene(origin: &str, source: &str) -> Result<Scene, SceneErrors> {
-    let file: SceneFile = ron::Options::default().from_str(source).map_err(|e| {
+    // implicit_some: authors write `channel: 1`, not `channel: Some(1)`.
+    let options = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+    let file: SceneFile = options.from_str(source).map_err(|e| {
         SceneErrors(vec![SceneError {
             origin: origin.into(),
             line: e.span.start.line.max(1),
@@ -255,11 +260,7 @@ impl Validator<'_> {
     }
 
     /// Resolves OSC aliases and MIDI mappings to parameters.
-    fn controls(
-        &mut self,
-        file: &SceneFile,
-        nodes: &[SceneNode],
-    ) -> (Vec<(String, Target)>, Vec<(MidiMapping, Target)>) {
+    fn controls(&mut self, file: &SceneFile, nodes: &[SceneNode]) -> ControlMaps {
         let mut aliases = Vec::new();
         for (address, target) in &file.controls.osc {
             let anchor = format!("\"{address}\"");

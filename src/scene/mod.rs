@@ -7,7 +7,7 @@ mod load;
 mod schema;
 
 pub use error::{SceneError, SceneErrors};
-pub use instance::{ControlEvent, SceneInstance};
+pub use instance::{ControlEvent, NodeValues, SceneInstance};
 pub use load::{
     BoundTrack, Scene, SceneNode, Target, load_scene, parse_scene, parse_value_override, raw_from_value,
     resolve_target, value_from_raw,

@@ -1,0 +1,130 @@
+//! Hot reload end to end, off-screen, through the real file watcher: a broken shader or scene
+//! keeps the last good image (the golden) and reports the error with its line; the fix brings
+//! the new version in.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use indra::assets::Assets;
+use indra::live::{LiveReload, ReloadReport};
+use indra::offscreen::{OffscreenRenderer, RenderedFrame};
+use indra::scene::load_scene;
+
+/// A private copy of the project's scenes/ and shaders/ to edit.
+fn sandbox(name: &str) -> PathBuf {
+    let root = std::env::temp_dir().join(format!("indra-live-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    for dir in ["scenes", "shaders"] {
+        std::fs::create_dir_all(root.join(dir)).unwrap();
+        for entry in std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(dir)).unwrap() {
+            let entry = entry.unwrap();
+            std::fs::copy(entry.path(), root.join(dir).join(entry.file_name())).unwrap();
+        }
+    }
+    root
+}
+
+fn renderer(root: &Path) -> (OffscreenRenderer, LiveReload) {
+    let assets = Assets::new(Some(root.to_path_buf()));
+    let scene = load_scene(&assets, "kleinian_classic").unwrap();
+    let live = LiveReload::new(&assets).unwrap();
+    (OffscreenRenderer::new(common::gpu(), &assets, scene, Some((256, 256)), None, None).unwrap(), live)
+}
+
+fn frame0(r: &mut OffscreenRenderer) -> RenderedFrame {
+    r.seek(0);
+    r.render_next().unwrap()
+}
+
+/// Polls until the watcher reports something (or 5 s pass).
+fn wait_for_reload(r: &mut OffscreenRenderer, live: &mut LiveReload) -> ReloadReport {
+    let start = Instant::now();
+    loop {
+        let report = r.poll_reload(live);
+        if !report.applied.is_empty() || !report.errors.is_empty() || start.elapsed() > Duration::from_secs(5) {
+            return report;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+fn edit(path: &Path, from: &str, to: &str) {
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.contains(from), "{from} not in {}", path.display());
+    std::fs::write(path, text.replacen(from, to, 1)).unwrap();
+}
+
+#[test]
+fn a_broken_shader_keeps_the_last_good_image_and_the_fix_applies() {
+    let root = sandbox("shader");
+    let (mut r, mut live) = renderer(&root);
+    let golden = common::golden();
+    golden.check("kleinian_classic_f0000", (256, 256), &frame0(&mut r).rgba).unwrap();
+
+    let shader = root.join("shaders/kleinian.wgsl");
+    edit(&shader, "    var z = start;", "    var z = start +;");
+    let line = std::fs::read_to_string(&shader).unwrap().lines().position(|l| l.contains("start +;")).unwrap() + 1;
+    let report = wait_for_reload(&mut r, &mut live);
+    assert_eq!(report.errors.len(), 1, "{report:?}");
+    assert!(report.errors[0].contains(&format!("kleinian.wgsl:{line}:")), "{}", report.errors[0]);
+    golden.check("kleinian_classic_f0000", (256, 256), &frame0(&mut r).rgba).expect("the last good shader still runs");
+
+    // Saving the same mistake again is not reported twice.
+    std::fs::write(&shader, std::fs::read_to_string(&shader).unwrap()).unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(r.poll_reload(&mut live).errors.is_empty());
+
+    // The fix swaps hit and background colours: the image must equal the old shader with the
+    // colours swapped by parameters.
+    edit(&shader, "    var z = start +;", "    var z = start;");
+    edit(
+        &shader,
+        "select(params.back_color, params.hit_color, hit)",
+        "select(params.hit_color, params.back_color, hit)",
+    );
+    let report = wait_for_reload(&mut r, &mut live);
+    assert_eq!((report.applied.len(), report.fixed.len()), (1, 1), "{report:?}");
+    let swapped = frame0(&mut r);
+    let mut reference = load_scene(&common::assets(), "kleinian_classic").unwrap();
+    reference.set_from_str("limit_set.hit_color=0.5,0.5,0.5").unwrap();
+    reference.set_from_str("limit_set.back_color=1,0,0").unwrap();
+    assert!(swapped.rgba == common::render_scene(reference, (256, 256), 0).rgba, "the fixed shader is live");
+    std::fs::remove_dir_all(root).unwrap();
+}
+
+#[test]
+fn a_broken_scene_keeps_running_and_the_fix_applies() {
+    let root = sandbox("scene");
+    let (mut r, mut live) = renderer(&root);
+    let before = frame0(&mut r);
+    let scene = root.join("scenes/kleinian_classic.ron");
+    edit(&scene, "\"scale\": 2.4,", "\"scale\": 2.4,,");
+    let report = wait_for_reload(&mut r, &mut live);
+    assert_eq!(report.errors.len(), 1, "{report:?}");
+    assert!(report.errors[0].contains("kleinian_classic.ron:"), "{}", report.errors[0]);
+    assert!(frame0(&mut r).rgba == before.rgba, "the running scene is untouched");
+
+    edit(&scene, "\"scale\": 2.4,,", "\"scale\": 3.0,");
+    let report = wait_for_reload(&mut r, &mut live);
+    assert!(report.scene_changed && report.fixed.len() == 1, "{report:?}");
+    let after = frame0(&mut r);
+    let mut reference = load_scene(&common::assets(), "kleinian_classic").unwrap();
+    reference.set_from_str("limit_set.scale=3.0").unwrap();
+    assert!(after.rgba == common::render_scene(reference, (256, 256), 0).rgba, "the edited default is live");
+    std::fs::remove_dir_all(root).unwrap();
+}
+
+#[test]
+fn a_file_broken_at_start_up_is_picked_up_when_fixed() {
+    let root = sandbox("startup");
+    let (mut r, mut live) = renderer(&root);
+    let shader = root.join("shaders/kleinian.wgsl");
+    live.mark_broken(shader.clone(), "broken at start-up".into());
+    std::fs::write(&shader, std::fs::read_to_string(&shader).unwrap() + "\n// fixed\n").unwrap();
+    let report = wait_for_reload(&mut r, &mut live);
+    assert_eq!(report.fixed, [shader.display().to_string()]);
+    assert_eq!(live.broken().count(), 0);
+    std::fs::remove_dir_all(root).unwrap();
+}

@@ -1,0 +1,325 @@
+//! OSC over real UDP on loopback: messages of every argument type, clamping, atomic bundles,
+//! future time tags, an external client (liblo's `oscsend`), 100,000 hostile packets, feedback
+//! out and the OSCQuery tree.
+
+mod common;
+
+use std::net::UdpSocket;
+use std::time::{Duration, Instant, SystemTime};
+
+use indra::control::feedback::OscFeedback;
+use indra::control::osc::{OscReceiver, OscRouter, Routed, decode};
+use indra::control::oscquery::OscQueryServer;
+use indra::params::ParamValue;
+use indra::scene::{ControlEvent, Scene, SceneInstance, load_scene};
+use rosc::{OscBundle, OscMessage, OscPacket, OscTime, OscType};
+
+fn scene(name: &str) -> Scene {
+    load_scene(&common::assets(), name).unwrap()
+}
+
+fn packet(addr: &str, args: Vec<OscType>) -> Vec<u8> {
+    rosc::encoder::encode(&OscPacket::Message(OscMessage { addr: addr.into(), args })).unwrap()
+}
+
+/// Waits until the receiver has seen `n` packets, then drains every due batch.
+fn receive(rx: &mut OscReceiver, n: u64) -> Vec<indra::control::osc::Batch> {
+    let start = Instant::now();
+    while rx.counters().packets.load(std::sync::atomic::Ordering::Relaxed) < n {
+        assert!(start.elapsed() < Duration::from_secs(5), "only {:?} arrived", rx.counters().snapshot());
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    std::thread::sleep(Duration::from_millis(20));
+    rx.drain(SystemTime::now())
+}
+
+/// Sends `packets`, routes what arrives, returns the events.
+fn send_and_route(scene: &Scene, packets: &[Vec<u8>]) -> (Vec<Routed>, OscReceiver) {
+    let mut rx = OscReceiver::bind("127.0.0.1:0").unwrap();
+    let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
+    for p in packets {
+        tx.send_to(p, rx.local_addr()).unwrap();
+    }
+    let router = OscRouter::new(scene);
+    let batches = receive(&mut rx, packets.len() as u64);
+    let routed = batches.iter().flat_map(|b| &b.messages).filter_map(|m| router.route(m, scene, &rx)).collect();
+    (routed, rx)
+}
+
+fn write_value(r: &Routed) -> ParamValue {
+    match r {
+        Routed::Event(ControlEvent::Write(w)) => w.value,
+        other => panic!("not a write: {other:?}"),
+    }
+}
+
+#[test]
+fn every_argument_type_reaches_its_parameter() {
+    let k = scene("kleinian");
+    let (routed, rx) = send_and_route(
+        &k,
+        &[
+            packet("/indra/limit_set/scale", vec![OscType::Float(2.5)]),
+            packet("/indra/limit_set/scale", vec![OscType::Double(3.5)]),
+            packet("/indra/limit_set/iterations", vec![OscType::Int(120)]),
+            packet("/indra/limit_set/iterations", vec![OscType::Long(77)]),
+            packet("/indra/limit_set/circle_inversion", vec![OscType::Bool(true)]),
+            packet("/indra/limit_set/t", vec![OscType::Float(1.9), OscType::Float(0.03)]),
+            packet("/indra/limit_set/hit_color", vec![OscType::Float(1.0), OscType::Float(0.5), OscType::Float(0.0)]),
+            packet("/indra/limit_set/t/y", vec![OscType::Float(0.01)]),
+        ],
+    );
+    let values: Vec<ParamValue> = routed.iter().map(write_value).collect();
+    assert_eq!(
+        values,
+        [
+            ParamValue::Float(2.5),
+            ParamValue::Float(3.5),
+            ParamValue::Int(120),
+            ParamValue::Int(77),
+            ParamValue::Bool(true),
+            ParamValue::Vec2([1.9, 0.03]),
+            ParamValue::Color([1.0, 0.5, 0.0, 1.0]),
+            ParamValue::Float(0.01),
+        ]
+    );
+    assert_eq!(rx.counters().snapshot()[5], 8, "all applied");
+    // Enums by name or index (StarGlow's composite type).
+    let s = scene("star_glow");
+    let (routed, _) = send_and_route(
+        &s,
+        &[
+            packet("/indra/glow/composite", vec![OscType::String("Screen".into())]),
+            packet("/indra/glow/composite", vec![OscType::Int(4)]),
+        ],
+    );
+    let values: Vec<ParamValue> = routed.iter().map(write_value).collect();
+    assert_eq!(values, [ParamValue::Enum(1), ParamValue::Enum(4)]);
+}
+
+#[test]
+fn wrong_arguments_and_unknown_addresses_are_counted_not_applied() {
+    let k = scene("kleinian");
+    let (routed, rx) = send_and_route(
+        &k,
+        &[
+            packet("/indra/limit_set/t", vec![OscType::Float(1.0)]),
+            packet("/indra/limit_set/scale", vec![OscType::String("big".into())]),
+            packet("/indra/nowhere/x", vec![OscType::Float(1.0)]),
+            vec![1, 2, 3, 4, 5],
+        ],
+    );
+    assert!(routed.is_empty());
+    let [packets, _, malformed, unknown, bad, applied] = rx.counters().snapshot();
+    assert_eq!((packets, malformed, unknown, bad, applied), (4, 1, 1, 2, 0));
+}
+
+#[test]
+fn out_of_range_values_are_clamped_when_applied() {
+    let gpu = common::gpu();
+    let k = scene("kleinian");
+    let mut instance = SceneInstance::new(&gpu, &common::assets(), k.clone(), (32, 32)).unwrap();
+    let (routed, _) = send_and_route(&k, &[packet("/indra/limit_set/scale", vec![OscType::Float(1e6)])]);
+    let events: Vec<ControlEvent> =
+        routed.into_iter().filter_map(|r| if let Routed::Event(e) = r { Some(e) } else { None }).collect();
+    instance.apply(&events);
+    let scale = instance.params(0).index("scale").unwrap();
+    assert_eq!(instance.params(0).target_at(scale), ParamValue::Float(50.0));
+}
+
+#[test]
+fn a_bundle_arrives_in_one_drain() {
+    let mut rx = OscReceiver::bind("127.0.0.1:0").unwrap();
+    let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let content = (0..3)
+        .map(|i| {
+            OscPacket::Message(OscMessage {
+                addr: "/indra/limit_set/scale".into(),
+                args: vec![OscType::Float(i as f32)],
+            })
+        })
+        .collect();
+    let bundle = OscPacket::Bundle(OscBundle { timetag: OscTime { seconds: 0, fractional: 1 }, content });
+    for _ in 0..50 {
+        tx.send_to(&rosc::encoder::encode(&bundle).unwrap(), rx.local_addr()).unwrap();
+    }
+    let batches = receive(&mut rx, 50);
+    assert_eq!(batches.len(), 50);
+    assert!(batches.iter().all(|b| b.messages.len() == 3), "a bundle is never split across frames");
+}
+
+#[test]
+fn a_future_time_tag_waits_until_due() {
+    let mut rx = OscReceiver::bind("127.0.0.1:0").unwrap();
+    let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let due = SystemTime::now() + Duration::from_millis(400);
+    let msg = OscPacket::Message(OscMessage { addr: "/indra/limit_set/scale".into(), args: vec![OscType::Float(2.0)] });
+    let bundle = OscPacket::Bundle(OscBundle { timetag: OscTime::try_from(due).unwrap(), content: vec![msg] });
+    tx.send_to(&rosc::encoder::encode(&bundle).unwrap(), rx.local_addr()).unwrap();
+    assert!(receive(&mut rx, 1).is_empty(), "not yet due");
+    std::thread::sleep(Duration::from_millis(450));
+    assert_eq!(rx.drain(SystemTime::now()).len(), 1);
+}
+
+#[test]
+fn an_external_client_controls_a_parameter() {
+    let k = scene("kleinian");
+    let mut rx = OscReceiver::bind("127.0.0.1:0").unwrap();
+    let port = rx.local_addr().port().to_string();
+    let status = std::process::Command::new("oscsend")
+        .args(["127.0.0.1", &port, "/indra/limit_set/t", "ff", "1.95", "0.015"])
+        .status()
+        .expect("oscsend from liblo-tools (tools/test installs it)");
+    assert!(status.success());
+    let batches = receive(&mut rx, 1);
+    let router = OscRouter::new(&k);
+    let routed = router.route(&batches[0].messages[0], &k, &rx).unwrap();
+    assert_eq!(write_value(&routed), ParamValue::Vec2([1.95, 0.015]));
+}
+
+/// A small deterministic generator (xorshift) for hostile input.
+fn xorshift(state: &mut u64) -> u64 {
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    *state
+}
+
+#[test]
+fn a_hundred_thousand_hostile_packets_never_panic() {
+    let valid = [
+        packet("/indra/limit_set/t", vec![OscType::Float(1.9), OscType::Float(0.02)]),
+        rosc::encoder::encode(&OscPacket::Bundle(OscBundle {
+            timetag: OscTime { seconds: 0, fractional: 1 },
+            content: vec![OscPacket::Message(OscMessage {
+                addr: "/a".into(),
+                args: vec![OscType::String("x".into())],
+            })],
+        }))
+        .unwrap(),
+    ];
+    let (mut ok, mut err) = (0u32, 0u32);
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    for i in 0..100_000 {
+        let bytes: Vec<u8> = if i % 2 == 0 {
+            let len = (xorshift(&mut state) % 96) as usize;
+            (0..len).map(|_| xorshift(&mut state) as u8).collect()
+        } else {
+            // Truncated or corrupted valid packets.
+            let v = &valid[i % valid.len()];
+            let mut b = v[..(xorshift(&mut state) as usize % (v.len() + 1))].to_vec();
+            if let Some(x) = b.get_mut(xorshift(&mut state) as usize % v.len()) {
+                *x ^= xorshift(&mut state) as u8;
+            }
+            b
+        };
+        match decode(&bytes) {
+            Ok(_) => ok += 1,
+            Err(_) => err += 1,
+        }
+    }
+    assert_eq!(ok + err, 100_000);
+    assert!(err > 50_000, "most hostile packets are rejected ({err})");
+    // And through the real socket: the counters add up.
+    let mut rx = OscReceiver::bind("127.0.0.1:0").unwrap();
+    let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let mut sent = 0u64;
+    for _ in 0..2000 {
+        let len = 1 + (xorshift(&mut state) % 64) as usize;
+        let bytes: Vec<u8> = (0..len).map(|_| xorshift(&mut state) as u8).collect();
+        tx.send_to(&bytes, rx.local_addr()).unwrap();
+        sent += 1;
+    }
+    let batches = receive(&mut rx, sent);
+    let [packets, _, malformed, ..] = rx.counters().snapshot();
+    assert_eq!(packets, sent);
+    assert_eq!(malformed + batches.len() as u64, sent, "every packet is either a batch or counted malformed");
+}
+
+#[test]
+fn feedback_sends_changed_values_to_the_controller() {
+    let gpu = common::gpu();
+    let mut instance = SceneInstance::new(&gpu, &common::assets(), scene("kleinian"), (32, 32)).unwrap();
+    let listener = UdpSocket::bind("127.0.0.1:0").unwrap();
+    listener.set_read_timeout(Some(Duration::from_secs(2))).unwrap();
+    let mut feedback = OscFeedback::connect(&listener.local_addr().unwrap().to_string()).unwrap();
+    assert_eq!(feedback.send_changes(&instance), 10, "everything once at first");
+    assert_eq!(feedback.send_changes(&instance), 0, "nothing changed");
+    let mut buf = [0u8; 1024];
+    for _ in 0..10 {
+        listener.recv(&mut buf).unwrap();
+    }
+    let scale = instance.params(0).index("scale").unwrap();
+    let write = indra::params::ParamWrite {
+        node: 0,
+        param: scale,
+        component: None,
+        value: ParamValue::Float(3.0),
+        source: indra::params::Source::Midi,
+    };
+    instance.apply(&[ControlEvent::Write(write)]);
+    assert_eq!(feedback.send_changes(&instance), 1);
+    let n = listener.recv(&mut buf).unwrap();
+    let (_, packet) = rosc::decoder::decode_udp(&buf[..n]).unwrap();
+    assert_eq!(
+        packet,
+        OscPacket::Message(OscMessage { addr: "/indra/limit_set/scale".into(), args: vec![OscType::Float(3.0)] })
+    );
+}
+
+fn http_get(addr: std::net::SocketAddr, path: &str) -> (u16, serde_json::Value) {
+    use std::io::{Read, Write};
+    let mut s = std::net::TcpStream::connect(addr).unwrap();
+    write!(s, "GET {path} HTTP/1.0\r\nHost: localhost\r\n\r\n").unwrap();
+    let mut response = String::new();
+    s.read_to_string(&mut response).unwrap();
+    let status = response[9..12].parse().unwrap();
+    let body = response.split("\r\n\r\n").nth(1).unwrap_or("{}");
+    (status, serde_json::from_str(body).unwrap())
+}
+
+#[test]
+fn oscquery_serves_every_parameter_with_type_range_and_value() {
+    let gpu = common::gpu();
+    let instance = SceneInstance::new(&gpu, &common::assets(), scene("star_glow"), (32, 32)).unwrap();
+    let server = OscQueryServer::start("127.0.0.1:0", 9000).unwrap();
+    server.publish(&instance);
+    let (status, tree) = http_get(server.local_addr(), "/");
+    assert_eq!(status, 200);
+    for (n, node) in instance.scene().nodes.iter().enumerate() {
+        let params = instance.params(n);
+        for (p, decl) in params.decls().iter().enumerate() {
+            let leaf = &tree["CONTENTS"]["indra"]["CONTENTS"][&node.id]["CONTENTS"][&decl.name];
+            assert_eq!(leaf["FULL_PATH"], format!("/indra/{}/{}", node.id, decl.name));
+            assert_eq!(leaf["DESCRIPTION"], decl.doc);
+            let value = params.target_at(p);
+            match value {
+                ParamValue::Enum(_) => {
+                    assert_eq!(leaf["TYPE"], "s");
+                    assert_eq!(leaf["VALUE"][0], decl.format(&value));
+                    assert_eq!(leaf["RANGE"][0]["VALS"].as_array().unwrap().len(), decl.options.len());
+                }
+                ParamValue::Bool(b) => assert_eq!(leaf["VALUE"][0], b),
+                ParamValue::Int(i) => {
+                    assert_eq!((leaf["TYPE"].as_str(), leaf["VALUE"][0].as_i64()), (Some("i"), Some(i64::from(i))))
+                }
+                other => {
+                    let got: Vec<f32> =
+                        leaf["VALUE"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap() as f32).collect();
+                    assert_eq!(got, other.components(), "{}", decl.name);
+                    assert_eq!(leaf["TYPE"].as_str().unwrap().len(), other.components().len());
+                }
+            }
+            if let (Some((lo, hi)), false) = (decl.range, !decl.options.is_empty()) {
+                assert_eq!(leaf["RANGE"][0]["MIN"].as_f64().unwrap() as f32, lo);
+                assert_eq!(leaf["RANGE"][0]["MAX"].as_f64().unwrap() as f32, hi);
+            }
+        }
+    }
+    let (_, info) = http_get(server.local_addr(), "/?HOST_INFO");
+    assert_eq!((info["OSC_PORT"].as_u64(), info["OSC_TRANSPORT"].as_str()), (Some(9000), Some("UDP")));
+    let (_, leaf) = http_get(server.local_addr(), "/indra/glow/streaks");
+    assert_eq!(leaf["VALUE"][0], 5);
+    let (status, _) = http_get(server.local_addr(), "/indra/nothing");
+    assert_eq!(status, 404);
+}
