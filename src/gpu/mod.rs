@@ -2,12 +2,14 @@
 //! naga validation and located errors, texture readback and the final display encode.
 //! Knows nothing of scenes or techniques.
 
+mod binding;
 mod blit;
 mod compute;
 mod context;
 mod readback;
 mod shader;
 
+pub use binding::{uniform_buffer, uniform_entry, wgsl_struct_size};
 pub use blit::{Blit, BlitTarget, DISPLAY_FORMAT};
 pub use compute::ComputeKernel;
 pub use context::{BackendChoice, Gpu, GpuError, GpuOptions, instance_descriptor};

@@ -123,16 +123,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("cube_field_layout"),
-        entries: &[wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: wgpu::BufferSize::new(size_of::<CubeFieldUniforms>() as u64),
-            },
-            count: None,
-        }],
+        entries: &[crate::gpu::uniform_entry::<CubeFieldUniforms>(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("cube_field_pipeline_layout"),
@@ -174,12 +165,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     if let Some(e) = pollster::block_on(scope.pop()) {
         return Err(ShaderError { origin, line: 1, column: 1, message: e.to_string() });
     }
-    let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("cube_field_uniforms"),
-        size: size_of::<CubeFieldUniforms>() as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let uniforms = crate::gpu::uniform_buffer::<CubeFieldUniforms>(device, "cube_field_uniforms");
     let instances = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("cube_field_instances"),
         size: (MAX_CUBES * size_of::<CubeInstance>()) as u64,
@@ -237,5 +223,19 @@ impl Technique for CubeField {
             pass.draw(0..36, 0..count);
         });
         color
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uniform_layout_matches_the_wgsl_struct() {
+        let source = include_str!("../../../shaders/cube_field.wgsl");
+        assert_eq!(
+            crate::gpu::wgsl_struct_size(source, "CubeFieldUniforms"),
+            Some(size_of::<CubeFieldUniforms>() as u32)
+        );
     }
 }

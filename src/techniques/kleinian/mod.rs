@@ -120,16 +120,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("kleinian_layout"),
         entries: &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: wgpu::BufferSize::new(size_of::<KleinianUniforms>() as u64),
-                },
-                count: None,
-            },
+            crate::gpu::uniform_entry::<KleinianUniforms>(0, wgpu::ShaderStages::COMPUTE),
             wgpu::BindGroupLayoutEntry {
                 binding: 1,
                 visibility: wgpu::ShaderStages::COMPUTE,
@@ -144,12 +135,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     });
     let (origin, source) = setup.shader_source("kleinian.wgsl")?;
     let kernel = ComputeKernel::new(device, &origin, &source, "render", &[&layout])?;
-    let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("kleinian_uniforms"),
-        size: size_of::<KleinianUniforms>() as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let uniforms = crate::gpu::uniform_buffer::<KleinianUniforms>(device, "kleinian_uniforms");
     Ok(Box::new(Kleinian { kernel, layout, uniforms, bind_groups: HashMap::new() }))
 }
 

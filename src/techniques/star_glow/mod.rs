@@ -204,16 +204,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let (origin, source) = setup.shader_source("star_glow.wgsl")?;
     let kernel = |entry: &str, bindings: &[Binding]| -> Result<Kernel, ShaderError> {
         let mut entries = vec![
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: wgpu::BufferSize::new(size_of::<StarGlowUniforms>() as u64),
-                },
-                count: None,
-            },
+            crate::gpu::uniform_entry::<StarGlowUniforms>(0, wgpu::ShaderStages::COMPUTE),
             wgpu::BindGroupLayoutEntry {
                 binding: 1,
                 visibility: wgpu::ShaderStages::COMPUTE,
@@ -246,16 +237,8 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         min_filter: wgpu::FilterMode::Linear,
         ..Default::default()
     });
-    let uniforms = (0..MAX_PASSES)
-        .map(|_| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("star_glow_uniforms"),
-                size: size_of::<StarGlowUniforms>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        })
-        .collect();
+    let uniforms =
+        (0..MAX_PASSES).map(|_| crate::gpu::uniform_buffer::<StarGlowUniforms>(device, "star_glow_uniforms")).collect();
     Ok(Box::new(StarGlow { kernels, sampler, uniforms, bind_groups: RefCell::new(HashMap::new()) }))
 }
 
