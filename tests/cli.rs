@@ -167,3 +167,31 @@ fn no_display_says_what_to_do_instead() {
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     assert!(text(&o).contains("cannot open a window") && text(&o).contains("indra render"), "{}", text(&o));
 }
+
+#[test]
+fn render_replays_a_recorded_control_stream() {
+    let dir = temp_dir("replay");
+    let recording = dir.join("show.ron");
+    std::fs::write(
+        &recording,
+        "(frame: 1, event: Write(node: \"limit_set\", param: \"hit_color\", component: None, value: [0.0, 1.0, 0.0], source: Osc))\n",
+    )
+    .unwrap();
+    let render = |extra: &[&str], out: &std::path::Path| {
+        let mut args =
+            vec!["render", "kleinian_classic", "--frames", "3", "--size", "32x32", "--out", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = indra(&args);
+        assert!(o.status.success(), "{}", text(&o));
+        (0..3).map(|f| std::fs::read(out.join(format!("kleinian_classic_{f:05}.png"))).unwrap()).collect::<Vec<_>>()
+    };
+    let plain = render(&[], &dir.join("plain"));
+    let replayed = render(&["--replay", recording.to_str().unwrap()], &dir.join("replayed"));
+    assert_eq!(plain[0], replayed[0], "nothing happens before frame 1");
+    assert_ne!(plain[1], replayed[1], "the recorded write applies at frame 1");
+    std::fs::write(&recording, "(frame: 1, event: Write(node: \"nobody\"))\n").unwrap();
+    let bad =
+        indra(&["render", "kleinian_classic", "--replay", recording.to_str().unwrap(), "--out", dir.to_str().unwrap()]);
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(text(&bad).contains("show.ron:1:"), "{}", text(&bad));
+}

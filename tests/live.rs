@@ -128,3 +128,20 @@ fn a_file_broken_at_start_up_is_picked_up_when_fixed() {
     assert_eq!(live.broken().count(), 0);
     std::fs::remove_dir_all(root).unwrap();
 }
+
+#[test]
+fn an_atomic_save_by_rename_is_picked_up() {
+    // Editors often write a temporary file and rename it over the original.
+    let root = sandbox("rename");
+    let (mut r, mut live) = renderer(&root);
+    let before = frame0(&mut r);
+    let scene = root.join("scenes/kleinian_classic.ron");
+    let temp = root.join("scenes/.kleinian_classic.ron.tmp");
+    std::fs::write(&temp, std::fs::read_to_string(&scene).unwrap().replace("\"scale\": 2.4,", "\"scale\": 2.0,"))
+        .unwrap();
+    std::fs::rename(&temp, &scene).unwrap();
+    let report = wait_for_reload(&mut r, &mut live);
+    assert!(report.scene_changed, "{report:?}");
+    assert!(frame0(&mut r).rgba != before.rgba);
+    std::fs::remove_dir_all(root).unwrap();
+}

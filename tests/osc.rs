@@ -323,3 +323,20 @@ fn oscquery_serves_every_parameter_with_type_range_and_value() {
     let (status, _) = http_get(server.local_addr(), "/indra/nothing");
     assert_eq!(status, 404);
 }
+
+#[test]
+fn stats_are_answered_over_osc() {
+    let mut rx = OscReceiver::bind("127.0.0.1:0").unwrap();
+    let client = UdpSocket::bind("127.0.0.1:0").unwrap();
+    client.set_read_timeout(Some(Duration::from_secs(2))).unwrap();
+    client.send_to(&[0xde, 0xad], rx.local_addr()).unwrap();
+    client.send_to(&packet("/indra/stats", vec![]), rx.local_addr()).unwrap();
+    let mut buf = [0u8; 512];
+    let n = client.recv(&mut buf).unwrap();
+    let (_, reply) = rosc::decoder::decode_udp(&buf[..n]).unwrap();
+    let OscPacket::Message(m) = reply else { panic!("{reply:?}") };
+    assert_eq!(m.addr, "/indra/stats");
+    // packets, messages, malformed, unknown address, bad arguments, applied
+    assert_eq!(m.args[..3], [OscType::Long(2), OscType::Long(1), OscType::Long(1)]);
+    let _ = receive(&mut rx, 2);
+}
