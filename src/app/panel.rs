@@ -122,7 +122,7 @@ fn preset_panel(
     });
     ui.add(egui::Slider::new(&mut overlay.morph_seconds, 0.0..=10.0).text("morph s"));
     ui.horizontal_wrapped(|ui| {
-        for (i, name) in hub.presets.names().iter().enumerate() {
+        for (i, name) in hub.preset_names().to_vec().iter().enumerate() {
             let label = if i < 9 { format!("{} {name}", i + 1) } else { name.clone() };
             if ui.button(label).clicked() {
                 events.extend(hub.recall(name, f64::from(overlay.morph_seconds), instance.scene()));

@@ -228,7 +228,7 @@ impl ApplicationHandler for WindowApp {
                 ..
             } if !consumed => {
                 if let Some(i) = c.parse::<usize>().ok().filter(|i| (1..=9).contains(i))
-                    && let Some(name) = r.hub.presets.names().get(i - 1).cloned()
+                    && let Some(name) = r.hub.preset_names().get(i - 1).cloned()
                 {
                     let seconds = f64::from(r.overlay.morph_seconds);
                     let scene = r.instance.scene().clone();

@@ -68,7 +68,13 @@ pub struct ControlHub {
     /// Things to tell the performer (shown in the overlay, logged once there).
     pub notices: Vec<String>,
     frame_count: u64,
+    /// Preset names, re-read on save and every [`PRESET_RESCAN_FRAMES`] frames (not per frame:
+    /// the panel shows them every frame).
+    preset_names: Vec<String>,
 }
+
+/// Frames between re-reads of the preset folder (files may be copied in by hand).
+const PRESET_RESCAN_FRAMES: u64 = 60;
 
 impl ControlHub {
     /// Opens what `options` asks for against `scene`.
@@ -96,6 +102,8 @@ impl ControlHub {
         let recorder = options.record.as_deref().and_then(|p| Recorder::create(p).map_err(|e| report(Err(e))).ok());
         let learn = LearnStore { path: options.learn_file.clone() };
         let mapper = MidiMapper::new(scene, &learn.load());
+        let presets = PresetStore { dir: options.presets_dir.clone() };
+        let preset_names = presets.names();
         Self {
             osc,
             router: OscRouter::new(scene),
@@ -105,10 +113,11 @@ impl ControlHub {
             parser: MidiParser::default(),
             mapper,
             learn,
-            presets: PresetStore { dir: options.presets_dir.clone() },
+            presets,
             recorder,
             notices,
             frame_count: 0,
+            preset_names,
         }
     }
 
@@ -155,7 +164,7 @@ impl ControlHub {
             let (writes, program) = self.mapper.handle(e, scene, seconds);
             events.extend(writes.into_iter().map(ControlEvent::Write));
             if let Some(p) = program
-                && let Some(name) = self.presets.names().get(usize::from(p)).cloned()
+                && let Some(name) = self.preset_names.get(usize::from(p)).cloned()
             {
                 events.extend(self.recall(&name, 0.0, scene));
             }
@@ -188,6 +197,12 @@ impl ControlHub {
             Ok(path) => log::info!("saved preset {}", path.display()),
             Err(e) => self.notice(e),
         }
+        self.preset_names = self.presets.names();
+    }
+
+    /// Preset names in recall order (1–9 keys, MIDI program numbers).
+    pub fn preset_names(&self) -> &[String] {
+        &self.preset_names
     }
 
     /// Starts MIDI learn for `target`: the next control moved is bound to it.
@@ -227,6 +242,9 @@ impl ControlHub {
             && self.frame_count.is_multiple_of(6)
         {
             q.publish(instance);
+        }
+        if self.frame_count.is_multiple_of(PRESET_RESCAN_FRAMES) {
+            self.preset_names = self.presets.names();
         }
         self.frame_count += 1;
     }
