@@ -57,8 +57,9 @@ pub fn params() -> Vec<ParamDecl> {
         ParamDecl::new("fov", Float(30.0), Some((5.0, 120.0)), "vertical field of view").with_unit("°"),
         ParamDecl::new("light_dir", Vec3([-0.4, 0.5, -0.75]), Some((-1.0, 1.0)), "direction towards the light"),
         ParamDecl::new("light_intensity", Float(0.87), Some((0.0, 10.0)), "light intensity"),
-        ParamDecl::new("specular", Float(4.0), Some((0.0, 20.0)), "specular strength; above ~1.2 glints exceed 1.0"),
-        ParamDecl::new("shininess", Float(64.0), Some((1.0, 512.0)), "Blinn-Phong exponent"),
+        // Narrow, strong highlights: single glints cross StarGlow's threshold of 1, faces do not.
+        ParamDecl::new("specular", Float(2.0), Some((0.0, 20.0)), "specular strength; above ~1.2 glints exceed 1.0"),
+        ParamDecl::new("shininess", Float(128.0), Some((1.0, 512.0)), "Blinn-Phong exponent"),
         ParamDecl::new("color", Color([1.0, 1.0, 1.0, 1.0]), None, "cube colour"),
     ]
 }
