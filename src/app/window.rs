@@ -227,6 +227,9 @@ impl ApplicationHandler for WindowApp {
                 event: KeyEvent { logical_key: Key::Character(c), state: ElementState::Pressed, repeat: false, .. },
                 ..
             } if !consumed => {
+                if c.eq_ignore_ascii_case("r") {
+                    r.ui_events.extend(r.instance.fire_all("reset", crate::params::Source::Ui));
+                }
                 if let Some(i) = c.parse::<usize>().ok().filter(|i| (1..=9).contains(i))
                     && let Some(name) = r.hub.preset_names().get(i - 1).cloned()
                 {
@@ -300,6 +303,9 @@ impl Running {
         self.window.pre_present_notify();
         self.gpu.queue.present(frame);
         self.hub.after_frame(&self.instance);
+        for m in self.instance.take_messages() {
+            self.overlay.report(m);
+        }
         for n in std::mem::take(&mut self.hub.notices) {
             self.overlay.report(n);
         }

@@ -17,5 +17,5 @@ pub use builder::{FrameGraph, PassBuilder, PassContext};
 pub use compile::{CompiledGraph, GraphError, compile};
 pub use execute::{FrameOutput, FrameStats, GraphRuntime};
 pub use pool::TexturePool;
-pub use resource::{BufferHandle, Extent, PersistentTexture, PingPong, TextureDesc, TextureHandle};
+pub use resource::{BufferHandle, Extent, PersistentTexture, PingPong, TextureDesc, TextureHandle, next_resource_id};
 pub use timing::{PassTiming, RollingMedian};

@@ -66,7 +66,7 @@ static NEXT_ID: AtomicU64 = AtomicU64::new(1);
 
 /// A process-unique id for a GPU resource, stable for its lifetime: techniques key cached bind
 /// groups by it, so steady-state frames create none.
-pub(crate) fn next_resource_id() -> u64 {
+pub fn next_resource_id() -> u64 {
     NEXT_ID.fetch_add(1, Ordering::Relaxed)
 }
 

@@ -225,6 +225,35 @@ impl SceneInstance {
         Ok(())
     }
 
+    /// What the techniques want the performer to know since the last call, prefixed by node id.
+    pub fn take_messages(&mut self) -> Vec<String> {
+        let ids = self.scene.nodes.iter().map(|n| n.id.as_str());
+        self.nodes
+            .iter_mut()
+            .zip(ids)
+            .flat_map(|(n, id)| n.take_messages().into_iter().map(move |m| format!("{id}: {m}")))
+            .collect()
+    }
+
+    /// Writes that fire every trigger parameter called `name` (e.g. R fires every `reset`).
+    pub fn fire_all(&self, name: &str, source: Source) -> Vec<ControlEvent> {
+        let mut events = Vec::new();
+        for (node, params) in self.params.iter().enumerate() {
+            if let Some(param) =
+                params.index(name).filter(|&p| params.decls()[p].ty() == crate::params::ParamType::Trigger)
+            {
+                events.push(ControlEvent::Write(ParamWrite {
+                    node,
+                    param,
+                    component: None,
+                    value: ParamValue::Trigger(true),
+                    source,
+                }));
+            }
+        }
+        events
+    }
+
     /// Declares this frame: every node adds its passes, the output node's texture is the output.
     pub fn build_graph(&mut self, output_size: (u32, u32), time: &FrameTime) -> FrameGraph<'_> {
         let mut graph = FrameGraph::new(output_size);

@@ -5,6 +5,7 @@
 //! To add a technique: write `src/techniques/<name>/`, `shaders/<name>.wgsl` and
 //! `scenes/<name>.ron`, then add its `INFO` to [`REGISTRY`]. Nothing else.
 
+pub mod cloth;
 pub mod cube_field;
 pub mod kleinian;
 pub mod star_glow;
@@ -16,7 +17,7 @@ use crate::params::{ParamDecl, ParamSet};
 use crate::time::FrameTime;
 
 /// Every technique indra knows, by scene name.
-pub const REGISTRY: &[TechniqueInfo] = &[kleinian::INFO, star_glow::INFO, cube_field::INFO];
+pub const REGISTRY: &[TechniqueInfo] = &[kleinian::INFO, star_glow::INFO, cube_field::INFO, cloth::INFO];
 
 /// Finds a technique by the name scenes use.
 pub fn find(name: &str) -> Option<&'static TechniqueInfo> {
@@ -69,6 +70,11 @@ impl NodeSetup<'_> {
 pub trait Technique {
     /// Advances the simulation by one fixed step (no-op for stateless techniques).
     fn step(&mut self, _params: &ParamSet, _time: &FrameTime) {}
+
+    /// Things to tell the performer since the last call (e.g. "the cloth blew up and was reset").
+    fn take_messages(&mut self) -> Vec<String> {
+        Vec::new()
+    }
 
     /// Adds this frame's passes; returns the texture downstream nodes (or the output) see.
     fn add_passes<'r>(

@@ -1,0 +1,226 @@
+//! GPU cloth: a grid of particles with 12 springs each, the book's mass-spring Verlet model or
+//! small-step XPBD, colliding with an oscillating sphere; drawn lit and two-sided, or as particles
+//! and springs. Simulation state lives in node-owned storage buffers imported into the graph;
+//! `step` queues fixed steps and `add_passes` records them, so all GPU work is timed by the graph.
+//!
+//! Book: [UGP4 ch.3] "GPU-Based Cloth Simulation" (oishi); [Macklin 2019] "Small Steps in Physics
+//! Simulation". Shaders: `shaders/cloth.wgsl`, `shaders/cloth_render.wgsl`.
+//! Goldens: `tests/golden/cloth*.png`.
+
+mod params;
+pub mod reference;
+mod render;
+mod state;
+
+pub use params::{ClothUniforms, PIN_MODES, SOLVERS, VIEWS, params, rest_pose, sphere_center, wind_force};
+use render::{ClothView, Renderer};
+use state::State;
+
+use crate::gpu::{ComputeKernel, ShaderError};
+use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
+use crate::params::ParamSet;
+use crate::time::{FrameTime, MAX_CATCH_UP_STEPS};
+
+use super::{NodeSetup, Technique, TechniqueInfo};
+
+/// The registry entry.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "cloth",
+    chapter: "3: GPU-Based Cloth Simulation",
+    summary: "mass-spring (Verlet) or XPBD cloth on the GPU with a colliding sphere",
+    params,
+    inputs: &[],
+    shaders: &["cloth.wgsl", "cloth_render.wgsl"],
+    create,
+};
+
+/// The colour target format.
+pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The simulation pipelines and the layout they share.
+struct Kernels {
+    verlet: ComputeKernel,
+    predict: ComputeKernel,
+    project: ComputeKernel,
+    normals: ComputeKernel,
+    layout: wgpu::BindGroupLayout,
+}
+
+/// A cloth node.
+pub struct Cloth {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    kernels: Kernels,
+    renderer: Renderer,
+    /// One uniform buffer per clock step a frame may run.
+    uniforms: Vec<wgpu::Buffer>,
+    state: Option<State>,
+    /// Steps queued by `step`, recorded by the next `add_passes`.
+    pending: Vec<ClothUniforms>,
+    messages: Vec<String>,
+}
+
+fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
+    Ok(Box::new(Cloth::new(setup)?))
+}
+
+impl Cloth {
+    /// Builds the pipelines; buffers are made on the first step, at the resolution asked for.
+    pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
+        let device = &setup.gpu.device;
+        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cloth_sim_layout"),
+            entries: &[
+                crate::gpu::uniform_entry::<ClothUniforms>(0, wgpu::ShaderStages::COMPUTE),
+                storage(1, true),
+                storage(2, true),
+                storage(3, false),
+                storage(4, false),
+                storage(5, false),
+            ],
+        });
+        let (origin, source) = setup.shader_source("cloth.wgsl")?;
+        let kernel = |entry| ComputeKernel::new(device, &origin, &source, entry, &[&layout]);
+        let kernels = Kernels {
+            verlet: kernel("verlet")?,
+            predict: kernel("predict")?,
+            project: kernel("project")?,
+            normals: kernel("compute_normals")?,
+            layout,
+        };
+        let renderer = Renderer::new(setup)?;
+        let uniforms = (0..MAX_CATCH_UP_STEPS.max(1))
+            .map(|_| crate::gpu::uniform_buffer::<ClothUniforms>(device, "cloth_uniforms"))
+            .collect();
+        Ok(Self {
+            device: device.clone(),
+            queue: setup.gpu.queue.clone(),
+            kernels,
+            renderer,
+            uniforms,
+            state: None,
+            pending: Vec::new(),
+            messages: Vec::new(),
+        })
+    }
+
+    /// Reads the current particle positions back (blocking; for tests and tools).
+    pub fn positions(&self) -> Vec<[f32; 4]> {
+        self.state.as_ref().map(|s| s.read_positions(&self.device, &self.queue)).unwrap_or_default()
+    }
+
+    /// (Re)creates the buffers if the resolution or pinning changed, or a reset was asked for.
+    fn ensure_state(&mut self, p: &ParamSet) {
+        let res = p.int("resolution").clamp(4, 1024) as u32;
+        let pin = p.choice("pin");
+        let fresh = self.state.as_ref().is_none_or(|s| s.res != res || s.pin != pin);
+        if fresh {
+            self.state = Some(State::new(&self.device, &self.kernels.layout, &self.renderer, res, pin));
+        }
+        if fresh || p.fired("reset") {
+            let pose = rest_pose(res, p.float("rest_length"), p.float("mass"), pin);
+            self.state.as_mut().expect("just made").reset(&self.queue, &pose);
+        }
+    }
+}
+
+impl Technique for Cloth {
+    fn step(&mut self, params: &ParamSet, time: &FrameTime) {
+        self.ensure_state(params);
+        let state = self.state.as_mut().expect("ensured");
+        if state.nan.poll(&state.status_readback) {
+            self.messages.push("cloth: the simulation blew up (a position became NaN or infinite); reset to the rest pose — lower the time step or stiffness, or add substeps".into());
+            let pose = rest_pose(state.res, params.float("rest_length"), params.float("mass"), state.pin);
+            state.reset(&self.queue, &pose);
+            self.pending.clear();
+        }
+        if self.pending.len() == self.uniforms.len() {
+            self.pending.remove(0);
+        }
+        self.pending.push(ClothUniforms::from_params(params, time, state.res));
+    }
+
+    fn take_messages(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.messages)
+    }
+
+    fn add_passes<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        params: &ParamSet,
+        time: &FrameTime,
+        _inputs: &[TextureHandle],
+    ) -> TextureHandle {
+        self.ensure_state(params);
+        // CPU work first: buffer rotation, bind groups and uniforms for every substep.
+        let substeps = params.int("substeps").clamp(1, 64) as u32;
+        let steps = std::mem::take(&mut self.pending);
+        for (slot, u) in steps.iter().enumerate() {
+            self.queue.write_buffer(&self.uniforms[slot], 0, bytemuck::bytes_of(u));
+        }
+        let state = self.state.as_mut().expect("ensured");
+        let dispatches = state.plan(&self.device, &self.kernels.layout, &self.uniforms, &steps, substeps);
+        let (w, h) = graph.output_size();
+        let view = ClothView::from_params(params, time, w as f32 / h as f32);
+        self.renderer.prepare(&self.device, &self.queue, state, &view, params.choice("view") == 1);
+        let this: &'r Cloth = self;
+        let state = this.state.as_ref().expect("ensured");
+
+        let particles = state.import(graph);
+        let count = state.res * state.res;
+        let mut sim = graph.add_pass("cloth/simulate").side_effect();
+        for &b in &particles {
+            sim = sim.write_buffer(b);
+        }
+        sim.record(move |ctx| {
+            let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("cloth/simulate"),
+                timestamp_writes: None,
+            });
+            for d in &dispatches {
+                let kernel = match d.kernel {
+                    state::Kernel::Verlet => &this.kernels.verlet,
+                    state::Kernel::Predict => &this.kernels.predict,
+                    state::Kernel::Project => &this.kernels.project,
+                };
+                kernel.dispatch(&mut pass, &[&state.bind_groups[&d.key]], [count, 1, 1]);
+            }
+            drop(pass);
+            state.nan.after_simulate(ctx.encoder, &state.status, &state.status_readback);
+        });
+        let normals = graph.import_buffer("cloth/normals", &state.normals, state.normals_id);
+        let cur = particles[state.cur];
+        graph.add_pass("cloth/normals").read_buffer(cur).write_buffer(normals).record(move |ctx| {
+            let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("cloth/normals"),
+                timestamp_writes: None,
+            });
+            this.kernels.normals.dispatch(&mut pass, &[&state.bind_groups[&state.normals_key()]], [count, 1, 1]);
+        });
+        let color = graph.create_texture("cloth/image", TextureDesc::full(FORMAT));
+        let depth = graph.create_texture("cloth/depth", TextureDesc::full(render::DEPTH));
+        let debug = params.choice("view") == 1;
+        let background = view.background;
+        graph
+            .add_pass("cloth/draw")
+            .read_buffer(cur)
+            .read_buffer(normals)
+            .render_target(color)
+            .render_target(depth)
+            .record(move |ctx| this.renderer.draw(ctx, state, color, depth, background, debug));
+        color
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,175 @@
+//! Cloth parameters and the uniform block built from them.
+
+use crate::params::{ParamDecl, ParamSet, ParamValue};
+use crate::time::FrameTime;
+
+/// Solvers, in the order of the `solver` enum parameter.
+pub const SOLVERS: [&str; 2] = ["Verlet", "XPBD"];
+/// Pin modes, in the order of the `pin` enum parameter.
+pub const PIN_MODES: [&str; 3] = ["TopRow", "TwoCorners", "None"];
+/// Views, in the order of the `view` enum parameter.
+pub const VIEWS: [&str; 2] = ["Lit", "Debug"];
+
+/// Parameters with the sample's C# defaults (seed-reference §3). The sample's `TimeStep` is the
+/// scene's fixed `dt`: each clock step simulates exactly dt seconds in `substeps` parts.
+pub fn params() -> Vec<ParamDecl> {
+    use ParamValue::*;
+    vec![
+        ParamDecl::choice(
+            "solver",
+            &SOLVERS,
+            0,
+            "Verlet: the book's mass-spring model; XPBD: stiff small-step constraints",
+        ),
+        ParamDecl::new("resolution", Int(128), Some((4.0, 1024.0)), "particles per side (changing it resets)"),
+        ParamDecl::new(
+            "substeps",
+            Int(4),
+            Some((1.0, 64.0)),
+            "solver steps per clock step (the sample's VerletIterationNum)",
+        ),
+        ParamDecl::new("rest_length", Float(0.02), Some((0.001, 1.0)), "structural spring length").with_unit("m"),
+        ParamDecl::new("stiffness", Float(10000.0), Some((1.0, 1e7)), "Verlet spring constant").with_unit("N/m"),
+        ParamDecl::new(
+            "damping",
+            Float(0.996),
+            Some((0.0, 100.0)),
+            "velocity damping coefficient, applied once per particle (the sample applied it per neighbour)",
+        )
+        .with_unit("kg/s"),
+        ParamDecl::new("compliance", Float(0.0), Some((0.0, 1.0)), "XPBD inverse stiffness; 0 = inextensible")
+            .with_unit("m/N"),
+        ParamDecl::new("mass", Float(1.0), Some((0.001, 100.0)), "mass per particle").with_unit("kg"),
+        ParamDecl::new("gravity", Vec3([0.0, -9.81, 0.0]), Some((-100.0, 100.0)), "gravity").with_unit("m/s²"),
+        ParamDecl::choice("pin", &PIN_MODES, 0, "which particles are fixed"),
+        ParamDecl::new("sphere", Bool(true), None, "collide with the sphere"),
+        ParamDecl::new("sphere_center", Vec3([0.0, 0.0, 0.0]), Some((-50.0, 50.0)), "sphere centre at rest"),
+        ParamDecl::new("sphere_radius", Float(1.01), Some((0.01, 20.0)), "sphere radius").with_unit("m"),
+        ParamDecl::new("sphere_travel", Float(4.0), Some((0.0, 50.0)), "amplitude of the sphere's z oscillation")
+            .with_unit("m"),
+        ParamDecl::new(
+            "sphere_speed",
+            Float(0.125),
+            Some((0.0, 10.0)),
+            "angular speed of the oscillation (the sample's 0.125 ≈ 50 s period)",
+        )
+        .with_unit("rad/s"),
+        ParamDecl::new("wind", Vec3([0.0, 0.0, 1.0]), Some((-1.0, 1.0)), "wind direction"),
+        ParamDecl::new("wind_strength", Float(0.0), Some((0.0, 100.0)), "wind force per particle").with_unit("N"),
+        ParamDecl::new("wind_gust", Float(0.5), Some((0.0, 1.0)), "how much the wind varies (smooth noise)"),
+        ParamDecl::choice("view", &VIEWS, 0, "lit surface, or particles and springs"),
+        ParamDecl::new("color", Color([0.0, 0.273, 1.0, 1.0]), None, "cloth colour"),
+        ParamDecl::new("sphere_color", Color([1.0, 0.1, 0.1, 1.0]), None, "sphere colour"),
+        ParamDecl::new(
+            "background",
+            Color([0.19, 0.3, 0.47, 1.0]),
+            None,
+            "background colour (Unity's default sky blue)",
+        ),
+        ParamDecl::new("light_dir", Vec3([-0.3, 0.6, -0.75]), Some((-1.0, 1.0)), "direction towards the light"),
+        ParamDecl::new("camera_distance", Float(10.0), Some((0.5, 100.0)), "camera distance in front of the cloth")
+            .with_unit("m"),
+        ParamDecl::new("fov", Float(60.0), Some((5.0, 120.0)), "vertical field of view").with_unit("°"),
+        ParamDecl::trigger("reset", "put the cloth back to its rest pose (R in the window)"),
+    ]
+}
+
+/// The simulation shader's uniform block.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ClothUniforms {
+    /// Particles per side.
+    pub res: u32,
+    /// res².
+    pub count: u32,
+    /// 0 Verlet, 1 XPBD.
+    pub solver: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Substep length.
+    pub dt: f32,
+    /// Structural rest length.
+    pub rest: f32,
+    /// Verlet k.
+    pub stiffness: f32,
+    /// Damping.
+    pub damping: f32,
+    /// Particle mass.
+    pub mass: f32,
+    /// XPBD compliance.
+    pub compliance: f32,
+    /// Sphere radius (0: none).
+    pub sphere_radius: f32,
+    /// Padding.
+    pub _pad1: f32,
+    /// Gravity + wind / mass.
+    pub acceleration: [f32; 4],
+    /// Sphere centre.
+    pub sphere: [f32; 4],
+}
+
+impl ClothUniforms {
+    /// The uniforms of the substeps that advance from `time` by one clock step.
+    pub fn from_params(p: &ParamSet, time: &FrameTime, res: u32) -> Self {
+        let substeps = p.int("substeps").clamp(1, 64) as f32;
+        let mass = p.float("mass");
+        let g = p.get("gravity").components();
+        let wind = wind_force(p, time.seconds);
+        Self {
+            res,
+            count: res * res,
+            solver: p.choice("solver"),
+            _pad0: 0,
+            dt: time.dt / substeps,
+            rest: p.float("rest_length"),
+            stiffness: p.float("stiffness"),
+            damping: p.float("damping"),
+            mass,
+            compliance: p.float("compliance"),
+            sphere_radius: if p.bool("sphere") { p.float("sphere_radius") } else { 0.0 },
+            _pad1: 0.0,
+            acceleration: [g[0] + wind[0] / mass, g[1] + wind[1] / mass, g[2] + wind[2] / mass, 0.0],
+            sphere: {
+                let c = sphere_center(p, time.seconds);
+                [c[0], c[1], c[2], 0.0]
+            },
+        }
+    }
+}
+
+/// The sphere's centre at clock time `seconds`: it oscillates along z as in the sample.
+pub fn sphere_center(p: &ParamSet, seconds: f64) -> [f32; 3] {
+    let c = p.get("sphere_center").components();
+    let z = c[2] + (f64::from(p.float("sphere_speed")) * seconds).cos() as f32 * p.float("sphere_travel");
+    [c[0], c[1], z]
+}
+
+/// Wind force at clock time `seconds`: direction × strength × (1 + gust × smooth noise), the
+/// noise a sum of incommensurate sines (deterministic, no state).
+pub fn wind_force(p: &ParamSet, seconds: f64) -> [f32; 3] {
+    let d = p.get("wind").components();
+    let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(1e-6);
+    let t = seconds;
+    let noise = ((t * 1.3).sin() * 0.5 + (t * 2.9 + 1.0).sin() * 0.3 + (t * 7.1 + 2.0).sin() * 0.2) as f32;
+    let s = p.float("wind_strength") * (1.0 + p.float("wind_gust") * noise);
+    [d[0] / len * s, d[1] / len * s, d[2] / len * s]
+}
+
+/// The rest pose: particle (i, j) at ((i − (res−1)/2)·rest, ((res−1)/2 − j)·rest, 0), row 0 on
+/// top (centred on the grid, not off by half a spacing as in the sample), with w = inverse mass
+/// and 0 for pinned particles.
+pub fn rest_pose(res: u32, rest: f32, mass: f32, pin: u32) -> Vec<[f32; 4]> {
+    let half = (res - 1) as f32 / 2.0;
+    let inverse_mass = 1.0 / mass;
+    (0..res * res)
+        .map(|k| {
+            let (i, j) = (k % res, k / res);
+            let pinned = match pin {
+                0 => j == 0,
+                1 => j == 0 && (i == 0 || i == res - 1),
+                _ => false,
+            };
+            [(i as f32 - half) * rest, (half - j as f32) * rest, 0.0, if pinned { 0.0 } else { inverse_mass }]
+        })
+        .collect()
+}

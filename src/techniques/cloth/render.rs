@@ -1,0 +1,271 @@
+//! Drawing the cloth: the lit two-sided surface and the sphere, or the debug view.
+
+use super::state::State;
+use crate::gpu::ShaderError;
+use crate::graph::{PassContext, TextureHandle};
+use crate::params::ParamSet;
+use crate::techniques::{NodeSetup, srgb_to_linear};
+use crate::time::FrameTime;
+
+/// Depth format of the draw pass.
+pub const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+const SPHERE_VERTICES: u32 = 32 * 16 * 6;
+
+/// The render shader's uniform block.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ClothViewUniforms {
+    /// Projection × view.
+    pub view_proj: [[f32; 4]; 4],
+    /// Camera position.
+    pub camera: [f32; 4],
+    /// Towards the light, unit.
+    pub light_dir: [f32; 4],
+    /// Linear cloth colour.
+    pub color: [f32; 4],
+    /// Linear sphere colour.
+    pub sphere_color: [f32; 4],
+    /// Sphere centre and radius (0: not drawn).
+    pub sphere: [f32; 4],
+}
+
+/// What one frame's draw needs from the parameters.
+pub struct ClothView {
+    /// The uniform block.
+    pub uniforms: ClothViewUniforms,
+    /// Linear clear colour.
+    pub background: wgpu::Color,
+}
+
+fn linear(c: [f32; 4]) -> [f32; 4] {
+    [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3]]
+}
+
+impl ClothView {
+    /// Camera at (0, 0, −distance) looking down +z, y up (the sample's camera at (0, 0, −10)).
+    pub fn from_params(p: &ParamSet, time: &FrameTime, aspect: f32) -> Self {
+        let eye = glam::Vec3::new(0.0, 0.0, -p.float("camera_distance"));
+        let proj = glam::camera::lh::proj::directx::perspective(p.float("fov").to_radians(), aspect, 0.05, 500.0);
+        let view = glam::camera::lh::view::look_to_mat4(eye, glam::Vec3::Z, glam::Vec3::Y);
+        let l = p.get("light_dir").components();
+        let light = glam::Vec3::new(l[0], l[1], l[2]).normalize_or(glam::Vec3::NEG_Z);
+        let c = super::sphere_center(p, time.seconds);
+        let radius = if p.bool("sphere") { p.float("sphere_radius") } else { 0.0 };
+        let b = linear(p.color("background"));
+        Self {
+            uniforms: ClothViewUniforms {
+                view_proj: (proj * view).to_cols_array_2d(),
+                camera: [eye.x, eye.y, eye.z, 1.0],
+                light_dir: [light.x, light.y, light.z, 0.0],
+                color: linear(p.color("color")),
+                sphere_color: linear(p.color("sphere_color")),
+                sphere: [c[0], c[1], c[2], radius],
+            },
+            background: wgpu::Color { r: f64::from(b[0]), g: f64::from(b[1]), b: f64::from(b[2]), a: 1.0 },
+        }
+    }
+}
+
+/// The draw pipelines and their uniform buffer.
+pub struct Renderer {
+    surface: wgpu::RenderPipeline,
+    sphere: wgpu::RenderPipeline,
+    lines: wgpu::RenderPipeline,
+    points: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    uniform: wgpu::Buffer,
+    draw_sphere: std::cell::Cell<bool>,
+}
+
+impl Renderer {
+    /// Builds the four pipelines from `shaders/cloth_render.wgsl`.
+    pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
+        let device = &setup.gpu.device;
+        let (origin, source) = setup.shader_source("cloth_render.wgsl")?;
+        let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
+        let storage = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::VERTEX,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cloth_draw_layout"),
+            entries: &[
+                crate::gpu::uniform_entry::<ClothViewUniforms>(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
+                storage(1),
+                storage(2),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("cloth_draw_pipeline_layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let pipeline = |vs: &str, fs: &str, topology| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(vs),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some(vs),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(fs),
+                    compilation_options: Default::default(),
+                    targets: &[Some(super::FORMAT.into())],
+                }),
+                primitive: wgpu::PrimitiveState { topology, ..Default::default() },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let surface = pipeline("vs_surface", "fs_surface", wgpu::PrimitiveTopology::TriangleList);
+        let sphere = pipeline("vs_sphere", "fs_sphere", wgpu::PrimitiveTopology::TriangleList);
+        let lines = pipeline("vs_debug", "fs_debug", wgpu::PrimitiveTopology::LineList);
+        let points = pipeline("vs_debug", "fs_debug", wgpu::PrimitiveTopology::PointList);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(ShaderError { origin, line: 1, column: 1, message: e.to_string() });
+        }
+        let uniform = crate::gpu::uniform_buffer::<ClothViewUniforms>(device, "cloth_view");
+        Ok(Self { surface, sphere, lines, points, layout, uniform, draw_sphere: std::cell::Cell::new(true) })
+    }
+
+    /// Two triangles per grid cell, shared vertices: indices are particle numbers.
+    pub fn surface_indices(&self, device: &wgpu::Device, res: u32) -> (wgpu::Buffer, u32) {
+        let mut indices = Vec::with_capacity(((res - 1) * (res - 1) * 6) as usize);
+        for j in 0..res - 1 {
+            for i in 0..res - 1 {
+                let a = j * res + i;
+                indices.extend_from_slice(&[a, a + 1, a + res, a + 1, a + res + 1, a + res]);
+            }
+        }
+        (index_buffer(device, "cloth_surface_indices", &indices), indices.len() as u32)
+    }
+
+    /// Writes this frame's view uniforms and makes the bind groups and buffers the draw needs.
+    pub fn prepare(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        state: &mut State,
+        view: &ClothView,
+        debug: bool,
+    ) {
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&view.uniforms));
+        self.draw_sphere.set(view.uniforms.sphere[3] > 0.0);
+        let cur = state.cur;
+        let (buffer, normals) = (state.particles()[cur].clone(), state.normals.clone());
+        state.draw_groups.entry(cur).or_insert_with(|| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("cloth_draw_bind_group"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: self.uniform.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: normals.as_entire_binding() },
+                ],
+            })
+        });
+        if debug && state.lines.is_none() {
+            state.lines = Some(spring_lines(device, state.res));
+        }
+    }
+
+    /// Records the draw into `color` and `depth`.
+    pub fn draw(
+        &self,
+        ctx: &mut PassContext<'_>,
+        state: &State,
+        color: TextureHandle,
+        depth: TextureHandle,
+        clear: wgpu::Color,
+        debug: bool,
+    ) {
+        let (color_view, depth_view) = (ctx.view(color).clone(), ctx.view(depth).clone());
+        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("cloth/draw"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &color_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        pass.set_bind_group(0, &state.draw_groups[&state.cur], &[]);
+        match (&state.lines, debug) {
+            (Some((lines, ranges)), true) => {
+                pass.set_pipeline(&self.lines);
+                pass.set_index_buffer(lines.slice(..), wgpu::IndexFormat::Uint32);
+                for (kind, range) in ranges.iter().enumerate() {
+                    pass.draw_indexed(range.clone(), 0, kind as u32..kind as u32 + 1);
+                }
+                pass.set_pipeline(&self.points);
+                pass.draw(0..state.res * state.res, 3..4);
+            }
+            _ => {
+                pass.set_pipeline(&self.surface);
+                pass.set_index_buffer(state.surface_indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..state.surface_count, 0, 0..1);
+                if self.draw_sphere.get() {
+                    pass.set_pipeline(&self.sphere);
+                    pass.draw(0..SPHERE_VERTICES, 0..1);
+                }
+            }
+        }
+    }
+}
+
+fn index_buffer(device: &wgpu::Device, label: &str, indices: &[u32]) -> wgpu::Buffer {
+    use wgpu::util::DeviceExt;
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::cast_slice(indices),
+        usage: wgpu::BufferUsages::INDEX,
+    })
+}
+
+/// Line indices of every spring, grouped by kind: structural, shear, distance-2 diagonal; each
+/// spring once, all inside the grid (the sample's debug lists ran past the border).
+fn spring_lines(device: &wgpu::Device, res: u32) -> (wgpu::Buffer, [std::ops::Range<u32>; 3]) {
+    let kinds: [&[(i32, i32)]; 3] = [&[(1, 0), (0, 1)], &[(1, 1), (-1, 1)], &[(2, 2), (-2, 2)]];
+    let mut indices = Vec::new();
+    let mut ranges: [std::ops::Range<u32>; 3] = Default::default();
+    for (k, offsets) in kinds.iter().enumerate() {
+        let start = indices.len() as u32;
+        for j in 0..res as i32 {
+            for i in 0..res as i32 {
+                for &(dx, dy) in offsets.iter() {
+                    let (ni, nj) = (i + dx, j + dy);
+                    if ni >= 0 && nj >= 0 && ni < res as i32 && nj < res as i32 {
+                        indices.extend_from_slice(&[(j * res as i32 + i) as u32, (nj * res as i32 + ni) as u32]);
+                    }
+                }
+            }
+        }
+        ranges[k] = start..indices.len() as u32;
+    }
+    (index_buffer(device, "cloth_spring_lines", &indices), ranges)
+}
