@@ -119,6 +119,11 @@ impl Cloth {
         self.state.as_ref().map(|s| s.read_positions(&self.device, &self.queue)).unwrap_or_default()
     }
 
+    /// Reads the previous positions back (blocking; for tests and tools).
+    pub fn previous_positions(&self) -> Vec<[f32; 4]> {
+        self.state.as_ref().map(|s| s.read_previous(&self.device, &self.queue)).unwrap_or_default()
+    }
+
     /// (Re)creates the buffers if the resolution or pinning changed, or a reset was asked for.
     fn ensure_state(&mut self, p: &ParamSet) {
         let res = p.int("resolution").clamp(4, 1024) as u32;

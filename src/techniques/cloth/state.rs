@@ -254,6 +254,15 @@ impl State {
 
     /// Copies the current positions to the CPU (blocking).
     pub fn read_positions(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Vec<[f32; 4]> {
+        self.read(device, queue, self.cur)
+    }
+
+    /// Copies the previous positions to the CPU (blocking).
+    pub fn read_previous(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Vec<[f32; 4]> {
+        self.read(device, queue, self.prev)
+    }
+
+    fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue, which: usize) -> Vec<[f32; 4]> {
         let size = u64::from(self.res * self.res) * 16;
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("cloth_positions_readback"),
@@ -263,7 +272,7 @@ impl State {
         });
         let mut encoder =
             device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("cloth_readback") });
-        encoder.copy_buffer_to_buffer(&self.particles[self.cur], 0, &staging, 0, size);
+        encoder.copy_buffer_to_buffer(&self.particles[which], 0, &staging, 0, size);
         queue.submit([encoder.finish()]);
         staging.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping the readback"));
         device.poll(wgpu::PollType::wait_indefinitely()).expect("device lost");

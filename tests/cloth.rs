@@ -1,0 +1,227 @@
+//! Chapter 3, GPU cloth: the simulation's invariants (pins hold, nothing inside the sphere, rest
+//! stays rest, symmetry), one GPU substep against the CPU reference, XPBD stiffness, blow-up
+//! detection and reset, determinism, and golden renders of the three scenes.
+
+mod common;
+
+use indra::graph::{FrameGraph, GraphRuntime};
+use indra::params::{ParamSet, ParamValue};
+use indra::scene::{load_scene, parse_value_override};
+use indra::techniques::cloth::{Cloth, ClothUniforms, reference, rest_pose};
+use indra::techniques::{NodeSetup, Technique};
+use indra::time::{FixedClock, FrameTime};
+
+/// A cloth node driven like the runtime drives it: step, then add_passes and execute.
+struct Rig {
+    gpu: indra::gpu::Gpu,
+    cloth: Cloth,
+    params: ParamSet,
+    runtime: GraphRuntime,
+    clock: FixedClock,
+}
+
+impl Rig {
+    fn new(settings: &[(&str, &str)], dt: f32) -> Self {
+        let gpu = common::gpu();
+        let assets = common::assets();
+        let cloth = Cloth::new(&NodeSetup { gpu: &gpu, assets: &assets, id: "cloth", output_size: (64, 64) }).unwrap();
+        let mut params = ParamSet::new(indra::techniques::cloth::params());
+        for (name, value) in [("resolution", "16"), ("rest_length", "0.1"), ("damping", "2")].iter().chain(settings) {
+            let i = params.index(name).unwrap_or_else(|| panic!("{name}"));
+            params.set_at(i, parse_value_override(value, &params.decls()[i]).unwrap());
+        }
+        params.snap();
+        let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
+        Self { gpu, cloth, params, runtime, clock: FixedClock::new(dt, 1) }
+    }
+
+    fn time(&self) -> FrameTime {
+        self.clock.now()
+    }
+
+    /// Runs `frames` fixed steps, each recorded and submitted like a frame.
+    fn run(&mut self, frames: u32) {
+        for _ in 0..frames {
+            let time = self.clock.now();
+            self.cloth.step(&self.params, &time);
+            let mut graph = FrameGraph::new((64, 64));
+            let out = self.cloth.add_passes(&mut graph, &self.params, &time, &[]);
+            graph.set_output(out);
+            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+            self.runtime.execute(&self.gpu.device, &self.gpu.queue, graph, &mut encoder).unwrap();
+            self.gpu.queue.submit([encoder.finish()]);
+            self.params.end_frame();
+            self.clock.step();
+        }
+    }
+
+    fn set(&mut self, name: &str, value: ParamValue) {
+        let i = self.params.index(name).unwrap();
+        self.params.set_at(i, value);
+    }
+}
+
+fn distance(a: [f32; 4], b: [f32; 4]) -> f32 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+#[test]
+fn pinned_particles_never_move_and_nothing_ends_inside_the_sphere() {
+    // The sphere sits in the cloth's plane, so it must push particles out every step.
+    let mut rig = Rig::new(&[("sphere_center", "0,-0.3,0.2"), ("sphere_travel", "0"), ("sphere_radius", "0.5")], 0.01);
+    let rest = rest_pose(16, 0.1, 1.0, 0);
+    for _ in 0..5 {
+        rig.run(20);
+        let p = rig.cloth.positions();
+        for i in 0..16 {
+            assert_eq!(p[i], rest[i], "pinned particle {i} moved");
+        }
+        for (i, q) in p.iter().enumerate() {
+            let d = distance(*q, [0.0, -0.3, 0.2, 0.0]);
+            assert!(d >= 0.5 - 1e-4, "particle {i} is {d} from the sphere's centre");
+        }
+    }
+}
+
+#[test]
+fn a_cloth_at_rest_stays_at_rest() {
+    for solver in ["Verlet", "XPBD"] {
+        let mut rig =
+            Rig::new(&[("gravity", "0,0,0"), ("sphere", "false"), ("wind_strength", "0"), ("solver", solver)], 0.01);
+        rig.run(60);
+        let rest = rest_pose(16, 0.1, 1.0, 0);
+        for (a, b) in rig.cloth.positions().iter().zip(&rest) {
+            assert!(distance(*a, *b) < 1e-5, "{solver}: {a:?} drifted from {b:?}");
+        }
+    }
+}
+
+#[test]
+fn a_symmetric_setup_stays_symmetric() {
+    let mut rig = Rig::new(&[("sphere_center", "0,-0.5,0.4"), ("sphere_travel", "0"), ("sphere_radius", "0.4")], 0.01);
+    rig.run(80);
+    let p = rig.cloth.positions();
+    for j in 0..16 {
+        for i in 0..16 {
+            let (a, b) = (p[j * 16 + i], p[j * 16 + 15 - i]);
+            assert!(
+                (a[0] + b[0]).abs() < 1e-3 && (a[1] - b[1]).abs() < 1e-3 && (a[2] - b[2]).abs() < 1e-3,
+                "({i}, {j}): {a:?} vs {b:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn one_gpu_substep_matches_the_cpu_reference() {
+    let mut rig = Rig::new(
+        &[
+            ("resolution", "8"),
+            ("substeps", "1"),
+            ("sphere_center", "0,-0.2,0.05"),
+            ("sphere_travel", "0"),
+            ("sphere_radius", "0.3"),
+            ("wind_strength", "2"),
+        ],
+        0.005,
+    );
+    rig.run(10); // springs stretched, particles moving, some against the sphere
+    let (prev, cur) = (rig.cloth.previous_positions(), rig.cloth.positions());
+    let u = ClothUniforms::from_params(&rig.params, &rig.time(), 8);
+    let expected = reference::verlet_step(&u, &prev, &cur);
+    rig.run(1);
+    let got = rig.cloth.positions();
+    for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
+        assert!(distance(*g, *e) < 2e-5, "particle {i}: GPU {g:?} CPU {e:?}");
+    }
+    assert!(expected.iter().zip(&cur).any(|(e, c)| distance(*e, *c) > 1e-4), "the step moved something");
+}
+
+/// Largest strain of the vertical structural springs hanging from the top row.
+fn top_row_strain(p: &[[f32; 4]], res: usize, rest: f32) -> f32 {
+    (0..res).map(|i| (distance(p[i], p[res + i]) - rest) / rest).fold(0.0, f32::max)
+}
+
+#[test]
+fn xpbd_holds_a_heavy_cloth_stiff_where_verlet_stretches() {
+    let settings = [("resolution", "32"), ("sphere", "false"), ("substeps", "16"), ("rest_length", "0.05")];
+    let mut xpbd = Rig::new(&[settings.as_slice(), &[("solver", "XPBD")]].concat(), 1.0 / 60.0);
+    xpbd.run(120);
+    let strain = top_row_strain(&xpbd.cloth.positions(), 32, 0.05);
+    assert!(strain < 0.10, "XPBD top-row strain {strain}");
+    let mut verlet =
+        Rig::new(&[settings.as_slice(), &[("solver", "Verlet"), ("stiffness", "2000")]].concat(), 1.0 / 60.0);
+    verlet.run(120);
+    let soft = top_row_strain(&verlet.cloth.positions(), 32, 0.05);
+    assert!(soft > strain * 2.0, "explicit springs of a stable stiffness stretch more: Verlet {soft} vs XPBD {strain}");
+}
+
+#[test]
+fn a_blow_up_is_detected_and_the_cloth_resets_itself() {
+    let mut rig =
+        Rig::new(&[("stiffness", "10000000"), ("substeps", "1"), ("damping", "0"), ("sphere", "false")], 0.02);
+    let mut messages = Vec::new();
+    for _ in 0..30 {
+        rig.run(1);
+        messages.extend(rig.cloth.take_messages());
+    }
+    assert!(messages.iter().any(|m| m.contains("blew up")), "{messages:?}");
+    assert!(rig.cloth.positions().iter().all(|p| p.iter().all(|c| c.is_finite())));
+}
+
+#[test]
+fn the_reset_trigger_restores_the_rest_pose() {
+    let mut rig = Rig::new(&[], 0.01);
+    rig.run(30);
+    assert_ne!(rig.cloth.positions(), rest_pose(16, 0.1, 1.0, 0));
+    rig.set("reset", ParamValue::Trigger(true));
+    rig.cloth.step(&rig.params, &rig.time());
+    assert_eq!(rig.cloth.positions(), rest_pose(16, 0.1, 1.0, 0));
+}
+
+fn golden_frames(scene: &str, frames: &[u64], sets: &[&str]) {
+    let mut s = load_scene(&common::assets(), scene).unwrap();
+    for set in sets {
+        s.set_from_str(set).unwrap();
+    }
+    let mut r =
+        indra::offscreen::OffscreenRenderer::new(common::gpu(), &common::assets(), s, Some((256, 256)), None, None)
+            .unwrap();
+    let last = *frames.iter().max().unwrap();
+    for f in 0..=last {
+        let frame = r.render_next().unwrap();
+        if frames.contains(&f) {
+            common::golden()
+                .check(&format!("{scene}_f{f:04}"), (256, 256), &frame.rgba)
+                .unwrap_or_else(|e| panic!("{e}"));
+        }
+    }
+}
+
+#[test]
+fn golden_cloth_before_and_while_the_sphere_pushes_through() {
+    golden_frames("cloth", &[100, 700], &[]);
+}
+
+#[test]
+fn golden_cloth_debug_view() {
+    golden_frames("cloth_debug", &[50, 150], &[]);
+}
+
+#[test]
+fn golden_cloth_1024_at_ci_resolution() {
+    // The scene's physics at 64² (same cloth size) so CI stays fast; 1024² runs on the H100 bench.
+    golden_frames("cloth_1024", &[20, 60], &["cloth.resolution=64", "cloth.rest_length=0.08", "cloth.mass=0.256"]);
+}
+
+#[test]
+fn same_scene_gives_the_same_bytes() {
+    let render = || {
+        let s = load_scene(&common::assets(), "cloth").unwrap();
+        let mut r =
+            indra::offscreen::OffscreenRenderer::new(common::gpu(), &common::assets(), s, Some((96, 96)), None, None)
+                .unwrap();
+        (0..40).map(|_| r.render_next().unwrap().rgba).last().unwrap()
+    };
+    assert!(render() == render());
+}
