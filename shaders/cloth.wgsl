@@ -6,8 +6,9 @@
 //   xpbd    - small-steps XPBD [Macklin et al. 2019, "Small Steps in Physics Simulation"]: predict,
 //             then one Jacobi projection of every distance constraint with compliance alpha/dt^2,
 //             corrections averaged per particle; stiff without tiny explicit time steps.
-// Positions are vec4: xyz, w = inverse mass (0 = pinned). One invocation per particle;
-// dispatched over res*res particles.
+// Positions are vec4: xyz, w = inverse mass (0 = pinned). The two kernels that read neighbours
+// run 16x16 workgroups over the res x res grid and stage a 20x20 tile (a halo of 2) in workgroup
+// memory, so each of the 12 neighbour reads is local; the others run one invocation per particle.
 
 struct ClothUniforms {
     res: u32,            // particles per side
@@ -32,12 +33,29 @@ struct ClothUniforms {
 @group(0) @binding(3) var<storage, read_write> next: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read_write> status: array<atomic<u32>>;
 
-// The 12 neighbour offsets: ring 1, then the distance-2 diagonals.
-const OFFSETS = array<vec2<i32>, 12>(
-    vec2<i32>(-1, -1), vec2<i32>(0, -1), vec2<i32>(1, -1), vec2<i32>(1, 0),
-    vec2<i32>(1, 1), vec2<i32>(0, 1), vec2<i32>(-1, 1), vec2<i32>(-1, 0),
-    vec2<i32>(-2, -2), vec2<i32>(2, -2), vec2<i32>(2, 2), vec2<i32>(-2, 2),
-);
+// The 12 neighbours: the 8-ring, then the four distance-2 diagonals (see `spring`).
+
+const TILE: u32 = 16u;
+const SPAN: u32 = 20u; // TILE + 2 halo on each side
+var<workgroup> tile: array<vec4<f32>, 400>;
+
+// Loads the workgroup's tile (clamped at the grid border) from `cur`. Call from uniform control
+// flow: every invocation takes part before any returns.
+fn load_tile(local: u32, group: vec2<u32>) -> vec2<i32> {
+    let origin = vec2<i32>(group * TILE) - vec2<i32>(2);
+    let last = vec2<i32>(i32(u.res) - 1);
+    for (var k = local; k < SPAN * SPAN; k = k + TILE * TILE) {
+        let c = clamp(origin + vec2<i32>(i32(k % SPAN), i32(k / SPAN)), vec2<i32>(0), last);
+        tile[k] = cur[u32(c.y) * u.res + u32(c.x)];
+    }
+    workgroupBarrier();
+    return origin;
+}
+
+fn from_tile(c: vec2<i32>, origin: vec2<i32>) -> vec4<f32> {
+    let t = c - origin;
+    return tile[u32(t.y) * SPAN + u32(t.x)];
+}
 
 fn coord(i: u32) -> vec2<i32> {
     return vec2<i32>(i32(i % u.res), i32(i / u.res));
@@ -49,6 +67,37 @@ fn inside(c: vec2<i32>) -> bool {
 
 fn index(c: vec2<i32>) -> u32 {
     return u32(c.y) * u.res + u32(c.x);
+}
+
+const SQRT2: f32 = 1.41421356;
+const SQRT8: f32 = 2.82842712;
+
+// Verlet: the force of the spring to neighbour c + offset (zero outside the grid). Called once
+// per neighbour with constant arguments: a dynamically indexed constant array would be copied to
+// per-invocation memory by the SPIR-V backend.
+fn spring(x: vec3<f32>, c: vec2<i32>, origin: vec2<i32>, offset: vec2<i32>, factor: f32) -> vec3<f32> {
+    let nc = c + offset;
+    if (!inside(nc)) {
+        return vec3<f32>(0.0);
+    }
+    let d = from_tile(nc, origin).xyz - x;
+    let len = length(d);
+    return u.stiffness * (len - factor * u.rest) * d / max(len, 1e-9);
+}
+
+// XPBD: this particle's correction from the constraint to neighbour c + offset (xyz), and 1 in w
+// if the constraint exists.
+fn constraint(x: vec4<f32>, c: vec2<i32>, origin: vec2<i32>, offset: vec2<i32>, factor: f32, alpha: f32) -> vec4<f32> {
+    let nc = c + offset;
+    if (!inside(nc)) {
+        return vec4<f32>(0.0);
+    }
+    let other = from_tile(nc, origin);
+    let d = x.xyz - other.xyz;
+    let len = length(d);
+    // Delta lambda from zero (one iteration per small step), applied to this particle only.
+    let lambda = -(len - factor * u.rest) / (x.w + other.w + alpha);
+    return vec4<f32>(x.w * lambda * d / max(len, 1e-9), 1.0);
 }
 
 // Pushes p out of the sphere onto its surface.
@@ -69,30 +118,32 @@ fn check(p: vec3<f32>) {
     }
 }
 
-@compute @workgroup_size(256, 1, 1)
-fn verlet(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
-    if (i >= u.count) {
+@compute @workgroup_size(16, 16, 1)
+fn verlet(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+    @builtin(workgroup_id) group: vec3<u32>,
+) {
+    let origin = load_tile(local, group.xy);
+    let c = vec2<i32>(id.xy);
+    if (any(id.xy >= vec2<u32>(u.res))) {
         return;
     }
-    let x = cur[i];
+    let i = index(c);
+    let x = from_tile(c, origin);
     if (x.w == 0.0) {
         next[i] = x;
         return;
     }
-    let c = coord(i);
     let v = (x.xyz - prev[i].xyz) / u.dt;
     var force = u.acceleration.xyz * u.mass - u.damping * v;
-    for (var k = 0; k < 12; k = k + 1) {
-        let nc = c + OFFSETS[k];
-        if (!inside(nc)) {
-            continue;
-        }
-        let d = cur[index(nc)].xyz - x.xyz;
-        let len = length(d);
-        let rest = length(vec2<f32>(OFFSETS[k])) * u.rest;
-        force += u.stiffness * (len - rest) * d / max(len, 1e-9);
-    }
+    let p0 = x.xyz;
+    force += spring(p0, c, origin, vec2<i32>(-1, -1), SQRT2) + spring(p0, c, origin, vec2<i32>(0, -1), 1.0);
+    force += spring(p0, c, origin, vec2<i32>(1, -1), SQRT2) + spring(p0, c, origin, vec2<i32>(1, 0), 1.0);
+    force += spring(p0, c, origin, vec2<i32>(1, 1), SQRT2) + spring(p0, c, origin, vec2<i32>(0, 1), 1.0);
+    force += spring(p0, c, origin, vec2<i32>(-1, 1), SQRT2) + spring(p0, c, origin, vec2<i32>(-1, 0), 1.0);
+    force += spring(p0, c, origin, vec2<i32>(-2, -2), SQRT8) + spring(p0, c, origin, vec2<i32>(2, -2), SQRT8);
+    force += spring(p0, c, origin, vec2<i32>(2, 2), SQRT8) + spring(p0, c, origin, vec2<i32>(-2, 2), SQRT8);
     let p = collide(2.0 * x.xyz - prev[i].xyz + force / u.mass * u.dt * u.dt);
     check(p);
     next[i] = vec4<f32>(p, x.w);
@@ -117,38 +168,32 @@ fn predict(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // XPBD step 2: one Jacobi projection of the 12 distance constraints of each particle, reading
 // the predicted positions (bound as `cur`) and writing the projected ones; then collision.
-@compute @workgroup_size(256, 1, 1)
-fn project(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
-    if (i >= u.count) {
+@compute @workgroup_size(16, 16, 1)
+fn project(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(local_invocation_index) local: u32,
+    @builtin(workgroup_id) group: vec3<u32>,
+) {
+    let origin = load_tile(local, group.xy);
+    let c = vec2<i32>(id.xy);
+    if (any(id.xy >= vec2<u32>(u.res))) {
         return;
     }
-    let x = cur[i];
+    let i = index(c);
+    let x = from_tile(c, origin);
     if (x.w == 0.0) {
         next[i] = x;
         return;
     }
-    let c = coord(i);
     let alpha = u.compliance / (u.dt * u.dt);
-    var correction = vec3<f32>(0.0);
-    var n = 0.0;
-    for (var k = 0; k < 12; k = k + 1) {
-        let nc = c + OFFSETS[k];
-        if (!inside(nc)) {
-            continue;
-        }
-        let other = cur[index(nc)];
-        let d = x.xyz - other.xyz;
-        let len = length(d);
-        let rest = length(vec2<f32>(OFFSETS[k])) * u.rest;
-        let w = x.w + other.w;
-        // Delta lambda from zero (one iteration per small step), applied to this particle only.
-        let lambda = -(len - rest) / (w + alpha);
-        correction += x.w * lambda * d / max(len, 1e-9);
-        n += 1.0;
-    }
+    var sum = constraint(x, c, origin, vec2<i32>(-1, -1), SQRT2, alpha) + constraint(x, c, origin, vec2<i32>(0, -1), 1.0, alpha);
+    sum += constraint(x, c, origin, vec2<i32>(1, -1), SQRT2, alpha) + constraint(x, c, origin, vec2<i32>(1, 0), 1.0, alpha);
+    sum += constraint(x, c, origin, vec2<i32>(1, 1), SQRT2, alpha) + constraint(x, c, origin, vec2<i32>(0, 1), 1.0, alpha);
+    sum += constraint(x, c, origin, vec2<i32>(-1, 1), SQRT2, alpha) + constraint(x, c, origin, vec2<i32>(-1, 0), 1.0, alpha);
+    sum += constraint(x, c, origin, vec2<i32>(-2, -2), SQRT8, alpha) + constraint(x, c, origin, vec2<i32>(2, -2), SQRT8, alpha);
+    sum += constraint(x, c, origin, vec2<i32>(2, 2), SQRT8, alpha) + constraint(x, c, origin, vec2<i32>(-2, 2), SQRT8, alpha);
     // Averaging keeps the Jacobi sum from overshooting (Bridson et al. 2003 style).
-    let p = collide(x.xyz + correction * (1.5 / max(n, 1.0)));
+    let p = collide(x.xyz + sum.xyz * (1.5 / max(sum.w, 1.0)));
     check(p);
     next[i] = vec4<f32>(p, x.w);
 }

@@ -192,13 +192,15 @@ impl Technique for Cloth {
                 label: Some("cloth/simulate"),
                 timestamp_writes: None,
             });
+            // The neighbour kernels run over the 2-D grid (tiled); prediction per particle.
+            let (grid, flat) = ([state.res, state.res, 1], [count, 1, 1]);
             for d in &dispatches {
-                let kernel = match d.kernel {
-                    state::Kernel::Verlet => &this.kernels.verlet,
-                    state::Kernel::Predict => &this.kernels.predict,
-                    state::Kernel::Project => &this.kernels.project,
+                let (kernel, threads) = match d.kernel {
+                    state::Kernel::Verlet => (&this.kernels.verlet, grid),
+                    state::Kernel::Predict => (&this.kernels.predict, flat),
+                    state::Kernel::Project => (&this.kernels.project, grid),
                 };
-                kernel.dispatch(&mut pass, &[&state.bind_groups[&d.key]], [count, 1, 1]);
+                kernel.dispatch(&mut pass, &[&state.bind_groups[&d.key]], threads);
             }
             drop(pass);
             state.nan.after_simulate(ctx.encoder, &state.status, &state.status_readback);
