@@ -5,10 +5,10 @@
 
 struct ClothView {
     view_proj: mat4x4<f32>,
-    camera: vec4<f32>,       // camera position (xyz)
+    camera: vec4<f32>,       // camera position (xyz), half the cloth's rest width (w)
     light_dir: vec4<f32>,    // towards the light (xyz, unit)
     color: vec4<f32>,        // linear cloth colour
-    sphere_color: vec4<f32>, // linear sphere colour
+    sphere_color: vec4<f32>, // linear sphere colour (rgb), output aspect (w)
     sphere: vec4<f32>,       // centre (xyz), radius (w)
 };
 
@@ -103,4 +103,42 @@ fn vs_debug(@builtin(vertex_index) particle: u32, @builtin(instance_index) kind:
 @fragment
 fn fs_debug(in: Flat) -> @location(0) vec4<f32> {
     return in.color;
+}
+
+// Debug insets: the position buffer (xyz mapped from the cloth's rest extent to colour) and the
+// normal buffer (n * 0.5 + 0.5), each as a res x res image in the top-left corner of the view.
+// Instance 0 draws positions, instance 1 normals.
+struct Inset {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+    @location(1) @interpolate(flat) which: u32,
+};
+
+@vertex
+fn vs_inset(@builtin(vertex_index) index: u32, @builtin(instance_index) which: u32) -> Inset {
+    let corner = array<vec2<f32>, 6>(
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 1.0), vec2<f32>(0.0, 1.0),
+    )[index];
+    // Each inset is 0.4 clip units high, square in pixels, stacked left to right from the corner.
+    let aspect = view.sphere_color.w; // the render shader stores the output aspect here
+    let size = vec2<f32>(0.4 / aspect, 0.4);
+    let origin = vec2<f32>(-0.98 + f32(which) * (size.x + 0.02), 0.98 - size.y);
+    var out: Inset;
+    out.clip = vec4<f32>(origin + corner * size, 0.0, 1.0);
+    out.uv = vec2<f32>(corner.x, 1.0 - corner.y);
+    out.which = which;
+    return out;
+}
+
+@fragment
+fn fs_inset(in: Inset) -> @location(0) vec4<f32> {
+    let res = u32(round(sqrt(f32(arrayLength(&positions)))));
+    let cell = min(vec2<u32>(in.uv * f32(res)), vec2<u32>(res - 1u));
+    let i = cell.y * res + cell.x;
+    if (in.which == 0u) {
+        let extent = max(view.camera.w, 1e-6); // half the cloth's rest width, stored in camera.w
+        return vec4<f32>(positions[i].xyz / (2.0 * extent) + 0.5, 1.0);
+    }
+    return vec4<f32>(normals[i].xyz * 0.5 + 0.5, 1.0);
 }

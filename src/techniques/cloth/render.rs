@@ -17,13 +17,13 @@ const SPHERE_VERTICES: u32 = 32 * 16 * 6;
 pub struct ClothViewUniforms {
     /// Projection × view.
     pub view_proj: [[f32; 4]; 4],
-    /// Camera position.
+    /// Camera position; w: half the cloth's rest width (scales the position inset).
     pub camera: [f32; 4],
     /// Towards the light, unit.
     pub light_dir: [f32; 4],
     /// Linear cloth colour.
     pub color: [f32; 4],
-    /// Linear sphere colour.
+    /// Linear sphere colour; w: output aspect (sizes the debug insets).
     pub sphere_color: [f32; 4],
     /// Sphere centre and radius (0: not drawn).
     pub sphere: [f32; 4],
@@ -52,13 +52,16 @@ impl ClothView {
         let c = super::sphere_center(p, time.seconds);
         let radius = if p.bool("sphere") { p.float("sphere_radius") } else { 0.0 };
         let b = linear(p.color("background"));
+        let half_width = (p.int("resolution").max(2) - 1) as f32 * p.float("rest_length") / 2.0;
+        let mut sphere_color = linear(p.color("sphere_color"));
+        sphere_color[3] = aspect;
         Self {
             uniforms: ClothViewUniforms {
                 view_proj: (proj * view).to_cols_array_2d(),
-                camera: [eye.x, eye.y, eye.z, 1.0],
+                camera: [eye.x, eye.y, eye.z, half_width],
                 light_dir: [light.x, light.y, light.z, 0.0],
                 color: linear(p.color("color")),
-                sphere_color: linear(p.color("sphere_color")),
+                sphere_color,
                 sphere: [c[0], c[1], c[2], radius],
             },
             background: wgpu::Color { r: f64::from(b[0]), g: f64::from(b[1]), b: f64::from(b[2]), a: 1.0 },
@@ -72,6 +75,7 @@ pub struct Renderer {
     sphere: wgpu::RenderPipeline,
     lines: wgpu::RenderPipeline,
     points: wgpu::RenderPipeline,
+    insets: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
     draw_sphere: std::cell::Cell<bool>,
@@ -85,7 +89,7 @@ impl Renderer {
         let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
         let storage = |binding| wgpu::BindGroupLayoutEntry {
             binding,
-            visibility: wgpu::ShaderStages::VERTEX,
+            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
             ty: wgpu::BindingType::Buffer {
                 ty: wgpu::BufferBindingType::Storage { read_only: true },
                 has_dynamic_offset: false,
@@ -140,11 +144,12 @@ impl Renderer {
         let sphere = pipeline("vs_sphere", "fs_sphere", wgpu::PrimitiveTopology::TriangleList);
         let lines = pipeline("vs_debug", "fs_debug", wgpu::PrimitiveTopology::LineList);
         let points = pipeline("vs_debug", "fs_debug", wgpu::PrimitiveTopology::PointList);
+        let insets = pipeline("vs_inset", "fs_inset", wgpu::PrimitiveTopology::TriangleList);
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(ShaderError { origin, line: 1, column: 1, message: e.to_string() });
         }
         let uniform = crate::gpu::uniform_buffer::<ClothViewUniforms>(device, "cloth_view");
-        Ok(Self { surface, sphere, lines, points, layout, uniform, draw_sphere: std::cell::Cell::new(true) })
+        Ok(Self { surface, sphere, lines, points, insets, layout, uniform, draw_sphere: std::cell::Cell::new(true) })
     }
 
     /// Two triangles per grid cell, shared vertices: indices are particle numbers.
@@ -224,6 +229,9 @@ impl Renderer {
                 }
                 pass.set_pipeline(&self.points);
                 pass.draw(0..state.res * state.res, 3..4);
+                // The position and normal buffers as images, drawn over everything.
+                pass.set_pipeline(&self.insets);
+                pass.draw(0..6, 0..2);
             }
             _ => {
                 pass.set_pipeline(&self.surface);
