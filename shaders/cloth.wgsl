@@ -5,7 +5,9 @@
 //             x' = 2x - x_prev + F/m dt^2;
 //   xpbd    - small-steps XPBD [Macklin et al. 2019, "Small Steps in Physics Simulation"]: predict,
 //             then one Jacobi projection of every distance constraint with compliance alpha/dt^2,
-//             corrections averaged per particle; stiff without tiny explicit time steps.
+//             corrections averaged per particle; plus long-range attachments [Kim, Chentanez &
+//             Mueller 2012]: no particle farther from its pins than its rest distance, which a
+//             Jacobi sweep (one row per substep) cannot achieve on a tall hanging cloth.
 // Positions are vec4: xyz, w = inverse mass (0 = pinned). The two kernels that read neighbours
 // run 16x16 workgroups over the res x res grid and stage a 20x20 tile (a halo of 2) in workgroup
 // memory, so each of the 12 neighbour reads is local; the others run one invocation per particle.
@@ -22,7 +24,7 @@ struct ClothUniforms {
     mass: f32,           // particle mass (kg)
     compliance: f32,     // xpbd: inverse stiffness (m/N); 0 = inextensible
     sphere_radius: f32,  // collision sphere radius (0 = no sphere)
-    _pad1: f32,
+    attachments: u32,    // xpbd long-range attachments: 0 off, 1 top row, 2 two top corners
     acceleration: vec4<f32>, // gravity + wind force / mass (xyz)
     sphere: vec4<f32>,       // collision sphere centre (xyz)
 };
@@ -98,6 +100,28 @@ fn constraint(x: vec4<f32>, c: vec2<i32>, origin: vec2<i32>, offset: vec2<i32>, 
     // Delta lambda from zero (one iteration per small step), applied to this particle only.
     let lambda = -(len - factor * u.rest) / (x.w + other.w + alpha);
     return vec4<f32>(x.w * lambda * d / max(len, 1e-9), 1.0);
+}
+
+// Keeps p within `limit` of `anchor` (a unilateral distance constraint).
+fn tether(p: vec3<f32>, anchor: vec3<f32>, limit: f32) -> vec3<f32> {
+    let d = p - anchor;
+    let len = length(d);
+    return select(p, anchor + d / len * limit, len > limit);
+}
+
+// Long-range attachments: the top-row pin of the same column (at j rest lengths), or the two
+// top corners (at their rest distances).
+fn attach(p: vec3<f32>, c: vec2<i32>) -> vec3<f32> {
+    let j = f32(c.y);
+    if (u.attachments == 1u) {
+        return tether(p, cur[u32(c.x)].xyz, j * u.rest);
+    }
+    if (u.attachments == 2u) {
+        let far = f32(i32(u.res) - 1 - c.x);
+        let q = tether(p, cur[0].xyz, sqrt(f32(c.x * c.x) + j * j) * u.rest);
+        return tether(q, cur[u.res - 1u].xyz, sqrt(far * far + j * j) * u.rest);
+    }
+    return p;
 }
 
 // Pushes p out of the sphere onto its surface.
@@ -193,7 +217,7 @@ fn project(
     sum += constraint(x, c, origin, vec2<i32>(-2, -2), SQRT8, alpha) + constraint(x, c, origin, vec2<i32>(2, -2), SQRT8, alpha);
     sum += constraint(x, c, origin, vec2<i32>(2, 2), SQRT8, alpha) + constraint(x, c, origin, vec2<i32>(-2, 2), SQRT8, alpha);
     // Averaging keeps the Jacobi sum from overshooting (Bridson et al. 2003 style).
-    let p = collide(x.xyz + sum.xyz * (1.5 / max(sum.w, 1.0)));
+    let p = collide(attach(x.xyz + sum.xyz * (1.5 / max(sum.w, 1.0)), c));
     check(p);
     next[i] = vec4<f32>(p, x.w);
 }

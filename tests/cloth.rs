@@ -4,61 +4,26 @@
 
 mod common;
 
-use indra::graph::{FrameGraph, GraphRuntime};
 use indra::params::{ParamSet, ParamValue};
 use indra::scene::{load_scene, parse_value_override};
-use indra::techniques::cloth::{Cloth, ClothUniforms, reference, rest_pose};
-use indra::techniques::{NodeSetup, Technique};
-use indra::time::{FixedClock, FrameTime};
+use indra::techniques::Technique;
+use indra::techniques::cloth::runner::{Runner, top_row_strain};
+use indra::techniques::cloth::{ClothUniforms, reference, rest_pose};
 
-/// A cloth node driven like the runtime drives it: step, then add_passes and execute.
-struct Rig {
-    gpu: indra::gpu::Gpu,
-    cloth: Cloth,
-    params: ParamSet,
-    runtime: GraphRuntime,
-    clock: FixedClock,
+/// A 16×16 cloth (rest 0.1, damping 2) with `settings` applied, stepping `dt` per frame.
+fn rig(settings: &[(&str, &str)], dt: f32) -> Runner {
+    let mut params = ParamSet::new(indra::techniques::cloth::params());
+    for (name, value) in [("resolution", "16"), ("rest_length", "0.1"), ("damping", "2")].iter().chain(settings) {
+        let i = params.index(name).unwrap_or_else(|| panic!("{name}"));
+        params.set_at(i, parse_value_override(value, &params.decls()[i]).unwrap());
+    }
+    params.snap();
+    Runner::new(common::gpu(), &common::assets(), params, dt).unwrap()
 }
 
-impl Rig {
-    fn new(settings: &[(&str, &str)], dt: f32) -> Self {
-        let gpu = common::gpu();
-        let assets = common::assets();
-        let cloth = Cloth::new(&NodeSetup { gpu: &gpu, assets: &assets, id: "cloth", output_size: (64, 64) }).unwrap();
-        let mut params = ParamSet::new(indra::techniques::cloth::params());
-        for (name, value) in [("resolution", "16"), ("rest_length", "0.1"), ("damping", "2")].iter().chain(settings) {
-            let i = params.index(name).unwrap_or_else(|| panic!("{name}"));
-            params.set_at(i, parse_value_override(value, &params.decls()[i]).unwrap());
-        }
-        params.snap();
-        let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
-        Self { gpu, cloth, params, runtime, clock: FixedClock::new(dt, 1) }
-    }
-
-    fn time(&self) -> FrameTime {
-        self.clock.now()
-    }
-
-    /// Runs `frames` fixed steps, each recorded and submitted like a frame.
-    fn run(&mut self, frames: u32) {
-        for _ in 0..frames {
-            let time = self.clock.now();
-            self.cloth.step(&self.params, &time);
-            let mut graph = FrameGraph::new((64, 64));
-            let out = self.cloth.add_passes(&mut graph, &self.params, &time, &[]);
-            graph.set_output(out);
-            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-            self.runtime.execute(&self.gpu.device, &self.gpu.queue, graph, &mut encoder).unwrap();
-            self.gpu.queue.submit([encoder.finish()]);
-            self.params.end_frame();
-            self.clock.step();
-        }
-    }
-
-    fn set(&mut self, name: &str, value: ParamValue) {
-        let i = self.params.index(name).unwrap();
-        self.params.set_at(i, value);
-    }
+fn set(r: &mut Runner, name: &str, value: ParamValue) {
+    let i = r.params.index(name).unwrap();
+    r.params.set_at(i, value);
 }
 
 fn distance(a: [f32; 4], b: [f32; 4]) -> f32 {
@@ -68,7 +33,7 @@ fn distance(a: [f32; 4], b: [f32; 4]) -> f32 {
 #[test]
 fn pinned_particles_never_move_and_nothing_ends_inside_the_sphere() {
     // The sphere sits in the cloth's plane, so it must push particles out every step.
-    let mut rig = Rig::new(&[("sphere_center", "0,-0.3,0.2"), ("sphere_travel", "0"), ("sphere_radius", "0.5")], 0.01);
+    let mut rig = rig(&[("sphere_center", "0,-0.3,0.2"), ("sphere_travel", "0"), ("sphere_radius", "0.5")], 0.01);
     let rest = rest_pose(16, 0.1, 1.0, 0);
     for _ in 0..5 {
         rig.run(20);
@@ -87,7 +52,7 @@ fn pinned_particles_never_move_and_nothing_ends_inside_the_sphere() {
 fn a_cloth_at_rest_stays_at_rest() {
     for solver in ["Verlet", "XPBD"] {
         let mut rig =
-            Rig::new(&[("gravity", "0,0,0"), ("sphere", "false"), ("wind_strength", "0"), ("solver", solver)], 0.01);
+            rig(&[("gravity", "0,0,0"), ("sphere", "false"), ("wind_strength", "0"), ("solver", solver)], 0.01);
         rig.run(60);
         let rest = rest_pose(16, 0.1, 1.0, 0);
         for (a, b) in rig.cloth.positions().iter().zip(&rest) {
@@ -98,7 +63,7 @@ fn a_cloth_at_rest_stays_at_rest() {
 
 #[test]
 fn a_symmetric_setup_stays_symmetric() {
-    let mut rig = Rig::new(&[("sphere_center", "0,-0.5,0.4"), ("sphere_travel", "0"), ("sphere_radius", "0.4")], 0.01);
+    let mut rig = rig(&[("sphere_center", "0,-0.5,0.4"), ("sphere_travel", "0"), ("sphere_radius", "0.4")], 0.01);
     rig.run(80);
     let p = rig.cloth.positions();
     for j in 0..16 {
@@ -114,7 +79,7 @@ fn a_symmetric_setup_stays_symmetric() {
 
 #[test]
 fn one_gpu_substep_matches_the_cpu_reference() {
-    let mut rig = Rig::new(
+    let mut rig = rig(
         &[
             ("resolution", "8"),
             ("substeps", "1"),
@@ -137,20 +102,14 @@ fn one_gpu_substep_matches_the_cpu_reference() {
     assert!(expected.iter().zip(&cur).any(|(e, c)| distance(*e, *c) > 1e-4), "the step moved something");
 }
 
-/// Largest strain of the vertical structural springs hanging from the top row.
-fn top_row_strain(p: &[[f32; 4]], res: usize, rest: f32) -> f32 {
-    (0..res).map(|i| (distance(p[i], p[res + i]) - rest) / rest).fold(0.0, f32::max)
-}
-
 #[test]
 fn xpbd_holds_a_heavy_cloth_stiff_where_verlet_stretches() {
     let settings = [("resolution", "32"), ("sphere", "false"), ("substeps", "16"), ("rest_length", "0.05")];
-    let mut xpbd = Rig::new(&[settings.as_slice(), &[("solver", "XPBD")]].concat(), 1.0 / 60.0);
+    let mut xpbd = rig(&[settings.as_slice(), &[("solver", "XPBD")]].concat(), 1.0 / 60.0);
     xpbd.run(120);
     let strain = top_row_strain(&xpbd.cloth.positions(), 32, 0.05);
     assert!(strain < 0.10, "XPBD top-row strain {strain}");
-    let mut verlet =
-        Rig::new(&[settings.as_slice(), &[("solver", "Verlet"), ("stiffness", "2000")]].concat(), 1.0 / 60.0);
+    let mut verlet = rig(&[settings.as_slice(), &[("solver", "Verlet"), ("stiffness", "2000")]].concat(), 1.0 / 60.0);
     verlet.run(120);
     let soft = top_row_strain(&verlet.cloth.positions(), 32, 0.05);
     assert!(soft > strain * 2.0, "explicit springs of a stable stiffness stretch more: Verlet {soft} vs XPBD {strain}");
@@ -158,8 +117,7 @@ fn xpbd_holds_a_heavy_cloth_stiff_where_verlet_stretches() {
 
 #[test]
 fn a_blow_up_is_detected_and_the_cloth_resets_itself() {
-    let mut rig =
-        Rig::new(&[("stiffness", "10000000"), ("substeps", "1"), ("damping", "0"), ("sphere", "false")], 0.02);
+    let mut rig = rig(&[("stiffness", "10000000"), ("substeps", "1"), ("damping", "0"), ("sphere", "false")], 0.02);
     let mut messages = Vec::new();
     for _ in 0..30 {
         rig.run(1);
@@ -171,10 +129,10 @@ fn a_blow_up_is_detected_and_the_cloth_resets_itself() {
 
 #[test]
 fn the_reset_trigger_restores_the_rest_pose() {
-    let mut rig = Rig::new(&[], 0.01);
+    let mut rig = rig(&[], 0.01);
     rig.run(30);
     assert_ne!(rig.cloth.positions(), rest_pose(16, 0.1, 1.0, 0));
-    rig.set("reset", ParamValue::Trigger(true));
+    set(&mut rig, "reset", ParamValue::Trigger(true));
     rig.cloth.step(&rig.params, &rig.time());
     assert_eq!(rig.cloth.positions(), rest_pose(16, 0.1, 1.0, 0));
 }

@@ -10,6 +10,7 @@
 mod params;
 pub mod reference;
 mod render;
+pub mod runner;
 mod state;
 
 pub use params::{ClothUniforms, PIN_MODES, SOLVERS, VIEWS, params, rest_pose, sphere_center, wind_force};

@@ -39,6 +39,12 @@ pub fn params() -> Vec<ParamDecl> {
         .with_unit("kg/s"),
         ParamDecl::new("compliance", Float(0.0), Some((0.0, 1.0)), "XPBD inverse stiffness; 0 = inextensible")
             .with_unit("m/N"),
+        ParamDecl::new(
+            "attachments",
+            Bool(true),
+            None,
+            "XPBD long-range attachments: nothing hangs farther from its pins than at rest",
+        ),
         ParamDecl::new("mass", Float(1.0), Some((0.001, 100.0)), "mass per particle").with_unit("kg"),
         ParamDecl::new("gravity", Vec3([0.0, -9.81, 0.0]), Some((-100.0, 100.0)), "gravity").with_unit("m/s²"),
         ParamDecl::choice("pin", &PIN_MODES, 0, "which particles are fixed"),
@@ -100,8 +106,8 @@ pub struct ClothUniforms {
     pub compliance: f32,
     /// Sphere radius (0: none).
     pub sphere_radius: f32,
-    /// Padding.
-    pub _pad1: f32,
+    /// XPBD long-range attachments: 0 off, 1 top row, 2 two corners.
+    pub attachments: u32,
     /// Gravity + wind / mass.
     pub acceleration: [f32; 4],
     /// Sphere centre.
@@ -127,7 +133,12 @@ impl ClothUniforms {
             mass,
             compliance: p.float("compliance"),
             sphere_radius: if p.bool("sphere") { p.float("sphere_radius") } else { 0.0 },
-            _pad1: 0.0,
+            // Attachments follow the pins: the top row (pin 0) or the two corners (pin 1).
+            attachments: if p.choice("solver") == 1 && p.bool("attachments") && p.choice("pin") < 2 {
+                p.choice("pin") + 1
+            } else {
+                0
+            },
             acceleration: [g[0] + wind[0] / mass, g[1] + wind[1] / mass, g[2] + wind[2] / mass, 0.0],
             sphere: {
                 let c = sphere_center(p, time.seconds);
