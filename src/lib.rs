@@ -10,6 +10,7 @@
 pub mod app;
 pub mod assets;
 pub mod control;
+pub mod geometry;
 
 pub mod gpu;
 pub mod graph;
