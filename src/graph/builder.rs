@@ -236,6 +236,32 @@ impl PassContext<'_> {
         self.buffers[buffer.0 as usize].as_ref().map(|b| b.1).unwrap_or(0)
     }
 
+    /// Begins a render pass that clears colour target `color` to `clear` and depth target
+    /// `depth` to 1 (the far plane; depth is not kept after the pass).
+    pub fn begin_color_depth_pass(
+        &mut self,
+        color: TextureHandle,
+        depth: TextureHandle,
+        clear: wgpu::Color,
+    ) -> wgpu::RenderPass<'_> {
+        let (color_view, depth_view) = (self.view(color).clone(), self.view(depth).clone());
+        self.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(self.pass_name),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &color_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        })
+    }
+
     /// This pass's name, for labels.
     pub fn name(&self) -> &str {
         self.pass_name

@@ -131,7 +131,7 @@ impl Cloth {
         let pin = p.choice("pin");
         let fresh = self.state.as_ref().is_none_or(|s| s.res != res || s.pin != pin);
         if fresh {
-            self.state = Some(State::new(&self.device, &self.kernels.layout, &self.renderer, res, pin));
+            self.state = Some(State::new(&self.device, &self.renderer, res, pin));
         }
         if fresh || p.fired("reset") {
             let pose = rest_pose(res, p.float("rest_length"), p.float("mass"), pin);
@@ -217,15 +217,18 @@ impl Technique for Cloth {
         });
         let color = graph.create_texture("cloth/image", TextureDesc::full(FORMAT));
         let depth = graph.create_texture("cloth/depth", TextureDesc::full(render::DEPTH));
-        let debug = params.choice("view") == 1;
-        let background = view.background;
+        let mode = render::DrawMode {
+            clear: view.background,
+            debug: params.choice("view") == 1,
+            sphere: view.uniforms.sphere[3] > 0.0,
+        };
         graph
             .add_pass("cloth/draw")
             .read_buffer(cur)
             .read_buffer(normals)
             .render_target(color)
             .render_target(depth)
-            .record(move |ctx| this.renderer.draw(ctx, state, color, depth, background, debug));
+            .record(move |ctx| this.renderer.draw(ctx, state, color, depth, mode));
         color
     }
 }

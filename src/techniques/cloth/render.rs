@@ -69,6 +69,17 @@ impl ClothView {
     }
 }
 
+/// What one frame's draw shows.
+#[derive(Clone, Copy, Debug)]
+pub struct DrawMode {
+    /// Linear clear colour.
+    pub clear: wgpu::Color,
+    /// Particles and springs instead of the lit surface.
+    pub debug: bool,
+    /// Draw the collision sphere.
+    pub sphere: bool,
+}
+
 /// The draw pipelines and their uniform buffer.
 pub struct Renderer {
     surface: wgpu::RenderPipeline,
@@ -78,7 +89,6 @@ pub struct Renderer {
     insets: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
-    draw_sphere: std::cell::Cell<bool>,
 }
 
 impl Renderer {
@@ -149,7 +159,7 @@ impl Renderer {
             return Err(ShaderError { origin, line: 1, column: 1, message: e.to_string() });
         }
         let uniform = crate::gpu::uniform_buffer::<ClothViewUniforms>(device, "cloth_view");
-        Ok(Self { surface, sphere, lines, points, insets, layout, uniform, draw_sphere: std::cell::Cell::new(true) })
+        Ok(Self { surface, sphere, lines, points, insets, layout, uniform })
     }
 
     /// Two triangles per grid cell, shared vertices: indices are particle numbers.
@@ -174,7 +184,6 @@ impl Renderer {
         debug: bool,
     ) {
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&view.uniforms));
-        self.draw_sphere.set(view.uniforms.sphere[3] > 0.0);
         let cur = state.cur;
         let (buffer, normals) = (state.particles()[cur].clone(), state.normals.clone());
         state.draw_groups.entry(cur).or_insert_with(|| {
@@ -200,27 +209,11 @@ impl Renderer {
         state: &State,
         color: TextureHandle,
         depth: TextureHandle,
-        clear: wgpu::Color,
-        debug: bool,
+        mode: DrawMode,
     ) {
-        let (color_view, depth_view) = (ctx.view(color).clone(), ctx.view(depth).clone());
-        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("cloth/draw"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
-                stencil_ops: None,
-            }),
-            ..Default::default()
-        });
+        let mut pass = ctx.begin_color_depth_pass(color, depth, mode.clear);
         pass.set_bind_group(0, &state.draw_groups[&state.cur], &[]);
-        match (&state.lines, debug) {
+        match (&state.lines, mode.debug) {
             (Some((lines, ranges)), true) => {
                 pass.set_pipeline(&self.lines);
                 pass.set_index_buffer(lines.slice(..), wgpu::IndexFormat::Uint32);
@@ -237,7 +230,7 @@ impl Renderer {
                 pass.set_pipeline(&self.surface);
                 pass.set_index_buffer(state.surface_indices.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(0..state.surface_count, 0, 0..1);
-                if self.draw_sphere.get() {
+                if mode.sphere {
                     pass.set_pipeline(&self.sphere);
                     pass.draw(0..SPHERE_VERTICES, 0..1);
                 }

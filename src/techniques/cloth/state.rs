@@ -123,13 +123,7 @@ fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
 
 impl State {
     /// Buffers for `res` × `res` particles.
-    pub fn new(
-        device: &wgpu::Device,
-        _layout: &wgpu::BindGroupLayout,
-        renderer: &Renderer,
-        res: u32,
-        pin: u32,
-    ) -> Self {
+    pub fn new(device: &wgpu::Device, renderer: &Renderer, res: u32, pin: u32) -> Self {
         let bytes = u64::from(res * res) * 16;
         let particles = std::array::from_fn(|i| storage(device, &format!("cloth_particles_{i}"), bytes));
         let status = storage(device, "cloth_status", 4);

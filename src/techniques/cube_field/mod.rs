@@ -199,25 +199,7 @@ impl Technique for CubeField {
         graph.add_pass("cube_field/draw").render_target(color).render_target(depth).record(move |ctx| {
             ctx.queue.write_buffer(&this.uniforms, 0, bytemuck::bytes_of(&uniforms));
             ctx.queue.write_buffer(&this.instances, 0, bytemuck::cast_slice(&this.scratch));
-            let (color_view, depth_view) = (ctx.view(color).clone(), ctx.view(depth).clone());
-            let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("cube_field/draw"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &color_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
-                    stencil_ops: None,
-                }),
-                ..Default::default()
-            });
+            let mut pass = ctx.begin_color_depth_pass(color, depth, wgpu::Color::BLACK);
             pass.set_pipeline(&this.pipeline);
             pass.set_bind_group(0, &this.bind_group, &[]);
             pass.set_vertex_buffer(0, this.instances.slice(..));
