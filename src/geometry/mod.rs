@@ -2,5 +2,6 @@
 
 pub mod poisson;
 mod rng;
+pub mod triangulate;
 
 pub use rng::SplitMix64;

@@ -1,0 +1,94 @@
+//! Triangulation, ours against the `earcut` (georust) and `earcutr` crates on the same inputs:
+//! earcut's fixtures (building 15 vertices … water-huge2 5,488 vertices / 443 rings) and a
+//! generated star polygon of 20,000 vertices with 400 holes. Each library reuses its buffers where
+//! its API allows. Run: `cargo bench --bench triangulate`; report ours/earcut as ratios.
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use indra::geometry::triangulate::Triangulator;
+
+struct Input {
+    name: String,
+    coords: Vec<f64>,
+    holes: Vec<usize>,
+}
+
+fn fixture(name: &str) -> Input {
+    let path = format!("{}/tests/fixtures/earcut/{name}.json", env!("CARGO_MANIFEST_DIR"));
+    let rings: Vec<Vec<Vec<f64>>> = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    from_rings(name, rings.into_iter().map(|r| r.into_iter().map(|p| [p[0], p[1]]).collect()).collect())
+}
+
+fn from_rings(name: &str, rings: Vec<Vec<[f64; 2]>>) -> Input {
+    let mut holes = Vec::new();
+    let mut n = 0;
+    for ring in &rings[..rings.len() - 1] {
+        n += ring.len();
+        holes.push(n);
+    }
+    Input { name: name.to_string(), coords: rings.into_iter().flatten().flatten().collect(), holes }
+}
+
+/// A wavy star of `n` vertices with a grid of small square holes inside its inner disc.
+fn generated(n: usize, holes_per_side: usize) -> Input {
+    let outer: Vec<[f64; 2]> = (0..n)
+        .map(|i| {
+            let t = i as f64 / n as f64 * std::f64::consts::TAU;
+            let r = 1000.0 * (1.0 + 0.08 * (37.0 * t).sin() + 0.03 * (211.0 * t).cos());
+            [r * t.cos(), r * t.sin()]
+        })
+        .collect();
+    let mut rings = vec![outer];
+    let pitch = 1200.0 / holes_per_side as f64;
+    for i in 0..holes_per_side {
+        for j in 0..holes_per_side {
+            let (cx, cy) = (-600.0 + (i as f64 + 0.5) * pitch, -600.0 + (j as f64 + 0.5) * pitch);
+            let s = pitch * 0.3;
+            rings.push(vec![[cx - s, cy - s], [cx - s, cy + s], [cx + s, cy + s], [cx + s, cy - s]]);
+        }
+    }
+    from_rings(&format!("star{n}-holes{}", holes_per_side * holes_per_side), rings)
+}
+
+fn bench(c: &mut Criterion) {
+    let mut inputs: Vec<Input> = ["building", "dude", "water", "water-huge", "water-huge2"].map(fixture).into();
+    inputs.push(generated(20_000, 20));
+    let mut group = c.benchmark_group("triangulate");
+    for input in &inputs {
+        let vertices = input.coords.len() / 2;
+        group.throughput(Throughput::Elements(vertices as u64));
+        let points: Vec<[f64; 2]> = input.coords.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
+        let holes_u32: Vec<u32> = input.holes.iter().map(|&h| h as u32).collect();
+
+        let mut ours = Triangulator::new();
+        let mut out = Vec::new();
+        group.bench_function(BenchmarkId::new("indra", &input.name), |b| {
+            b.iter(|| {
+                out.clear();
+                ours.flat(&input.coords, &input.holes, &mut out).unwrap();
+                out.len()
+            })
+        });
+        let mut theirs = earcut::Earcut::new();
+        let mut out32: Vec<u32> = Vec::new();
+        group.bench_function(BenchmarkId::new("earcut", &input.name), |b| {
+            b.iter(|| {
+                theirs.earcut(points.iter().copied(), &holes_u32, &mut out32);
+                out32.len()
+            })
+        });
+        group.bench_function(BenchmarkId::new("earcutr", &input.name), |b| {
+            b.iter(|| earcutr::earcut(&input.coords, &input.holes, 2).unwrap().len())
+        });
+        eprintln!(
+            "{}: {vertices} vertices, {} rings; triangles indra {}, earcut {}",
+            input.name,
+            input.holes.len() + 1,
+            out.len() / 3,
+            out32.len() / 3
+        );
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

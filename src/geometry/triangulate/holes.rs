@@ -1,0 +1,247 @@
+//! Bridging holes into their outer ring [UGP4 ch.5, after Eberly, "Triangulation by Ear
+//! Clipping" §3]: holes are taken right to left by their rightmost vertex M; a ray from M to +x
+//! finds the nearest outer edge, and the bridge goes to the visible vertex that makes the
+//! smallest angle with the ray. Cutting along the bridge (both ends duplicated) turns an outer
+//! ring with holes into one weakly simple ring.
+//!
+//! With many holes, walking the whole merged ring per hole is O(holes × vertices); above
+//! [`BANDS_FROM_HOLES`] holes the ring's edges are bucketed into horizontal bands so that both
+//! searches only visit edges near the hole's y.
+
+use super::linked::{NIL, Rings, point_in_triangle};
+
+/// Holes from which the band index pays for itself.
+const BANDS_FROM_HOLES: usize = 8;
+
+/// Edges of the merged ring bucketed by y: each band lists the start nodes of the edges whose y
+/// range overlaps it. Entries go stale when nodes are removed (checked on use) and are added for
+/// every new edge, so a band always lists every live edge crossing it.
+#[derive(Default)]
+pub(super) struct Bands {
+    min_y: f64,
+    inv_height: f64,
+    lists: Vec<Vec<u32>>,
+}
+
+impl Bands {
+    fn reset(&mut self, min_y: f64, max_y: f64, count: usize) {
+        let count = count.max(1);
+        self.lists.iter_mut().for_each(Vec::clear);
+        self.lists.resize_with(count, Vec::new);
+        self.lists.truncate(count);
+        self.min_y = min_y;
+        self.inv_height = if max_y > min_y { count as f64 / (max_y - min_y) } else { 0.0 };
+    }
+
+    #[inline]
+    fn band(&self, y: f64) -> usize {
+        (((y - self.min_y) * self.inv_height).max(0.0) as usize).min(self.lists.len() - 1)
+    }
+
+    /// Registers the edge that starts at `p`.
+    fn add_edge(&mut self, rings: &Rings, p: u32) {
+        let (a, b) = (rings.get(p).y, rings.get(rings.next(p)).y);
+        for band in self.band(a.min(b))..=self.band(a.max(b)) {
+            self.lists[band].push(p);
+        }
+    }
+
+    fn add_ring(&mut self, rings: &Rings, start: u32) {
+        let mut p = start;
+        loop {
+            self.add_edge(rings, p);
+            p = rings.next(p);
+            if p == start {
+                break;
+            }
+        }
+    }
+}
+
+/// Where the bridge searches look for outer edges and vertices.
+enum Search<'a> {
+    /// Walk the whole ring from a node.
+    Ring(u32),
+    /// Look up the bands.
+    Bands(&'a Bands),
+}
+
+/// Splices every hole (a node of each linked clockwise hole ring in `holes`) into the outer ring
+/// of `outer`; returns a node of the merged ring.
+pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u32, holes: &mut [u32]) -> u32 {
+    for hole in holes.iter_mut() {
+        *hole = rightmost(rings, *hole);
+    }
+    // Right first: every hole to the right of the current one is already part of the outer ring,
+    // so its ray can only meet the outer ring.
+    holes.sort_unstable_by(|&a, &b| {
+        let (na, nb) = (rings.get(a), rings.get(b));
+        nb.x.total_cmp(&na.x).then(na.y.total_cmp(&nb.y)).then(a.cmp(&b))
+    });
+    let banded = holes.len() >= BANDS_FROM_HOLES;
+    if banded {
+        let (mut lo, mut hi, mut count) = (f64::INFINITY, f64::NEG_INFINITY, 0);
+        let mut p = outer;
+        loop {
+            lo = lo.min(rings.get(p).y);
+            hi = hi.max(rings.get(p).y);
+            count += 1;
+            p = rings.next(p);
+            if p == outer {
+                break;
+            }
+        }
+        bands.reset(lo, hi, count / 4);
+        bands.add_ring(rings, outer);
+        rings.recording = true;
+    }
+    for &hole in holes.iter() {
+        let search = if banded { Search::Bands(bands) } else { Search::Ring(outer) };
+        let Some(bridge) = find_bridge(rings, hole, search) else {
+            // No outer edge to the right: the hole is not inside this ring. Leave it out.
+            continue;
+        };
+        rings.touched.clear();
+        if banded {
+            // The hole's edges join the ring: note them while the hole is still a ring of its own.
+            let mut p = hole;
+            loop {
+                rings.touched.push(p);
+                p = rings.next(p);
+                if p == hole {
+                    break;
+                }
+            }
+        }
+        let reverse = rings.split(bridge, hole);
+        // Tidy collinear points around both cuts.
+        rings.filter(reverse, rings.next(reverse));
+        outer = rings.filter(bridge, rings.next(bridge));
+        if banded {
+            // New edges: the hole's, both bridge edges, and those the filters shortened.
+            for p in [bridge, reverse, rings.next(reverse), rings.prev(reverse)] {
+                if rings.alive(p) {
+                    bands.add_edge(rings, p);
+                }
+            }
+            for i in 0..rings.touched.len() {
+                let p = rings.touched[i];
+                if rings.alive(p) {
+                    bands.add_edge(rings, p);
+                }
+            }
+        }
+    }
+    rings.recording = false;
+    // Bridges line up with edges often enough that a pass over the merged ring pays off.
+    rings.filter(outer, NIL)
+}
+
+/// The node of a ring with the largest x (lowest y among ties).
+fn rightmost(rings: &Rings, start: u32) -> u32 {
+    let mut best = start;
+    let mut p = rings.next(start);
+    while p != start {
+        let (n, b) = (rings.get(p), rings.get(best));
+        if n.x > b.x || (n.x == b.x && n.y < b.y) {
+            best = p;
+        }
+        p = n.next;
+    }
+    best
+}
+
+/// Calls `visit` with the start node of every live edge that may cross y in [y0, y1].
+fn for_each_edge(rings: &Rings, search: &Search, y0: f64, y1: f64, mut visit: impl FnMut(u32)) {
+    match search {
+        Search::Ring(start) => {
+            let mut p = *start;
+            loop {
+                visit(p);
+                p = rings.next(p);
+                if p == *start {
+                    break;
+                }
+            }
+        }
+        Search::Bands(bands) => {
+            for band in bands.band(y0)..=bands.band(y1) {
+                for &p in &bands.lists[band] {
+                    if rings.alive(p) {
+                        visit(p);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The outer vertex the hole's rightmost vertex connects to.
+fn find_bridge(rings: &Rings, hole: u32, search: Search) -> Option<u32> {
+    let (hx, hy) = (rings.get(hole).x, rings.get(hole).y);
+    // The nearest crossing of the ray y = hy, x ≥ hx with an outer edge seen from inside
+    // (counter-clockwise, so an edge going up).
+    let mut qx = f64::INFINITY;
+    let mut m = NIL;
+    let mut touch = NIL;
+    for_each_edge(rings, &search, hy, hy, |p| {
+        let (n, nn) = (rings.get(p), rings.get(rings.next(p)));
+        if n.y <= hy && hy <= nn.y && nn.y != n.y {
+            let x = n.x + (hy - n.y) * (nn.x - n.x) / (nn.y - n.y);
+            if x >= hx && (x < qx || (x == qx && touch == NIL && x == hx)) {
+                qx = x;
+                m = if n.x > nn.x { p } else { n.next };
+                if x == hx {
+                    // The hole touches the outer ring at a vertex: bridge there (zero length).
+                    touch = if hy == n.y {
+                        p
+                    } else if hy == nn.y {
+                        n.next
+                    } else {
+                        NIL
+                    };
+                }
+            }
+        }
+    });
+    if touch != NIL {
+        return Some(touch);
+    }
+    if m == NIL {
+        return None;
+    }
+    // A reflex vertex inside triangle (hole point, crossing, endpoint) may hide the endpoint;
+    // the visible one is the vertex in there with the smallest angle to the ray.
+    let (mx, my) = (rings.get(m).x, rings.get(m).y);
+    let mut tan_min = f64::INFINITY;
+    let mut best = m;
+    let mut consider = |p: u32| {
+        let n = rings.get(p);
+        if hx <= n.x && n.x <= mx && hx != n.x && point_in_triangle([hx, hy], [qx, hy], [mx, my], [n.x, n.y]) {
+            let tan = (hy - n.y).abs() / (n.x - hx);
+            let b = rings.get(best);
+            if rings.locally_inside(p, hole)
+                && (tan < tan_min
+                    || (tan == tan_min && (n.x < b.x || (n.x == b.x && rings.sector_contains_sector(best, p)))))
+            {
+                best = p;
+                tan_min = tan;
+            }
+        }
+    };
+    match search {
+        // The sample's order: from the endpoint once around.
+        Search::Ring(_) => {
+            let mut p = m;
+            loop {
+                consider(p);
+                p = rings.next(p);
+                if p == m {
+                    break;
+                }
+            }
+        }
+        Search::Bands(_) => for_each_edge(rings, &search, hy.min(my), hy.max(my), consider),
+    }
+    Some(best)
+}

@@ -1,0 +1,315 @@
+//! The working state of ear slicing: vertex rings as circular doubly-linked lists in one arena
+//! (indices, not pointers), each node also on a z-order list for the spatial hash, plus the
+//! geometric predicates the slicer asks of them.
+//!
+//! Convention: y up, outer rings counter-clockwise, holes clockwise; `area(p, q, r) > 0` is a
+//! left turn.
+
+/// "No node".
+pub(super) const NIL: u32 = u32::MAX;
+
+/// One vertex of a ring.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Node {
+    pub x: f64,
+    pub y: f64,
+    /// Index of the vertex in the caller's vertex array (what triangles refer to).
+    pub vertex: u32,
+    pub prev: u32,
+    pub next: u32,
+    /// Morton code of the quantised position (0 until hashed).
+    pub z: u32,
+    pub prev_z: u32,
+    pub next_z: u32,
+    /// A hole of one point: never filtered away.
+    pub steiner: bool,
+}
+
+/// The node arena (reused between calls).
+#[derive(Default)]
+pub(super) struct Rings {
+    pub nodes: Vec<Node>,
+    /// While set, [`Rings::filter`] records here each node whose outgoing edge it changed.
+    pub recording: bool,
+    pub touched: Vec<u32>,
+}
+
+/// Twice the signed area of triangle (p, q, r): positive when p → q → r turns left.
+#[inline]
+pub(super) fn area(p: &Node, q: &Node, r: &Node) -> f64 {
+    (q.x - p.x) * (r.y - p.y) - (q.y - p.y) * (r.x - p.x)
+}
+
+/// Whether (px, py) lies in or on the triangle (a, b, c), whatever its orientation.
+#[inline]
+pub(super) fn point_in_triangle(a: [f64; 2], b: [f64; 2], c: [f64; 2], p: [f64; 2]) -> bool {
+    let d1 = (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]);
+    let d2 = (c[0] - b[0]) * (p[1] - b[1]) - (c[1] - b[1]) * (p[0] - b[0]);
+    let d3 = (a[0] - c[0]) * (p[1] - c[1]) - (a[1] - c[1]) * (p[0] - c[0]);
+    let negative = d1 < 0.0 || d2 < 0.0 || d3 < 0.0;
+    let positive = d1 > 0.0 || d2 > 0.0 || d3 > 0.0;
+    !(negative && positive)
+}
+
+#[inline]
+fn sign(v: f64) -> i8 {
+    (v > 0.0) as i8 - (v < 0.0) as i8
+}
+
+/// For collinear p, q, r: whether q lies within the bounding box of segment p–r.
+#[inline]
+fn on_segment(p: &Node, q: &Node, r: &Node) -> bool {
+    q.x <= p.x.max(r.x) && q.x >= p.x.min(r.x) && q.y <= p.y.max(r.y) && q.y >= p.y.min(r.y)
+}
+
+/// Whether segments p1–q1 and p2–q2 meet (touching and collinear overlap included).
+pub(super) fn intersects(p1: &Node, q1: &Node, p2: &Node, q2: &Node) -> bool {
+    let o1 = sign(area(p1, q1, p2));
+    let o2 = sign(area(p1, q1, q2));
+    let o3 = sign(area(p2, q2, p1));
+    let o4 = sign(area(p2, q2, q1));
+    (o1 != o2 && o3 != o4)
+        || (o1 == 0 && on_segment(p1, p2, q1))
+        || (o2 == 0 && on_segment(p1, q2, q1))
+        || (o3 == 0 && on_segment(p2, p1, q2))
+        || (o4 == 0 && on_segment(p2, q1, q2))
+}
+
+impl Rings {
+    /// Forgets every node (keeps the allocation).
+    pub fn clear(&mut self) {
+        self.nodes.clear();
+    }
+
+    #[inline]
+    pub fn get(&self, i: u32) -> &Node {
+        &self.nodes[i as usize]
+    }
+
+    #[inline]
+    pub fn next(&self, i: u32) -> u32 {
+        self.nodes[i as usize].next
+    }
+
+    #[inline]
+    pub fn prev(&self, i: u32) -> u32 {
+        self.nodes[i as usize].prev
+    }
+
+    /// Twice the signed area of the triangle of three nodes.
+    #[inline]
+    pub fn area(&self, p: u32, q: u32, r: u32) -> f64 {
+        area(self.get(p), self.get(q), self.get(r))
+    }
+
+    /// Whether a node is still linked into a ring.
+    #[inline]
+    pub fn alive(&self, p: u32) -> bool {
+        self.prev(self.next(p)) == p
+    }
+
+    /// Whether two nodes sit at the same position.
+    #[inline]
+    pub fn equals(&self, a: u32, b: u32) -> bool {
+        let (a, b) = (self.get(a), self.get(b));
+        a.x == b.x && a.y == b.y
+    }
+
+    /// Appends a node for `vertex` after `last` (or as a ring of one) and returns it.
+    fn insert(&mut self, vertex: u32, [x, y]: [f64; 2], last: u32) -> u32 {
+        let id = self.nodes.len() as u32;
+        let mut node = Node { x, y, vertex, prev: id, next: id, z: 0, prev_z: NIL, next_z: NIL, steiner: false };
+        if last != NIL {
+            node.prev = last;
+            node.next = self.next(last);
+            let after = node.next;
+            self.nodes[after as usize].prev = id;
+            self.nodes[last as usize].next = id;
+        }
+        self.nodes.push(node);
+        id
+    }
+
+    /// Unlinks a node from its ring and its z-order list.
+    pub fn remove(&mut self, p: u32) {
+        let Node { prev, next, prev_z, next_z, .. } = *self.get(p);
+        self.nodes[next as usize].prev = prev;
+        self.nodes[prev as usize].next = next;
+        if prev_z != NIL {
+            self.nodes[prev_z as usize].next_z = next_z;
+        }
+        if next_z != NIL {
+            self.nodes[next_z as usize].prev_z = prev_z;
+        }
+    }
+
+    /// Links `points` (vertex index, position) into a ring that runs counter-clockwise when
+    /// `ccw` (clockwise otherwise), whatever their input order, skipping repeats of the previous
+    /// point. `signed_area` is the ring's shoelace area (positive = counter-clockwise). Returns a
+    /// node of the ring, or NIL when there were no points.
+    pub fn link_ring(&mut self, vertices: &[[f64; 2]], first_vertex: u32, signed_area: f64, ccw: bool) -> u32 {
+        let mut last = NIL;
+        let mut push = |rings: &mut Self, i: usize| {
+            if last == NIL || {
+                let l = rings.get(last);
+                l.x != vertices[i][0] || l.y != vertices[i][1]
+            } {
+                last = rings.insert(first_vertex + i as u32, vertices[i], last);
+            }
+        };
+        if (signed_area > 0.0) == ccw {
+            (0..vertices.len()).for_each(|i| push(self, i));
+        } else {
+            (0..vertices.len()).rev().for_each(|i| push(self, i));
+        }
+        if last != NIL && self.next(last) != last && self.equals(last, self.next(last)) {
+            let first = self.next(last);
+            self.remove(last);
+            last = first;
+        }
+        last
+    }
+
+    /// Removes repeated points and collinear runs between `start` and `end` (the whole ring when
+    /// `end` is NIL); returns a node still on the ring.
+    pub fn filter(&mut self, start: u32, end: u32) -> u32 {
+        if start == NIL {
+            return start;
+        }
+        let mut end = if end == NIL { start } else { end };
+        let mut p = start;
+        loop {
+            let next = self.next(p);
+            let removable = !self.get(p).steiner && (self.equals(p, next) || self.area(self.prev(p), p, next) == 0.0);
+            if removable {
+                let prev = self.prev(p);
+                self.remove(p);
+                if self.recording {
+                    self.touched.push(prev);
+                }
+                p = prev;
+                end = prev;
+                if p == self.next(p) {
+                    break;
+                }
+            } else {
+                p = next;
+                if p == end {
+                    break;
+                }
+            }
+        }
+        end
+    }
+
+    /// Cuts the ring along the diagonal a–b into two rings, duplicating a and b; returns the
+    /// copy of b, a node of the second ring (a stays on the first).
+    pub fn split(&mut self, a: u32, b: u32) -> u32 {
+        let (an, bp) = (self.next(a), self.prev(b));
+        let a2 = self.insert(self.get(a).vertex, [self.get(a).x, self.get(a).y], NIL);
+        let b2 = self.insert(self.get(b).vertex, [self.get(b).x, self.get(b).y], NIL);
+        let n = &mut self.nodes;
+        n[a as usize].next = b;
+        n[b as usize].prev = a;
+        n[a2 as usize].next = an;
+        n[an as usize].prev = a2;
+        n[b2 as usize].next = a2;
+        n[a2 as usize].prev = b2;
+        n[bp as usize].next = b2;
+        n[b2 as usize].prev = bp;
+        b2
+    }
+
+    /// Whether the diagonal from a towards b starts into the polygon's interior at a.
+    pub fn locally_inside(&self, a: u32, b: u32) -> bool {
+        let (ap, an) = (self.prev(a), self.next(a));
+        if self.area(ap, a, an) > 0.0 {
+            self.area(a, b, an) <= 0.0 && self.area(a, ap, b) <= 0.0
+        } else {
+            self.area(a, b, ap) > 0.0 || self.area(a, an, b) > 0.0
+        }
+    }
+
+    /// Whether the midpoint of a–b is inside the ring of a (even–odd crossing count).
+    pub fn middle_inside(&self, a: u32, b: u32) -> bool {
+        let (na, nb) = (self.get(a), self.get(b));
+        let (px, py) = ((na.x + nb.x) / 2.0, (na.y + nb.y) / 2.0);
+        let mut inside = false;
+        let mut p = a;
+        loop {
+            let (n, nn) = (self.get(p), self.get(self.next(p)));
+            if (n.y > py) != (nn.y > py) && nn.y != n.y && px < (nn.x - n.x) * (py - n.y) / (nn.y - n.y) + n.x {
+                inside = !inside;
+            }
+            p = n.next;
+            if p == a {
+                return inside;
+            }
+        }
+    }
+
+    /// Whether segment a–b crosses an edge of a's ring that does not end at a or b.
+    pub fn intersects_ring(&self, a: u32, b: u32) -> bool {
+        let (na, nb) = (self.get(a), self.get(b));
+        let (va, vb) = (na.vertex, nb.vertex);
+        let (x0, x1) = (na.x.min(nb.x), na.x.max(nb.x));
+        let (y0, y1) = (na.y.min(nb.y), na.y.max(nb.y));
+        let mut p = a;
+        loop {
+            let np = self.get(p);
+            let nq = self.get(np.next);
+            // Edges whose box misses the segment's box cannot touch it.
+            let overlaps = np.x.max(nq.x) >= x0 && np.x.min(nq.x) <= x1 && np.y.max(nq.y) >= y0 && np.y.min(nq.y) <= y1;
+            if overlaps
+                && np.vertex != va
+                && nq.vertex != va
+                && np.vertex != vb
+                && nq.vertex != vb
+                && intersects(np, nq, na, nb)
+            {
+                return true;
+            }
+            p = np.next;
+            if p == a {
+                return false;
+            }
+        }
+    }
+
+    /// Whether a–b is a diagonal that splits the ring into two valid rings. The O(1) tests run
+    /// before the two that walk the ring.
+    pub fn is_valid_diagonal(&self, a: u32, b: u32) -> bool {
+        let (na, nb) = (self.get(a), self.get(b));
+        if self.get(na.next).vertex == nb.vertex || self.get(na.prev).vertex == nb.vertex {
+            return false;
+        }
+        // Both sectors must not face each other across a zero-area spike.
+        let not_opposite = self.area(na.prev, a, nb.prev) != 0.0 || self.area(a, nb.prev, b) != 0.0;
+        let locally = not_opposite && self.locally_inside(a, b) && self.locally_inside(b, a);
+        // Two reflex copies of one point may always be joined.
+        let zero_length =
+            self.equals(a, b) && self.area(na.prev, a, na.next) < 0.0 && self.area(nb.prev, b, nb.next) < 0.0;
+        if !(locally || zero_length) || self.intersects_ring(a, b) {
+            return false;
+        }
+        zero_length || self.middle_inside(a, b)
+    }
+
+    /// Whether the sector at `p` lies inside the sector at `m` (two nodes at one position).
+    pub fn sector_contains_sector(&self, m: u32, p: u32) -> bool {
+        self.area(self.prev(m), m, self.prev(p)) > 0.0 && self.area(self.next(p), m, self.next(m)) > 0.0
+    }
+}
+
+/// Shoelace signed area of a ring (positive = counter-clockwise), summed in a form that keeps
+/// precision for coordinates far from the origin.
+pub(super) fn signed_area(vertices: &[[f64; 2]]) -> f64 {
+    let Some(&last) = vertices.last() else { return 0.0 };
+    let mut sum = 0.0;
+    let mut j = last;
+    for &i in vertices {
+        sum += (j[0] - i[0]) * (j[1] + i[1]);
+        j = i;
+    }
+    sum / 2.0
+}

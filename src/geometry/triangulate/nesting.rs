@@ -1,0 +1,97 @@
+//! The nesting tree of a set of rings [UGP4 ch.5]: rings sorted by bounding-box area, largest
+//! first, each placed under the deepest ring that contains it. Odd depth = an outer ring (filled),
+//! even depth = a hole; islands inside holes come out as outer rings of their own.
+
+/// What the tree needs to know of one ring.
+pub(super) struct RingShape<'a> {
+    pub vertices: &'a [[f64; 2]],
+    pub min: [f64; 2],
+    pub max: [f64; 2],
+}
+
+impl<'a> RingShape<'a> {
+    /// A ring and its bounding box.
+    pub fn new(vertices: &'a [[f64; 2]]) -> Self {
+        let mut min = [f64::INFINITY; 2];
+        let mut max = [f64::NEG_INFINITY; 2];
+        for v in vertices {
+            for k in 0..2 {
+                min[k] = min[k].min(v[k]);
+                max[k] = max[k].max(v[k]);
+            }
+        }
+        Self { vertices, min, max }
+    }
+
+    fn box_area(&self) -> f64 {
+        (self.max[0] - self.min[0]) * (self.max[1] - self.min[1])
+    }
+
+    fn box_contains(&self, other: &Self) -> bool {
+        (0..2).all(|k| self.min[k] <= other.min[k] && other.max[k] <= self.max[k])
+    }
+
+    /// Inside (`Some(true)`), outside (`Some(false)`) or on the boundary (`None`), by counting
+    /// crossings of a ray to +x.
+    fn locate(&self, p: [f64; 2]) -> Option<bool> {
+        let mut inside = false;
+        let mut j = *self.vertices.last()?;
+        for &i in self.vertices {
+            // On the edge j–i?
+            let cross = (i[0] - j[0]) * (p[1] - j[1]) - (i[1] - j[1]) * (p[0] - j[0]);
+            if cross == 0.0
+                && p[0] >= i[0].min(j[0])
+                && p[0] <= i[0].max(j[0])
+                && p[1] >= i[1].min(j[1])
+                && p[1] <= i[1].max(j[1])
+            {
+                return None;
+            }
+            if (i[1] > p[1]) != (j[1] > p[1]) && p[0] < (j[0] - i[0]) * (p[1] - i[1]) / (j[1] - i[1]) + i[0] {
+                inside = !inside;
+            }
+            j = i;
+        }
+        Some(inside)
+    }
+
+    /// Whether `other` lies inside this ring: decided by its first vertex not on this ring's
+    /// boundary (rings may touch). A ring lying wholly on this one's boundary is not inside.
+    fn contains(&self, other: &Self) -> bool {
+        self.box_contains(other) && other.vertices.iter().find_map(|&v| self.locate(v)).unwrap_or(false)
+    }
+}
+
+/// An outer ring and the holes directly inside it (indices into the shapes).
+#[derive(Debug, PartialEq, Eq)]
+pub(super) struct Group {
+    pub outer: usize,
+    pub holes: Vec<usize>,
+}
+
+/// Builds the nesting tree and returns it as outer rings with their holes.
+pub(super) fn nest(shapes: &[RingShape]) -> Vec<Group> {
+    let mut order: Vec<usize> = (0..shapes.len()).collect();
+    order.sort_by(|&a, &b| shapes[b].box_area().total_cmp(&shapes[a].box_area()).then(a.cmp(&b)));
+    // children[i + 1] = rings directly inside ring i; children[0] = the top level.
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); shapes.len() + 1];
+    let mut depth = vec![0usize; shapes.len()];
+    for &ring in &order {
+        let mut parent = None;
+        loop {
+            let list = &children[parent.map_or(0, |p| p + 1)];
+            match list.iter().copied().find(|&c| shapes[c].contains(&shapes[ring])) {
+                Some(c) => parent = Some(c),
+                None => break,
+            }
+        }
+        depth[ring] = parent.map_or(1, |p| depth[p] + 1);
+        children[parent.map_or(0, |p| p + 1)].push(ring);
+    }
+    let mut groups: Vec<Group> = (0..shapes.len())
+        .filter(|&r| depth[r] % 2 == 1)
+        .map(|outer| Group { outer, holes: children[outer + 1].clone() })
+        .collect();
+    groups.sort_by_key(|g| g.outer);
+    groups
+}

@@ -1,0 +1,125 @@
+use super::*;
+
+fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<[f64; 2]> {
+    // Clockwise, as the sample lists its test data.
+    vec![[x0, y0], [x0, y1], [x1, y1], [x1, y0]]
+}
+
+/// Every triangle counter-clockwise with positive area.
+fn assert_ccw(mesh: &Mesh2D) {
+    for t in mesh.indices.chunks_exact(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| mesh.positions[i as usize]);
+        let cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        assert!(cross > 0.0, "triangle {t:?} is not counter-clockwise ({cross})");
+    }
+}
+
+#[test]
+fn square_makes_two_triangles_either_orientation() {
+    for ring in [rect(0.0, 0.0, 1.0, 1.0), rect(0.0, 0.0, 1.0, 1.0).into_iter().rev().collect()] {
+        let mesh = triangulate(&[ring]).unwrap();
+        assert_eq!(mesh.triangle_count(), 2);
+        assert_eq!(mesh.report.area_deviation(), 0.0);
+        assert_ccw(&mesh);
+    }
+}
+
+#[test]
+fn book_nested_shapes() {
+    // seed-reference §5: an outer ring, two holes, three islands inside the holes.
+    let rings = vec![
+        rect(-2.0, -2.0, 5.0, 2.0),
+        rect(-1.0, -1.0, 1.0, 1.0),
+        rect(2.0, -1.0, 4.0, 1.0),
+        rect(-0.5, -0.5, 0.5, 0.5),
+        rect(2.25, -0.75, 3.0, -0.25),
+        rect(3.0, 0.25, 3.75, 0.75),
+    ];
+    let mesh = triangulate(&rings).unwrap();
+    assert_eq!((mesh.report.outers, mesh.report.holes), (4, 2));
+    // Outer: 4 + 8 hole vertices, 2 holes → 12 + 4 − 2 = 14; each island 2. The hole edges at
+    // y = −1 line up with the bridge, so collinear points may merge and save triangles.
+    assert!((16..=20).contains(&mesh.triangle_count()), "{}", mesh.triangle_count());
+    let expected = 28.0 - 4.0 - 4.0 + 1.0 + 0.375 + 0.375;
+    assert!((mesh.report.polygon_area - expected).abs() < 1e-12);
+    assert!(mesh.report.area_deviation() < 1e-12);
+    assert_ccw(&mesh);
+    // UVs span the bounding rectangle of everything.
+    assert_eq!(mesh.uvs[0], [0.0, 0.0]);
+    assert_eq!(mesh.uvs[2], [1.0, 1.0]);
+}
+
+#[test]
+fn flat_layout_matches_rings() {
+    let outer = rect(0.0, 0.0, 10.0, 10.0);
+    let hole = rect(4.0, 4.0, 6.0, 6.0);
+    let coords: Vec<f64> = outer.iter().chain(&hole).flatten().copied().collect();
+    let flat = triangulate_flat(&coords, &[4]).unwrap();
+    let rings = triangulate(&[outer, hole]).unwrap();
+    assert_eq!(flat.len() / 3, 8);
+    assert_eq!(flat, rings.indices);
+}
+
+#[test]
+fn degenerate_rings_are_reported_not_meshed() {
+    let rings = vec![
+        rect(0.0, 0.0, 1.0, 1.0),
+        vec![[5.0, 5.0], [6.0, 6.0], [7.0, 7.0]],
+        vec![[9.0, 9.0], [9.0, 9.0], [9.0, 9.0]],
+        vec![],
+    ];
+    let mesh = triangulate(&rings).unwrap();
+    assert_eq!(mesh.triangle_count(), 2);
+    let reasons: Vec<_> = mesh.report.dropped.iter().map(|d| (d.ring, d.reason)).collect();
+    assert_eq!(reasons, vec![(1, DropReason::ZeroArea), (2, DropReason::TooFewPoints), (3, DropReason::TooFewPoints)]);
+    assert_eq!(mesh.report.warnings().len(), 3);
+}
+
+#[test]
+fn duplicates_and_collinear_runs_are_absorbed() {
+    let ring = vec![[0.0, 0.0], [0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, 2.0], [2.0, 2.0], [1.0, 2.0], [0.0, 2.0]];
+    let mesh = triangulate(&[ring]).unwrap();
+    assert!(mesh.report.area_deviation() < 1e-12);
+    assert_ccw(&mesh);
+}
+
+#[test]
+fn hole_touching_outer_and_self_touching_ring() {
+    // A hole sharing the outer ring's corner.
+    let mesh = triangulate(&[rect(0.0, 0.0, 4.0, 4.0), vec![[0.0, 0.0], [1.0, 2.0], [2.0, 1.0]]]).unwrap();
+    assert_eq!(mesh.report.holes, 1);
+    assert!(mesh.report.area_deviation() < 1e-12, "{:?}", mesh.report);
+    // A bow-tie of two squares touching at one vertex, as one ring.
+    let bow = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [2.0, 1.0], [2.0, 2.0], [1.0, 2.0], [1.0, 1.0], [0.0, 1.0]];
+    let mesh = triangulate(&[bow]).unwrap();
+    assert!(mesh.report.area_deviation() < 1e-12, "{:?}", mesh.report);
+    assert_ccw(&mesh);
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    assert_eq!(
+        triangulate(&[vec![[0.0, 0.0], [f64::NAN, 1.0], [1.0, 1.0]]]).unwrap_err(),
+        TriangulateError::NonFinite { ring: 0, vertex: 1 }
+    );
+    assert_eq!(triangulate_flat(&[0.0, 1.0, 2.0], &[]).unwrap_err(), TriangulateError::OddCoordinates(3));
+    assert!(matches!(triangulate_flat(&[0.0; 8], &[7]), Err(TriangulateError::BadHoleIndex { .. })));
+    assert!(triangulate::<Vec<[f64; 2]>>(&[]).unwrap().indices.is_empty());
+}
+
+#[test]
+fn large_comb_uses_the_hash_and_stays_exact() {
+    // A comb of 400 teeth (1,602 vertices, all reflex notches): n − 2 triangles, exact area.
+    let teeth = 400;
+    let mut ring = vec![[0.0, -1.0]];
+    for i in 0..teeth {
+        let x = i as f64;
+        ring.extend([[x, 0.0], [x + 0.25, 10.0], [x + 0.5, 0.0]]);
+        ring.push([x + 0.75, 0.0]);
+    }
+    ring.push([teeth as f64, -1.0]);
+    let mesh = triangulate(&[ring.clone()]).unwrap();
+    assert!(mesh.report.area_deviation() < 1e-12, "{:?}", mesh.report);
+    assert_ccw(&mesh);
+    assert!(mesh.triangle_count() <= ring.len() - 2);
+}

@@ -1,0 +1,265 @@
+//! Triangulation end to end: earcut's fixture suite in four exact rotations (deviation bounds and
+//! triangle counts), property tests on random simple polygons with holes, and random garbage that
+//! must not panic or hang.
+
+use indra::geometry::triangulate::{Mesh2D, triangulate, triangulate_flat};
+use proptest::prelude::*;
+
+type Ring = Vec<[f64; 2]>;
+
+fn fixture(name: &str) -> Vec<Ring> {
+    let path = format!("{}/tests/fixtures/earcut/{name}.json", env!("CARGO_MANIFEST_DIR"));
+    let rings: Vec<Vec<Vec<f64>>> = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    rings.into_iter().map(|r| r.into_iter().map(|p| [p[0], p[1]]).collect()).collect()
+}
+
+/// Exact rotation by a multiple of 90°.
+fn rotate(rings: &[Ring], quarter_turns: u32) -> Vec<Ring> {
+    let turn = |[x, y]: [f64; 2]| match quarter_turns % 4 {
+        0 => [x, y],
+        1 => [-y, x],
+        2 => [-x, -y],
+        _ => [y, -x],
+    };
+    rings.iter().map(|r| r.iter().map(|&p| turn(p)).collect()).collect()
+}
+
+fn ring_area(ring: &[[f64; 2]]) -> f64 {
+    let mut sum = 0.0;
+    for (i, a) in ring.iter().enumerate() {
+        let b = ring[(i + 1) % ring.len()];
+        sum += a[0] * b[1] - b[0] * a[1];
+    }
+    sum / 2.0
+}
+
+/// earcut's deviation: |Σ |triangle| − (|outer| − Σ |hole|)| / (|outer| − Σ |hole|). For a
+/// polygon of no area, the triangles' area relative to the bounding box instead.
+fn deviation(rings: &[Ring], indices: &[u32]) -> f64 {
+    let vertices: Vec<[f64; 2]> = rings.concat();
+    let polygon = ring_area(&rings[0]).abs() - rings[1..].iter().map(|r| ring_area(r).abs()).sum::<f64>();
+    let triangles: f64 = indices
+        .chunks_exact(3)
+        .map(|t| ring_area(&[vertices[t[0] as usize], vertices[t[1] as usize], vertices[t[2] as usize]]).abs())
+        .sum();
+    if polygon > 0.0 {
+        ((triangles - polygon) / polygon).abs()
+    } else {
+        let (lo, hi) = vertices.iter().fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), p| {
+            ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])])
+        });
+        triangles / ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(f64::MIN_POSITIVE)
+    }
+}
+
+fn flat(rings: &[Ring]) -> (Vec<f64>, Vec<usize>) {
+    let coords = rings.iter().flatten().flatten().copied().collect();
+    let mut starts = Vec::new();
+    let mut n = 0;
+    for ring in &rings[..rings.len() - 1] {
+        n += ring.len();
+        starts.push(n);
+    }
+    (coords, starts)
+}
+
+/// (fixture, earcut's triangle count, maximum deviation). Counts are implementation-specific
+/// (collinear points merge, fallbacks drop points): ours must not exceed earcut's by more than 2%
+/// or 3 triangles, nor n + 2h − 2. Deviation bounds are those of earcut's own suite (0 = exact, 1e-14)
+/// except for [`CROSSING`].
+const FIXTURES: &[(&str, usize, f64)] = &[
+    ("building", 13, 0.0),
+    ("dude", 106, 0.0),
+    ("water", 2482, 9e-4),
+    ("water2", 1212, 0.0),
+    ("water3", 197, 0.0),
+    ("water3b", 25, 0.0),
+    ("water4", 705, 0.0),
+    ("water-huge", 5174, CROSSING),
+    ("water-huge2", 4461, CROSSING),
+    ("degenerate", 0, 0.0),
+    ("bad-hole", 42, CROSSING),
+    ("empty-square", 0, 0.0),
+    ("issue16", 12, 0.0),
+    ("issue17", 11, 0.0),
+    ("steiner", 9, 0.0),
+    ("issue29", 40, 0.0),
+    ("issue34", 139, 0.0),
+    ("issue35", 844, 0.0),
+    ("self-touching", 124, 3.4e-14),
+    ("outside-ring", 64, 0.0),
+    ("simplified-us-border", 120, 0.0),
+    ("touching-holes", 57, 0.0),
+    ("hole-touching-outer", 77, 0.0),
+    ("hilbert", 1024, 0.0),
+    ("issue45", 10, 0.0),
+    ("eberly-3", 73, 0.0),
+    ("eberly-6", 1429, 0.0),
+    ("issue52", 109, 0.0),
+    ("shared-points", 4, 0.0),
+    ("bad-diagonals", 7, 0.0),
+    ("issue83", 0, 1e-14),
+    ("infinite-loop-jhl", 0, 1e-14),
+    ("filtered-bridge-jhl", 25, 1e-14),
+    ("issue142", 0, 0.13),
+    ("issue149", 0, 1e-14),
+];
+
+/// Deviation bound for the fixtures whose rings cross each other (no exact triangulation exists;
+/// the result depends on where the cuts fall): water-huge, water-huge2, bad-hole. The `earcut`
+/// crate itself reaches 0.072 on them under rotation and mirroring (measured with the same
+/// deviation); earcut's suite allows 1.8e-3, 3e-3 and 0.019 at 0° only.
+const CROSSING: f64 = 0.12;
+
+#[test]
+fn earcut_fixtures_in_four_rotations() {
+    let mut failures = Vec::new();
+    for &(name, expected, bound) in FIXTURES {
+        let base = fixture(name);
+        let n: usize = base.iter().map(Vec::len).sum();
+        let formula = (n + 2 * (base.len() - 1)).saturating_sub(2);
+        let tolerance = if bound == CROSSING { 0.05 } else { 0.02 };
+        for turn in 0..4 {
+            let rings = rotate(&base, turn);
+            let (coords, starts) = flat(&rings);
+            let indices = triangulate_flat(&coords, &starts).unwrap();
+            let count = indices.len() / 3;
+            let dev = deviation(&rings, &indices);
+            // Fewer is fine (collinear points merged); more would mean extra cuts.
+            let near = count as f64 <= (expected as f64 * (1.0 + tolerance)).max(expected as f64 + 3.0);
+            if count > formula || (expected > 0 && !near) || dev > bound.max(1e-14) {
+                failures.push(format!(
+                    "{name} @{}°: {count} triangles (earcut {expected}), deviation {dev:.3e} (bound {bound:.1e})",
+                    turn * 90
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn fixtures_without_a_valid_interior_give_no_triangles() {
+    for name in ["degenerate", "empty-square"] {
+        let (coords, starts) = flat(&fixture(name));
+        assert!(triangulate_flat(&coords, &starts).unwrap().is_empty(), "{name}");
+    }
+}
+
+/// A star-shaped ring around `centre`: n angles evenly spaced and jittered by up to half a step
+/// (`jitter` in [0, 1)), radii in whatever range the caller drew.
+fn star(centre: [f64; 2], jitter: &[f64], radii: &[f64]) -> Ring {
+    let step = std::f64::consts::TAU / jitter.len() as f64;
+    jitter
+        .iter()
+        .zip(radii)
+        .enumerate()
+        .map(|(i, (&j, &r))| {
+            let t = (i as f64 + 0.5 * j) * step;
+            [centre[0] + r * t.cos(), centre[1] + r * t.sin()]
+        })
+        .collect()
+}
+
+/// A random simple polygon: a star-shaped outer ring (≥ 12 vertices, radius 0.5–1, so angular
+/// gaps < 45° keep the disc of radius 0.45 inside) and up to 16 star-shaped holes of radius ≤ 0.075
+/// in disjoint cells of a 4×4 grid of pitch 0.16 within that disc (from 8 holes the bridge search
+/// uses its band index, so both paths are covered).
+fn polygon() -> impl Strategy<Value = Vec<Ring>> {
+    let ring = |n: std::ops::Range<usize>, r_min: f64, r_max: f64| {
+        n.prop_flat_map(move |n| (prop::collection::vec(0.0..1.0, n), prop::collection::vec(r_min..r_max, n)))
+    };
+    let outer = ring(12..80, 0.5, 1.0);
+    let holes = prop::collection::vec((any::<prop::sample::Index>(), ring(3..12, 0.02, 0.075)), 0..24);
+    (outer, holes).prop_map(|((jitter, radii), holes)| {
+        let mut rings = vec![star([0.0, 0.0], &jitter, &radii)];
+        let mut used = [false; 16];
+        for (cell, (hole_jitter, hole_radii)) in holes {
+            let c = cell.index(16);
+            if std::mem::replace(&mut used[c], true) {
+                continue;
+            }
+            let centre = [(c % 4) as f64 * 0.16 - 0.24, (c / 4) as f64 * 0.16 - 0.24];
+            rings.push(star(centre, &hole_jitter, &hole_radii));
+        }
+        rings
+    })
+}
+
+/// Three nearly collinear consecutive points would let a correct triangulator merge them.
+fn in_general_position(rings: &[Ring]) -> bool {
+    rings.iter().all(|r| {
+        (0..r.len()).all(|i| {
+            let (a, b, c) = (r[i], r[(i + 1) % r.len()], r[(i + 2) % r.len()]);
+            ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs() > 1e-9
+        })
+    })
+}
+
+fn point_in_ring(p: [f64; 2], ring: &[[f64; 2]]) -> bool {
+    let mut inside = false;
+    let mut j = ring.len() - 1;
+    for i in 0..ring.len() {
+        let (a, b) = (ring[i], ring[j]);
+        if (a[1] > p[1]) != (b[1] > p[1]) && p[0] < (b[0] - a[0]) * (p[1] - a[1]) / (b[1] - a[1]) + a[0] {
+            inside = !inside;
+        }
+        j = i;
+    }
+    inside
+}
+
+fn check_mesh(rings: &[Ring], mesh: &Mesh2D) -> Result<(), TestCaseError> {
+    // The outer ring is the largest, wherever the input put it.
+    let outer = (0..rings.len()).max_by(|&a, &b| ring_area(&rings[a]).abs().total_cmp(&ring_area(&rings[b]).abs()));
+    let outer = outer.unwrap();
+    let mut ordered = vec![rings[outer].clone()];
+    ordered.extend(rings.iter().enumerate().filter(|&(i, _)| i != outer).map(|(_, r)| r.clone()));
+    let n: usize = rings.iter().map(Vec::len).sum();
+    let h = rings.len() - 1;
+    prop_assert_eq!(mesh.triangle_count(), n + 2 * h - 2);
+    prop_assert!(mesh.report.area_deviation() <= 1e-9, "deviation {}", mesh.report.area_deviation());
+    // Independently of the report: mesh positions are the input rings in input order.
+    prop_assert_eq!(&mesh.positions, &rings.concat());
+    let triangles: f64 =
+        mesh.indices.chunks_exact(3).map(|t| ring_area(&[t[0], t[1], t[2]].map(|i| mesh.positions[i as usize]))).sum();
+    let polygon = ring_area(&ordered[0]).abs() - ordered[1..].iter().map(|r| ring_area(r).abs()).sum::<f64>();
+    prop_assert!(((triangles - polygon) / polygon).abs() <= 1e-9);
+    for t in mesh.indices.chunks_exact(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| mesh.positions[i as usize]);
+        let cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        prop_assert!(cross > 0.0, "triangle {:?} not counter-clockwise", t);
+        let centroid = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0];
+        prop_assert!(point_in_ring(centroid, &ordered[0]), "triangle {:?} outside the outer ring", t);
+        prop_assert!(!ordered[1..].iter().any(|hole| point_in_ring(centroid, hole)), "triangle {:?} in a hole", t);
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 400, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_polygons_with_holes(rings in polygon(), reverse in any::<bool>()) {
+        prop_assume!(in_general_position(&rings));
+        for turn in 0..4 {
+            let mut rings = rotate(&rings, turn);
+            if reverse {
+                // Orientation and ring order must not matter.
+                rings.iter_mut().for_each(|r| r.reverse());
+                rings.reverse();
+            }
+            let mesh = triangulate(&rings).unwrap();
+            check_mesh(&rings, &mesh)?;
+        }
+    }
+
+    #[test]
+    fn garbage_never_panics(rings in prop::collection::vec(prop::collection::vec(prop::array::uniform2(-3i8..3), 0..40), 0..6)) {
+        // Integer grids are full of repeats, collinear runs, touching and crossing rings.
+        let rings: Vec<Ring> = rings.iter().map(|r| r.iter().map(|p| [p[0] as f64, p[1] as f64]).collect()).collect();
+        let mesh = triangulate(&rings).unwrap();
+        prop_assert!(mesh.indices.iter().all(|&i| (i as usize) < mesh.positions.len()));
+        prop_assert!(mesh.report.area_deviation().is_finite() || mesh.report.polygon_area == 0.0);
+    }
+}
