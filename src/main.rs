@@ -1,6 +1,7 @@
 //! The `indra` command line: parsing only; each command's work is in `commands`.
 
 mod commands;
+mod triangulate_cmd;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -48,6 +49,8 @@ enum Command {
     List,
     /// Render off-screen and print per-pass GPU medians and frame time.
     Bench(commands::BenchArgs),
+    /// Triangulate rings from a JSON or SVG file; print triangle count, area deviation and time.
+    Triangulate(triangulate_cmd::TriangulateArgs),
 }
 
 fn main() -> ExitCode {
@@ -65,6 +68,7 @@ fn main() -> ExitCode {
         Some(Command::Check { files }) => commands::check(&assets, &files),
         Some(Command::List) => commands::list(&assets),
         Some(Command::Bench(args)) => commands::bench(&assets, &gpu, &args),
+        Some(Command::Triangulate(args)) => triangulate_cmd::triangulate(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -195,3 +195,43 @@ fn render_replays_a_recorded_control_stream() {
     assert_eq!(bad.status.code(), Some(1));
     assert!(text(&bad).contains("show.ron:1:"), "{}", text(&bad));
 }
+
+#[test]
+fn triangulate_reads_json_and_svg_and_writes_the_mesh() {
+    let dir = temp_dir("triangulate");
+    let fixture = format!("{}/tests/fixtures/earcut/dude.json", env!("CARGO_MANIFEST_DIR"));
+    let o = indra(&["triangulate", &fixture]);
+    assert!(o.status.success(), "{}", text(&o));
+    // dude: 104 vertices, 2 holes → 106 triangles, exact area.
+    assert!(text(&o).contains("3 rings (1 filled, 2 holes), 104 vertices → 106 triangles"), "{}", text(&o));
+    let deviation: f64 = text(&o).split("area deviation ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    assert!(deviation < 1e-12, "{}", text(&o));
+
+    let svg = dir.join("square.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg"><path d="M0 0 H10 V10 H0 Z M2 2 h6 v6 h-6 z"/></svg>"#,
+    )
+    .unwrap();
+    let mesh = dir.join("square.json");
+    let o = indra(&["triangulate", svg.to_str().unwrap(), "--out", mesh.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&mesh).unwrap()).unwrap();
+    assert_eq!(json["indices"].as_array().unwrap().len(), 8 * 3);
+    assert_eq!(json["positions"].as_array().unwrap().len(), 8);
+    assert_eq!(json["uvs"][2], serde_json::json!([1.0, 1.0]));
+}
+
+#[test]
+fn triangulate_bad_input_is_one_clear_message() {
+    let dir = temp_dir("triangulate-bad");
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, "[[[0, 0], [1, 0]").unwrap();
+    let o = indra(&["triangulate", bad.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("JSON rings (an array of rings of [x, y])"), "{}", text(&o));
+    let path = dir.join("bad.svgd");
+    std::fs::write(&path, "M0 0 L10 x").unwrap();
+    let o = indra(&["triangulate", path.to_str().unwrap()]);
+    assert!(!o.status.success() && text(&o).contains("SVG path data"), "{}", text(&o));
+}
