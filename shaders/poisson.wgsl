@@ -1,0 +1,61 @@
+// Poisson disk samples [UGP4 ch.7] as instanced camera-facing quads: flat discs (2-D, seen from
+// above) or sphere impostors lit by one light (3-D). Colour follows insertion order along a
+// blue-magenta-yellow ramp, so the growth front reads as the brightest samples.
+
+struct PoissonUniforms {
+    view_proj: mat4x4<f32>,
+    right: vec4<f32>,       // xyz: camera right (world, unit)
+    up: vec4<f32>,          // xyz: camera up (world, unit)
+    draw_radius: f32,       // radius of each drawn disc or sphere (world units)
+    count: f32,             // samples so far
+    spheres: u32,           // 0: discs, 1: lit spheres
+    _pad: f32,
+};
+
+@group(0) @binding(0) var<uniform> u: PoissonUniforms;
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) corner: vec2<f32>,   // quad coordinates in [-1, 1]
+    @location(1) order: f32,          // insertion order in [0, 1]
+};
+
+@vertex
+fn vs_main(@builtin(vertex_index) index: u32, @location(0) sample: vec4<f32>) -> VertexOut {
+    let quad = array<vec2<f32>, 6>(
+        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0),
+        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0),
+    );
+    let c = quad[index];
+    let world = sample.xyz + (u.right.xyz * c.x + u.up.xyz * c.y) * u.draw_radius;
+    var out: VertexOut;
+    out.clip = u.view_proj * vec4<f32>(world, 1.0);
+    out.corner = c;
+    out.order = sample.w / max(u.count - 1.0, 1.0);
+    return out;
+}
+
+// Deep blue → magenta → yellow (sRGB anchors), returned in linear light.
+fn ramp(t: f32) -> vec3<f32> {
+    let blue = vec3<f32>(0.15, 0.25, 0.95);
+    let magenta = vec3<f32>(0.9, 0.2, 0.6);
+    let yellow = vec3<f32>(1.0, 0.9, 0.25);
+    let srgb = select(mix(magenta, yellow, t * 2.0 - 1.0), mix(blue, magenta, t * 2.0), t < 0.5);
+    return pow(srgb, vec3<f32>(2.2));
+}
+
+@fragment
+fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    let d2 = dot(in.corner, in.corner);
+    if (d2 > 1.0) {
+        discard;
+    }
+    var color = ramp(in.order);
+    if (u.spheres == 1u) {
+        // Sphere normal in camera space from the quad position; light from upper left, front.
+        let normal = vec3<f32>(in.corner, -sqrt(1.0 - d2));
+        let light = normalize(vec3<f32>(-0.5, 0.7, -0.6));
+        color = color * (0.15 + 0.85 * max(dot(normal, light), 0.0));
+    }
+    return vec4<f32>(color, 1.0);
+}

@@ -1,0 +1,351 @@
+//! Poisson disk samples growing step by step [UGP4 ch.7]: the 2-D set as flat discs seen from
+//! above, the 3-D set as lit spheres seen by an orbiting camera, both coloured by insertion order
+//! (first samples deep blue, through magenta, newest yellow). Sampling is [`crate::geometry::poisson`] on the CPU;
+//! each fixed step runs `steps_per_step` sampler steps and only new samples are uploaded.
+//! Changing dimensions, radius, attempts, extent or seed restarts the run (so does `restart`).
+//! Shader: `shaders/poisson.wgsl` (instanced quads: discs, or sphere impostors).
+
+use crate::geometry::poisson::{PoissonDisk, PoissonSettings, Step};
+use crate::gpu::ShaderError;
+use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
+use crate::params::{ParamDecl, ParamSet, ParamValue};
+use crate::time::FrameTime;
+
+use super::{NodeSetup, Technique, TechniqueInfo};
+
+/// The registry entry.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "poisson",
+    chapter: "7: Fast Poisson disk sampling",
+    summary: "Bridson Poisson disk samples in 2-D or 3-D, growing step by step",
+    params,
+    inputs: &[],
+    shaders: &["poisson.wgsl"],
+    create,
+};
+
+const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Parameters; defaults are the sample's 2-D scene (seed-reference §7).
+pub fn params() -> Vec<ParamDecl> {
+    use ParamValue::*;
+    vec![
+        ParamDecl::choice("dimensions", &["2d", "3d"], 0, "sample a rectangle (discs) or a box (spheres)"),
+        ParamDecl::new("radius", Float(5.0), Some((0.5, 100.0)), "minimum distance between samples").with_unit("u"),
+        ParamDecl::new("attempts", Int(30), Some((1.0, 200.0)), "candidates per active sample before it retires (k)"),
+        ParamDecl::new("extent", Vec3([200.0, 200.0, 200.0]), Some((1.0, 10000.0)), "size of the box (2-D uses x, y)"),
+        ParamDecl::new("seed", Int(1), Some((0.0, 1e9)), "seed of every random choice"),
+        ParamDecl::new("steps_per_step", Int(2), Some((0.0, 100000.0)), "sampler steps per fixed time step"),
+        ParamDecl::new("draw_scale", Float(1.0), Some((0.05, 2.0)), "drawn radius = radius × draw_scale / 2"),
+        ParamDecl::new("orbit_speed", Float(10.0), Some((-360.0, 360.0)), "3-D camera orbit").with_unit("°/s"),
+        ParamDecl::trigger("restart", "start sampling again from one seed point"),
+    ]
+}
+
+/// The shader's uniform block.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct PoissonUniforms {
+    /// Projection × view.
+    pub view_proj: [[f32; 4]; 4],
+    /// Camera right (world, unit) — billboard axis.
+    pub right: [f32; 4],
+    /// Camera up (world, unit) — billboard axis.
+    pub up: [f32; 4],
+    /// Drawn radius of a sample.
+    pub draw_radius: f32,
+    /// Samples so far (for the colour ramp).
+    pub count: f32,
+    /// 0: flat discs, 1: lit spheres.
+    pub spheres: u32,
+    /// Padding.
+    pub _pad: f32,
+}
+
+/// What restarts a run when it changes.
+#[derive(Clone, Debug, PartialEq)]
+struct RunKey {
+    three_d: bool,
+    radius: f32,
+    attempts: i32,
+    extent: [f32; 3],
+    seed: i32,
+}
+
+impl RunKey {
+    fn of(p: &ParamSet) -> Self {
+        let e = p.get("extent").components();
+        Self {
+            three_d: p.choice("dimensions") == 1,
+            radius: p.float("radius"),
+            attempts: p.int("attempts"),
+            extent: [e[0], e[1], e[2]],
+            seed: p.int("seed"),
+        }
+    }
+}
+
+enum Sampler {
+    Flat(PoissonDisk<2>),
+    Volume(PoissonDisk<3>),
+}
+
+impl Sampler {
+    fn new(key: &RunKey) -> Self {
+        fn settings<const N: usize>(key: &RunKey, extent: [f64; N]) -> PoissonSettings<N> {
+            let mut s = PoissonSettings::new(extent, f64::from(key.radius), key.seed as u64);
+            s.attempts = key.attempts.max(1) as u32;
+            s
+        }
+        let [x, y, z] = key.extent.map(f64::from);
+        if key.three_d {
+            Sampler::Volume(PoissonDisk::new(settings(key, [x, y, z])))
+        } else {
+            Sampler::Flat(PoissonDisk::new(settings(key, [x, y])))
+        }
+    }
+
+    /// One sampler step; false when the run is complete.
+    fn step(&mut self) -> bool {
+        match self {
+            Sampler::Flat(s) => !matches!(s.step(), Step::Done),
+            Sampler::Volume(s) => !matches!(s.step(), Step::Done),
+        }
+    }
+
+    /// Sample positions from `from` on, centred on the origin, as (x, y, z, insertion index).
+    fn instances_from(&self, from: usize, key: &RunKey, out: &mut Vec<[f32; 4]>) {
+        let half = key.extent.map(|e| e / 2.0);
+        match self {
+            Sampler::Flat(s) => out.extend(
+                s.points()[from..]
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| [p[0] as f32 - half[0], p[1] as f32 - half[1], 0.0, (from + i) as f32]),
+            ),
+            Sampler::Volume(s) => out.extend(s.points()[from..].iter().enumerate().map(|(i, p)| {
+                [p[0] as f32 - half[0], p[1] as f32 - half[1], p[2] as f32 - half[2], (from + i) as f32]
+            })),
+        }
+    }
+
+    fn len(&self) -> usize {
+        match self {
+            Sampler::Flat(s) => s.points().len(),
+            Sampler::Volume(s) => s.points().len(),
+        }
+    }
+}
+
+/// A Poisson disk node.
+pub struct Poisson {
+    pipeline: wgpu::RenderPipeline,
+    uniforms: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    instances: wgpu::Buffer,
+    capacity: usize,
+    /// Samples already in `instances`.
+    uploaded: usize,
+    key: Option<RunKey>,
+    sampler: Option<Sampler>,
+    /// The first frame whose sampler steps have not run yet: frames skipped by a seek are caught
+    /// up, so frame N renders the same whether reached by playing or by seeking.
+    next_frame: u64,
+    pending: Vec<[f32; 4]>,
+    device: wgpu::Device,
+}
+
+fn instance_buffer(device: &wgpu::Device, capacity: usize) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("poisson_instances"),
+        size: (capacity * size_of::<[f32; 4]>()) as u64,
+        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
+    let device = &setup.gpu.device;
+    let (origin, source) = setup.shader_source("poisson.wgsl")?;
+    let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("poisson_layout"),
+        entries: &[crate::gpu::uniform_entry::<PoissonUniforms>(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("poisson_pipeline_layout"),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("poisson_pipeline"),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: size_of::<[f32; 4]>() as u64,
+                step_mode: wgpu::VertexStepMode::Instance,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x4],
+            })],
+        },
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(FORMAT.into())],
+        }),
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: wgpu::MultisampleState::default(),
+        multiview_mask: None,
+        cache: None,
+    });
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(ShaderError { origin, line: 1, column: 1, message: e.to_string() });
+    }
+    let uniforms = crate::gpu::uniform_buffer::<PoissonUniforms>(device, "poisson_uniforms");
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("poisson_bind_group"),
+        layout: &layout,
+        entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() }],
+    });
+    let capacity = 4096;
+    Ok(Box::new(Poisson {
+        pipeline,
+        uniforms,
+        bind_group,
+        instances: instance_buffer(device, capacity),
+        capacity,
+        uploaded: 0,
+        key: None,
+        sampler: None,
+        next_frame: 0,
+        pending: Vec::new(),
+        device: device.clone(),
+    }))
+}
+
+impl Poisson {
+    /// Restarts the run if its settings changed or `restart` fired (a scene's first run counts
+    /// from frame 0, later ones from the frame they start in).
+    fn sync(&mut self, params: &ParamSet, time: &FrameTime) {
+        let key = RunKey::of(params);
+        let first = self.key.is_none();
+        if first || self.key.as_ref() != Some(&key) || params.fired("restart") {
+            self.sampler = Some(Sampler::new(&key));
+            self.key = Some(key);
+            self.uploaded = 0;
+            self.next_frame = if first { 0 } else { time.frame };
+        }
+    }
+}
+
+impl Technique for Poisson {
+    fn step(&mut self, params: &ParamSet, time: &FrameTime) {
+        self.sync(params, time);
+        let frames = (time.frame + 1).saturating_sub(self.next_frame);
+        self.next_frame = time.frame + 1;
+        let sampler = self.sampler.as_mut().expect("synced");
+        for _ in 0..frames * params.int("steps_per_step").max(0) as u64 {
+            if !sampler.step() {
+                break;
+            }
+        }
+    }
+
+    fn add_passes<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        params: &ParamSet,
+        time: &FrameTime,
+        _inputs: &[TextureHandle],
+    ) -> TextureHandle {
+        self.sync(params, time);
+        let key = self.key.clone().expect("synced");
+        let sampler = self.sampler.as_ref().expect("synced");
+        let count = sampler.len();
+        if count > self.capacity {
+            // Grow by doubling; everything is uploaded again into the new buffer.
+            self.capacity = count.next_power_of_two();
+            self.instances = instance_buffer(&self.device, self.capacity);
+            self.uploaded = 0;
+        }
+        self.pending.clear();
+        let first_new = self.uploaded;
+        sampler.instances_from(first_new, &key, &mut self.pending);
+        self.uploaded = count;
+
+        let color = graph.create_texture("poisson/image", TextureDesc::full(FORMAT));
+        let depth = graph.create_texture("poisson/depth", TextureDesc::full(DEPTH));
+        let (w, h) = graph.texture_size(color);
+        let uniforms = camera(&key, params, time, w as f32 / h as f32, count);
+        let this: &'r Poisson = self;
+        graph.add_pass("poisson/draw").render_target(color).render_target(depth).record(move |ctx| {
+            ctx.queue.write_buffer(&this.uniforms, 0, bytemuck::bytes_of(&uniforms));
+            if !this.pending.is_empty() {
+                let offset = (first_new * size_of::<[f32; 4]>()) as u64;
+                ctx.queue.write_buffer(&this.instances, offset, bytemuck::cast_slice(&this.pending));
+            }
+            let mut pass = ctx.begin_color_depth_pass(color, depth, wgpu::Color::BLACK);
+            pass.set_pipeline(&this.pipeline);
+            pass.set_bind_group(0, &this.bind_group, &[]);
+            pass.set_vertex_buffer(0, this.instances.slice(..));
+            pass.draw(0..6, 0..count as u32);
+        });
+        color
+    }
+}
+
+/// 2-D: orthographic, top-down, the rectangle fitted with a 5% margin. 3-D: perspective (60°),
+/// orbiting the box at 0.8 × its diagonal, slightly from above.
+fn camera(key: &RunKey, params: &ParamSet, time: &FrameTime, aspect: f32, count: usize) -> PoissonUniforms {
+    use glam::Vec3;
+    let draw_radius = key.radius * params.float("draw_scale") / 2.0;
+    let (view_proj, right, up) = if key.three_d {
+        let diagonal = Vec3::from(key.extent).length();
+        let angle = (params.float("orbit_speed") * time.seconds as f32).to_radians();
+        // Close enough that the box fills about two thirds of the 60° view (corners may leave it).
+        let eye = Vec3::new(angle.sin(), 0.35, -angle.cos()).normalize() * 0.8 * diagonal;
+        let view = glam::camera::lh::view::look_at_mat4(eye, Vec3::ZERO, Vec3::Y);
+        let proj =
+            glam::camera::lh::proj::directx::perspective(60f32.to_radians(), aspect, diagonal * 0.05, diagonal * 5.0);
+        let inverse = view.inverse();
+        (proj * view, inverse.x_axis.truncate(), inverse.y_axis.truncate())
+    } else {
+        let half = [key.extent[0] / 2.0 * 1.05, key.extent[1] / 2.0 * 1.05];
+        let (hw, hh) =
+            if half[0] / half[1] > aspect { (half[0], half[0] / aspect) } else { (half[1] * aspect, half[1]) };
+        let proj = glam::camera::lh::proj::directx::orthographic(-hw, hw, -hh, hh, -1.0, 1.0);
+        (proj, Vec3::X, Vec3::Y)
+    };
+    PoissonUniforms {
+        view_proj: view_proj.to_cols_array_2d(),
+        right: right.extend(0.0).into(),
+        up: up.extend(0.0).into(),
+        draw_radius,
+        count: count as f32,
+        spheres: u32::from(key.three_d),
+        _pad: 0.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uniform_layout_matches_the_wgsl_struct() {
+        let source = include_str!("../../../shaders/poisson.wgsl");
+        assert_eq!(crate::gpu::wgsl_struct_size(source, "PoissonUniforms"), Some(size_of::<PoissonUniforms>() as u32));
+    }
+}
