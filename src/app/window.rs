@@ -40,6 +40,8 @@ struct Running {
     last_time: crate::time::FrameTime,
     /// Panel events of the last frame, applied before the next step.
     ui_events: Vec<crate::scene::ControlEvent>,
+    /// Last cursor position over the window, in physical pixels.
+    pointer: [f32; 2],
 }
 
 /// The winit handler; creates the window on `resumed`, as winit 0.30 asks.
@@ -163,6 +165,7 @@ impl WindowApp {
             live,
             last_time,
             ui_events: Vec::new(),
+            pointer: [0.0, 0.0],
         })
     }
 }
@@ -230,12 +233,33 @@ impl ApplicationHandler for WindowApp {
                 if c.eq_ignore_ascii_case("r") {
                     r.ui_events.extend(r.instance.fire_all("reset", crate::params::Source::Ui));
                 }
+                // Drawing scenes: U removes the last polygon, C clears.
+                if c.eq_ignore_ascii_case("u") {
+                    r.ui_events.extend(r.instance.fire_all("undo", crate::params::Source::Ui));
+                }
+                if c.eq_ignore_ascii_case("c") {
+                    r.ui_events.extend(r.instance.fire_all("clear", crate::params::Source::Ui));
+                }
                 if let Some(i) = c.parse::<usize>().ok().filter(|i| (1..=9).contains(i))
                     && let Some(name) = r.hub.preset_names().get(i - 1).cloned()
                 {
                     let seconds = f64::from(r.overlay.morph_seconds);
                     let scene = r.instance.scene().clone();
                     r.ui_events.extend(r.hub.recall(&name, seconds, &scene));
+                }
+            }
+            WindowEvent::CursorMoved { position, .. } => r.pointer = [position.x as f32, position.y as f32],
+            // Clicks the panel did not take go to the scene (drawing nodes add/close points).
+            WindowEvent::MouseInput { state: ElementState::Pressed, button, .. } if !consumed => {
+                let primary = match button {
+                    winit::event::MouseButton::Left => Some(true),
+                    winit::event::MouseButton::Right => Some(false),
+                    _ => None,
+                };
+                if let Some(primary) = primary {
+                    let (w, h) = (r.config.width.max(1) as f32, r.config.height.max(1) as f32);
+                    let view = [r.pointer[0] / w, 1.0 - r.pointer[1] / h];
+                    r.ui_events.extend(r.instance.pointer(view, primary, crate::params::Source::Ui));
                 }
             }
             WindowEvent::RedrawRequested => {

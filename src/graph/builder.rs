@@ -236,15 +236,30 @@ impl PassContext<'_> {
         self.buffers[buffer.0 as usize].as_ref().map(|b| b.1).unwrap_or(0)
     }
 
-    /// Begins a render pass that clears colour target `color` to `clear` and depth target
-    /// `depth` to 1 (the far plane; depth is not kept after the pass).
+    /// Begins a render pass that clears `color` (and a depth buffer to 1.0, discarded after the
+    /// pass): the usual start of a rasterising technique.
     pub fn begin_color_depth_pass(
         &mut self,
         color: TextureHandle,
         depth: TextureHandle,
         clear: wgpu::Color,
     ) -> wgpu::RenderPass<'_> {
-        let (color_view, depth_view) = (self.view(color).clone(), self.view(depth).clone());
+        self.begin_pass(color, Some(depth), clear)
+    }
+
+    /// Begins a render pass that clears `color`, without depth.
+    pub fn begin_color_pass(&mut self, color: TextureHandle, clear: wgpu::Color) -> wgpu::RenderPass<'_> {
+        self.begin_pass(color, None, clear)
+    }
+
+    fn begin_pass(
+        &mut self,
+        color: TextureHandle,
+        depth: Option<TextureHandle>,
+        clear: wgpu::Color,
+    ) -> wgpu::RenderPass<'_> {
+        let color_view = self.view(color).clone();
+        let depth_view = depth.map(|d| self.view(d).clone());
         self.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(self.pass_name),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -253,8 +268,8 @@ impl PassContext<'_> {
                 resolve_target: None,
                 ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
             })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
+            depth_stencil_attachment: depth_view.as_ref().map(|view| wgpu::RenderPassDepthStencilAttachment {
+                view,
                 depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
                 stencil_ops: None,
             }),

@@ -254,6 +254,39 @@ impl SceneInstance {
         events
     }
 
+    /// Writes for a click at `position` (view units 0–1, y up): every node that declares a
+    /// vec2 `cursor` gets it set, then its `add` trigger (primary button) or `close` trigger
+    /// (secondary button) fires. This is how the window's mouse draws, through the same
+    /// parameters OSC and recordings use.
+    pub fn pointer(&self, position: [f32; 2], primary: bool, source: Source) -> Vec<ControlEvent> {
+        let trigger = if primary { "add" } else { "close" };
+        let mut events = Vec::new();
+        for (node, params) in self.params.iter().enumerate() {
+            let Some(cursor) =
+                params.index("cursor").filter(|&p| params.decls()[p].ty() == crate::params::ParamType::Vec2)
+            else {
+                continue;
+            };
+            events.push(ControlEvent::Write(ParamWrite {
+                node,
+                param: cursor,
+                component: None,
+                value: ParamValue::Vec2(position),
+                source,
+            }));
+            if let Some(param) = params.index(trigger) {
+                events.push(ControlEvent::Write(ParamWrite {
+                    node,
+                    param,
+                    component: None,
+                    value: ParamValue::Trigger(true),
+                    source,
+                }));
+            }
+        }
+        events
+    }
+
     /// Declares this frame: every node adds its passes, the output node's texture is the output.
     pub fn build_graph(&mut self, output_size: (u32, u32), time: &FrameTime) -> FrameGraph<'_> {
         let mut graph = FrameGraph::new(output_size);

@@ -9,6 +9,7 @@ pub mod cloth;
 pub mod cube_field;
 pub mod kleinian;
 pub mod poisson;
+pub mod polygon_draw;
 pub mod star_glow;
 
 use crate::assets::{AssetKind, Assets};
@@ -18,7 +19,8 @@ use crate::params::{ParamDecl, ParamSet};
 use crate::time::FrameTime;
 
 /// Every technique indra knows, by scene name.
-pub const REGISTRY: &[TechniqueInfo] = &[kleinian::INFO, star_glow::INFO, cube_field::INFO, cloth::INFO, poisson::INFO];
+pub const REGISTRY: &[TechniqueInfo] =
+    &[kleinian::INFO, star_glow::INFO, cube_field::INFO, cloth::INFO, poisson::INFO, polygon_draw::INFO];
 
 /// Finds a technique by the name scenes use.
 pub fn find(name: &str) -> Option<&'static TechniqueInfo> {

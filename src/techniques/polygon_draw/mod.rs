@@ -1,0 +1,182 @@
+//! The book's DrawTest [UGP4 ch.5]: draw polygons point by point; closing one re-triangulates
+//! all of them together, so rings inside rings become holes and islands by nesting. The fill is
+//! textured by a generated UV checker (UVs from the bounding rectangle of all polygons, as in the
+//! book) with the triangle wireframe on top; the loop being drawn cycles its hue.
+//!
+//! Input is parameters only, so OSC, MIDI, recordings and tests can draw as well as the mouse:
+//! `cursor` (view position, 0–1, y up) then the `add` trigger appends a vertex, `close` ends the
+//! polygon, `undo` removes the last polygon, `clear` removes all. In the window a left click
+//! sets `cursor` and fires `add`, a right click fires `close`, U and C fire `undo` and `clear`.
+//! Shader: `shaders/polygon_draw.wgsl`.
+
+mod gpu;
+
+use crate::geometry::triangulate::{Mesh2D, Triangulator};
+use crate::gpu::ShaderError;
+use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
+use crate::params::{ParamDecl, ParamSet, ParamValue};
+use crate::time::FrameTime;
+
+use super::{NodeSetup, Technique, TechniqueInfo};
+pub use gpu::PolygonUniforms;
+
+/// The registry entry.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "polygon_draw",
+    chapter: "5: Triangulation by ear clipping",
+    summary: "draw polygons with the mouse or OSC; holes and islands by nesting, UV checker + wireframe",
+    params,
+    inputs: &[],
+    shaders: &["polygon_draw.wgsl"],
+    create,
+};
+
+/// Parameters; the view is the sample's orthographic camera of size 5.
+pub fn params() -> Vec<ParamDecl> {
+    use ParamValue::*;
+    vec![
+        ParamDecl::new("cursor", Vec2([0.5, 0.5]), Some((0.0, 1.0)), "where `add` puts a vertex: view position, y up"),
+        ParamDecl::trigger("add", "append a vertex at the cursor to the polygon being drawn"),
+        ParamDecl::trigger("close", "close the polygon being drawn and re-triangulate everything"),
+        ParamDecl::trigger("undo", "remove the last closed polygon"),
+        ParamDecl::trigger("clear", "remove every polygon"),
+        ParamDecl::choice("start", &["book", "empty"], 0, "start with the book's nested test shapes, or nothing"),
+        ParamDecl::new("wireframe", Bool(true), None, "draw the triangle edges over the fill"),
+        ParamDecl::new("checker", Int(8), Some((1.0, 64.0)), "checker cells across the UV range"),
+        ParamDecl::new("view_size", Float(5.0), Some((0.5, 100.0)), "half the view height in world units"),
+    ]
+}
+
+/// The sample's TriangulationTest data (seed-reference §5): an outer ring, two holes, three
+/// islands inside the holes — clockwise, y up.
+pub fn book_shapes() -> Vec<Vec<[f64; 2]>> {
+    let rect = |x0: f64, y0: f64, x1: f64, y1: f64| vec![[x0, y0], [x0, y1], [x1, y1], [x1, y0]];
+    vec![
+        rect(-2.0, -2.0, 5.0, 2.0),
+        rect(-1.0, -1.0, 1.0, 1.0),
+        rect(2.0, -1.0, 4.0, 1.0),
+        rect(-0.5, -0.5, 0.5, 0.5),
+        rect(2.25, -0.75, 3.0, -0.25),
+        rect(3.0, 0.25, 3.75, 0.75),
+    ]
+}
+
+/// A drawing node.
+pub struct PolygonDraw {
+    gpu: gpu::Renderer,
+    polygons: Vec<Vec<[f64; 2]>>,
+    drawing: Vec<[f64; 2]>,
+    triangulator: Triangulator,
+    mesh: Mesh2D,
+    /// The `start` option the polygons were seeded from.
+    started: Option<u32>,
+    /// Whether the GPU buffers are behind the polygons.
+    dirty: bool,
+    messages: Vec<String>,
+}
+
+fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
+    Ok(Box::new(PolygonDraw {
+        gpu: gpu::Renderer::new(setup)?,
+        polygons: Vec::new(),
+        drawing: Vec::new(),
+        triangulator: Triangulator::new(),
+        mesh: Mesh2D::default(),
+        started: None,
+        dirty: true,
+        messages: Vec::new(),
+    }))
+}
+
+impl PolygonDraw {
+    /// The closed polygons, in world units.
+    pub fn polygons(&self) -> &[Vec<[f64; 2]>] {
+        &self.polygons
+    }
+
+    /// The current triangulation of all closed polygons.
+    pub fn mesh(&self) -> &Mesh2D {
+        &self.mesh
+    }
+
+    fn retriangulate(&mut self) {
+        self.mesh = match self.triangulator.rings(&self.polygons) {
+            Ok(mesh) => mesh,
+            Err(e) => {
+                self.messages.push(e.to_string());
+                Mesh2D::default()
+            }
+        };
+        self.messages.extend(self.mesh.report.warnings());
+        self.dirty = true;
+    }
+
+    /// Applies this frame's triggers (once per frame, whatever the number of fixed steps).
+    fn apply_triggers(&mut self, params: &ParamSet, aspect: f32) {
+        let start = params.choice("start");
+        let mut changed = false;
+        if self.started != Some(start) {
+            self.started = Some(start);
+            self.polygons = if start == 0 { book_shapes() } else { Vec::new() };
+            self.drawing.clear();
+            changed = true;
+        }
+        if params.fired("clear") {
+            self.polygons.clear();
+            self.drawing.clear();
+            changed = true;
+        }
+        if params.fired("undo") && self.polygons.pop().is_some() {
+            changed = true;
+        }
+        if params.fired("add") {
+            let [cx, cy] = params.vec2("cursor");
+            let half = f64::from(params.float("view_size"));
+            let world = [(f64::from(cx) * 2.0 - 1.0) * half * f64::from(aspect), (f64::from(cy) * 2.0 - 1.0) * half];
+            if self.drawing.last() != Some(&world) {
+                self.drawing.push(world);
+                self.dirty = true;
+            }
+        }
+        if params.fired("close") {
+            if self.drawing.len() >= 3 {
+                self.polygons.push(std::mem::take(&mut self.drawing));
+                changed = true;
+            } else if !self.drawing.is_empty() {
+                self.messages.push(format!("a polygon needs 3 points; this one has {}", self.drawing.len()));
+            }
+        }
+        if changed {
+            self.retriangulate();
+        }
+    }
+}
+
+impl Technique for PolygonDraw {
+    fn take_messages(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.messages)
+    }
+
+    fn add_passes<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        params: &ParamSet,
+        time: &FrameTime,
+        _inputs: &[TextureHandle],
+    ) -> TextureHandle {
+        let color = graph.create_texture("polygon_draw/image", TextureDesc::full(gpu::FORMAT));
+        let (w, h) = graph.texture_size(color);
+        let aspect = w as f32 / h as f32;
+        self.apply_triggers(params, aspect);
+        if std::mem::take(&mut self.dirty) {
+            self.gpu.upload(&self.mesh, &self.drawing);
+        }
+        let uniforms = PolygonUniforms::new(params, time, aspect);
+        let this: &'r PolygonDraw = self;
+        let wireframe = params.bool("wireframe");
+        graph.add_pass("polygon_draw/draw").render_target(color).record(move |ctx| {
+            this.gpu.record(ctx, color, &uniforms, wireframe);
+        });
+        color
+    }
+}
