@@ -194,6 +194,14 @@ fn param_widget(ui: &mut egui::Ui, decl: &ParamDecl, value: &mut ParamValue) -> 
             *fired = ui.button("fire").clicked();
             *fired
         }
+        ParamValue::Text(text) => {
+            let mut edit = text.as_str().to_string();
+            let changed = ui.text_edit_singleline(&mut edit).changed();
+            if changed {
+                *text = crate::params::Text::new(&edit);
+            }
+            changed
+        }
         ParamValue::Enum(i) => {
             let before = *i;
             let shown = decl.format(&ParamValue::Enum(*i));

@@ -49,6 +49,7 @@ impl OscFeedback {
                     ParamValue::Int(i) => vec![OscType::Int(i)],
                     ParamValue::Bool(b) => vec![OscType::Bool(b)],
                     ParamValue::Enum(i) => vec![OscType::String(decl.format(&ParamValue::Enum(i)))],
+                    ParamValue::Text(t) => vec![OscType::String(t.as_str().to_string())],
                     other => other.components().into_iter().map(OscType::Float).collect(),
                 };
                 let packet = OscPacket::Message(OscMessage { addr: param_address(&node.id, &decl.name), args });

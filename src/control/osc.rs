@@ -298,7 +298,8 @@ fn numbers(args: &[OscType]) -> Option<Vec<f64>> {
 }
 
 /// Arguments as a value of `decl`'s type: N numbers for N components (colours 3 or 4), a
-/// string or index for enums, T/F or 0/1 for bools, anything for triggers. Ranges clamp later.
+/// string or index for enums, a string for text, T/F or 0/1 for bools, anything for triggers.
+/// Ranges clamp later.
 pub fn coerce_args(args: &[OscType], decl: &ParamDecl) -> Option<ParamValue> {
     match decl.ty() {
         ParamType::Trigger => match numbers(args) {
@@ -310,6 +311,13 @@ pub fn coerce_args(args: &[OscType], decl: &ParamDecl) -> Option<ParamValue> {
             _ => numbers(args)
                 .filter(|n| n.len() == 1 && n[0] >= 0.0 && (n[0] as usize) < decl.options.len())
                 .map(|n| ParamValue::Enum(n[0] as u32)),
+        },
+        // Text takes one string (TouchOSC text fields); a number is written as text.
+        ParamType::Text => match args {
+            [OscType::String(text)] => Some(ParamValue::Text(crate::params::Text::new(text))),
+            _ => numbers(args)
+                .filter(|n| n.len() == 1)
+                .map(|n| ParamValue::Text(crate::params::Text::new(&n[0].to_string()))),
         },
         ParamType::Bool => numbers(args).filter(|n| n.len() == 1).map(|n| ParamValue::Bool(n[0] != 0.0)),
         ParamType::Int => numbers(args).filter(|n| n.len() == 1).map(|n| ParamValue::Int(n[0].round() as i32)),

@@ -23,7 +23,7 @@ fn type_tag(ty: ParamType) -> &'static str {
         ParamType::Vec2 => "ff",
         ParamType::Vec3 => "fff",
         ParamType::Vec4 | ParamType::Color => "ffff",
-        ParamType::Enum => "s",
+        ParamType::Enum | ParamType::Text => "s",
         ParamType::Trigger => "I",
     }
 }
@@ -33,6 +33,7 @@ fn value_json(value: &ParamValue, decl: &ParamDecl) -> Value {
         ParamValue::Int(i) => json!([i]),
         ParamValue::Bool(b) => json!([b]),
         ParamValue::Enum(_) => json!([decl.format(value)]),
+        ParamValue::Text(t) => json!([t.as_str()]),
         ParamValue::Trigger(_) => json!([]),
         other => json!(other.components()),
     }

@@ -10,5 +10,5 @@ mod write;
 pub use morph::Morph;
 pub use set::ParamSet;
 pub use track::{Interpolation, Key, LoopMode, Track, mix};
-pub use value::{ParamDecl, ParamType, ParamValue};
+pub use value::{ParamDecl, ParamType, ParamValue, Text};
 pub use write::{ParamWrite, Source};

@@ -23,6 +23,8 @@ pub enum ParamType {
     Enum,
     /// A momentary event (button): true for the one frame it fires in, never smoothed.
     Trigger,
+    /// A short string (text field); up to [`Text::CAPACITY`] bytes of UTF-8.
+    Text,
 }
 
 impl ParamType {
@@ -33,6 +35,7 @@ impl ParamType {
             ParamType::Vec2 => 2,
             ParamType::Vec3 => 3,
             ParamType::Vec4 | ParamType::Color => 4,
+            ParamType::Text => 0,
         }
     }
 
@@ -48,6 +51,7 @@ impl ParamType {
             ParamType::Color => "color",
             ParamType::Enum => "enum",
             ParamType::Trigger => "trigger",
+            ParamType::Text => "text",
         }
     }
 
@@ -103,6 +107,44 @@ pub enum ParamValue {
     Enum(u32),
     /// See [`ParamType::Trigger`]: whether it fired this frame.
     Trigger(bool),
+    /// See [`ParamType::Text`].
+    Text(Text),
+}
+
+/// A short UTF-8 string stored inline, so that values stay `Copy` (they are written from
+/// control threads and snapshotted every frame). Longer input is cut at a character boundary.
+#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Text {
+    len: u8,
+    bytes: [u8; Text::CAPACITY],
+}
+
+impl Text {
+    /// Most bytes a text value holds.
+    pub const CAPACITY: usize = 62;
+
+    /// `text`, cut to [`Text::CAPACITY`] bytes at a character boundary.
+    pub fn new(text: &str) -> Self {
+        let mut end = text.len().min(Self::CAPACITY);
+        while !text.is_char_boundary(end) {
+            end -= 1;
+        }
+        let mut bytes = [0; Self::CAPACITY];
+        bytes[..end].copy_from_slice(&text.as_bytes()[..end]);
+        Self { len: end as u8, bytes }
+    }
+
+    /// The string.
+    pub fn as_str(&self) -> &str {
+        // Only `new` writes the bytes, from a &str cut at a boundary.
+        std::str::from_utf8(&self.bytes[..usize::from(self.len)]).unwrap_or_default()
+    }
+}
+
+impl fmt::Debug for Text {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Debug::fmt(self.as_str(), f)
+    }
 }
 
 impl ParamValue {
@@ -118,6 +160,7 @@ impl ParamValue {
             ParamValue::Color(_) => ParamType::Color,
             ParamValue::Enum(_) => ParamType::Enum,
             ParamValue::Trigger(_) => ParamType::Trigger,
+            ParamValue::Text(_) => ParamType::Text,
         }
     }
 
@@ -132,10 +175,12 @@ impl ParamValue {
             ParamValue::Vec4(v) | ParamValue::Color(v) => v.to_vec(),
             ParamValue::Enum(i) => vec![i as f32],
             ParamValue::Trigger(b) => vec![if b { 1.0 } else { 0.0 }],
+            ParamValue::Text(_) => Vec::new(),
         }
     }
 
-    /// A value of type `ty` from float components (ints round, bools threshold at 0.5).
+    /// A value of type `ty` from float components (ints round, bools threshold at 0.5; text has
+    /// no components and comes out empty).
     pub fn from_components(ty: ParamType, c: &[f32]) -> ParamValue {
         let at = |i: usize| c.get(i).copied().unwrap_or(0.0);
         match ty {
@@ -148,13 +193,14 @@ impl ParamValue {
             ParamType::Color => ParamValue::Color([at(0), at(1), at(2), at(3)]),
             ParamType::Enum => ParamValue::Enum(at(0).round().max(0.0) as u32),
             ParamType::Trigger => ParamValue::Trigger(at(0) >= 0.5),
+            ParamType::Text => ParamValue::Text(Text::new("")),
         }
     }
 
     /// Clamps every component into `range` (colours are not clamped by a range; they keep [0, ∞)).
     pub fn clamped(&self, range: Option<(f32, f32)>) -> ParamValue {
         let Some((lo, hi)) = range else { return *self };
-        if matches!(self, ParamValue::Bool(_) | ParamValue::Trigger(_)) {
+        if matches!(self, ParamValue::Bool(_) | ParamValue::Trigger(_) | ParamValue::Text(_)) {
             return *self;
         }
         let c: Vec<f32> = self.components().iter().map(|x| x.clamp(lo, hi)).collect();
@@ -170,6 +216,7 @@ impl fmt::Display for ParamValue {
             ParamValue::Enum(i) => write!(f, "#{i}"),
             ParamValue::Bool(b) | ParamValue::Trigger(b) => write!(f, "{b}"),
             ParamValue::Float(x) => write!(f, "{x}"),
+            ParamValue::Text(t) => write!(f, "{:?}", t.as_str()),
             other => {
                 let parts: Vec<String> = other.components().iter().map(|c| c.to_string()).collect();
                 write!(f, "({})", parts.join(", "))
@@ -218,6 +265,11 @@ impl ParamDecl {
         let mut decl = Self::new(name, ParamValue::Enum(default), Some((0.0, last)), doc);
         decl.options = options.iter().map(|o| o.to_string()).collect();
         decl
+    }
+
+    /// A text parameter.
+    pub fn text(name: &str, default: &str, doc: &str) -> Self {
+        Self::new(name, ParamValue::Text(Text::new(default)), None, doc)
     }
 
     /// A trigger (momentary button) parameter.
@@ -281,6 +333,15 @@ mod tests {
         assert_eq!(ParamValue::Vec2([1.5, 0.25]).to_string(), "(1.5, 0.25)");
         assert_eq!(ParamValue::Int(50).to_string(), "50");
         assert_eq!(ParamValue::Bool(true).to_string(), "true");
+    }
+
+    #[test]
+    fn text_is_cut_at_a_character_boundary() {
+        let long = "é".repeat(40);
+        let t = Text::new(&long);
+        assert_eq!(t.as_str().len(), 62);
+        assert_eq!(t.as_str(), "é".repeat(31));
+        assert_eq!(ParamValue::Text(Text::new("hi")).to_string(), "\"hi\"");
     }
 
     #[test]

@@ -135,9 +135,14 @@ impl Scene {
     }
 }
 
-/// Parses a command-line value (`1.5`, `2,0`, `true`, an enum option name) for `decl`.
+/// Parses a command-line value (`1.5`, `2,0`, `true`, an enum option name, any text for text
+/// parameters) for `decl`.
 pub fn parse_value_override(text: &str, decl: &ParamDecl) -> Result<ParamValue, String> {
     let ty = decl.ty();
+    if ty == ParamType::Text {
+        // Text is taken as written (`--set title.text=HELLO WORLD`).
+        return Ok(ParamValue::Text(crate::params::Text::new(text)));
+    }
     let raw = match text.trim() {
         "true" => RawValue::Bool(true),
         "false" => RawValue::Bool(false),
@@ -456,6 +461,7 @@ pub fn raw_from_value(value: &ParamValue, decl: &ParamDecl) -> RawValue {
     match value {
         ParamValue::Bool(b) | ParamValue::Trigger(b) => RawValue::Bool(*b),
         ParamValue::Enum(i) => RawValue::Text(decl.options.get(*i as usize).cloned().unwrap_or_default()),
+        ParamValue::Text(t) => RawValue::Text(t.as_str().to_string()),
         ParamValue::Float(x) => RawValue::Number(f64::from(*x)),
         ParamValue::Int(i) => RawValue::Number(f64::from(*i)),
         other => RawValue::List(other.components().iter().map(|&c| f64::from(c)).collect()),
@@ -477,9 +483,9 @@ fn coerce(raw: &RawValue, ty: ParamType, options: &[String]) -> Option<ParamValu
             options.iter().position(|o| o.eq_ignore_ascii_case(name)).map(|i| ParamValue::Enum(i as u32))
         }
         (RawValue::Number(i), ParamType::Enum) if (*i as usize) < options.len() => ty.value_from(&[*i]),
-        (RawValue::Bool(_) | RawValue::Text(_), _) | (_, ParamType::Bool | ParamType::Enum | ParamType::Trigger) => {
-            None
-        }
+        (RawValue::Text(text), ParamType::Text) => Some(ParamValue::Text(crate::params::Text::new(text))),
+        (RawValue::Bool(_) | RawValue::Text(_), _)
+        | (_, ParamType::Bool | ParamType::Enum | ParamType::Trigger | ParamType::Text) => None,
         (raw, ty) => ty.value_from(&raw.numbers()),
     }
 }

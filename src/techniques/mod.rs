@@ -11,6 +11,7 @@ pub mod kleinian;
 pub mod poisson;
 pub mod polygon_draw;
 pub mod star_glow;
+pub mod text_mesh;
 
 use crate::assets::{AssetKind, Assets};
 use crate::gpu::{Gpu, ShaderError};
@@ -19,8 +20,15 @@ use crate::params::{ParamDecl, ParamSet};
 use crate::time::FrameTime;
 
 /// Every technique indra knows, by scene name.
-pub const REGISTRY: &[TechniqueInfo] =
-    &[kleinian::INFO, star_glow::INFO, cube_field::INFO, cloth::INFO, poisson::INFO, polygon_draw::INFO];
+pub const REGISTRY: &[TechniqueInfo] = &[
+    kleinian::INFO,
+    star_glow::INFO,
+    cube_field::INFO,
+    cloth::INFO,
+    poisson::INFO,
+    polygon_draw::INFO,
+    text_mesh::INFO,
+];
 
 /// Finds a technique by the name scenes use.
 pub fn find(name: &str) -> Option<&'static TechniqueInfo> {

@@ -9,7 +9,7 @@
 //! sets `cursor` and fires `add`, a right click fires `close`, U and C fire `undo` and `clear`.
 //! Shader: `shaders/polygon_draw.wgsl`.
 
-mod gpu;
+pub(crate) mod gpu;
 
 use crate::geometry::triangulate::{Mesh2D, Triangulator};
 use crate::gpu::ShaderError;
