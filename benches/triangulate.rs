@@ -6,26 +6,18 @@
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use indra::geometry::triangulate::Triangulator;
 
+#[path = "../tests/common/earcut_fixtures.rs"]
+mod earcut_fixtures;
+
 struct Input {
     name: String,
     coords: Vec<f64>,
     holes: Vec<usize>,
 }
 
-fn fixture(name: &str) -> Input {
-    let path = format!("{}/tests/fixtures/earcut/{name}.json", env!("CARGO_MANIFEST_DIR"));
-    let rings: Vec<Vec<Vec<f64>>> = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
-    from_rings(name, rings.into_iter().map(|r| r.into_iter().map(|p| [p[0], p[1]]).collect()).collect())
-}
-
-fn from_rings(name: &str, rings: Vec<Vec<[f64; 2]>>) -> Input {
-    let mut holes = Vec::new();
-    let mut n = 0;
-    for ring in &rings[..rings.len() - 1] {
-        n += ring.len();
-        holes.push(n);
-    }
-    Input { name: name.to_string(), coords: rings.into_iter().flatten().flatten().collect(), holes }
+fn from_rings(name: &str, rings: &[earcut_fixtures::Ring]) -> Input {
+    let (coords, holes) = earcut_fixtures::flat(rings);
+    Input { name: name.to_string(), coords, holes }
 }
 
 /// A wavy star of `n` vertices with a grid of small square holes inside its inner disc.
@@ -46,11 +38,13 @@ fn generated(n: usize, holes_per_side: usize) -> Input {
             rings.push(vec![[cx - s, cy - s], [cx - s, cy + s], [cx + s, cy + s], [cx + s, cy - s]]);
         }
     }
-    from_rings(&format!("star{n}-holes{}", holes_per_side * holes_per_side), rings)
+    from_rings(&format!("star{n}-holes{}", holes_per_side * holes_per_side), &rings)
 }
 
 fn bench(c: &mut Criterion) {
-    let mut inputs: Vec<Input> = ["building", "dude", "water", "water-huge", "water-huge2"].map(fixture).into();
+    let mut inputs: Vec<Input> = ["building", "dude", "water", "water-huge", "water-huge2"]
+        .map(|name| from_rings(name, &earcut_fixtures::fixture(name)))
+        .into();
     inputs.push(generated(20_000, 20));
     let mut group = c.benchmark_group("triangulate");
     for input in &inputs {

@@ -5,13 +5,10 @@
 use indra::geometry::triangulate::{Mesh2D, triangulate, triangulate_flat};
 use proptest::prelude::*;
 
-type Ring = Vec<[f64; 2]>;
+#[path = "common/earcut_fixtures.rs"]
+mod earcut_fixtures;
 
-fn fixture(name: &str) -> Vec<Ring> {
-    let path = format!("{}/tests/fixtures/earcut/{name}.json", env!("CARGO_MANIFEST_DIR"));
-    let rings: Vec<Vec<Vec<f64>>> = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-    rings.into_iter().map(|r| r.into_iter().map(|p| [p[0], p[1]]).collect()).collect()
-}
+use earcut_fixtures::{Ring, fixture, flat};
 
 /// Exact rotation by a multiple of 90°.
 fn rotate(rings: &[Ring], quarter_turns: u32) -> Vec<Ring> {
@@ -50,17 +47,6 @@ fn deviation(rings: &[Ring], indices: &[u32]) -> f64 {
         });
         triangles / ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(f64::MIN_POSITIVE)
     }
-}
-
-fn flat(rings: &[Ring]) -> (Vec<f64>, Vec<usize>) {
-    let coords = rings.iter().flatten().flatten().copied().collect();
-    let mut starts = Vec::new();
-    let mut n = 0;
-    for ring in &rings[..rings.len() - 1] {
-        n += ring.len();
-        starts.push(n);
-    }
-    (coords, starts)
 }
 
 /// (fixture, earcut's triangle count, maximum deviation). Counts are implementation-specific

@@ -30,26 +30,23 @@ impl ComputeKernel {
                     message: format!("no compute entry point named '{entry}'"),
                 }
             })?;
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let bind_group_layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(*l)).collect();
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(origin),
-            bind_group_layouts: &bind_group_layouts,
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(entry),
-            layout: Some(&layout),
-            module: &shader,
-            entry_point: Some(entry),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        match pollster::block_on(scope.pop()) {
-            None => Ok(Self { pipeline, workgroup_size }),
-            // naga accepted it but the pipeline did not (e.g. bindings differ from the layout).
-            Some(e) => Err(ShaderError { origin: origin.into(), line: 1, column: 1, message: e.to_string() }),
-        }
+        let pipeline = super::validated(device, origin, || {
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(origin),
+                bind_group_layouts: &bind_group_layouts,
+                immediate_size: 0,
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&layout),
+                module: &shader,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        })?;
+        Ok(Self { pipeline, workgroup_size })
     }
 
     /// Workgroups to cover `threads` invocations on each axis.

@@ -6,6 +6,7 @@ mod binding;
 mod blit;
 mod compute;
 mod context;
+mod raster;
 mod readback;
 mod shader;
 
@@ -13,5 +14,6 @@ pub use binding::{uniform_buffer, uniform_entry, wgsl_struct_size};
 pub use blit::{Blit, BlitTarget, DISPLAY_FORMAT};
 pub use compute::ComputeKernel;
 pub use context::{BackendChoice, Gpu, GpuError, GpuOptions, instance_descriptor};
+pub use raster::{GrowableBuffer, RasterDesc, UniformBlock, raster_pipeline};
 pub use readback::{read_texture_bytes, read_texture_rgba8};
-pub use shader::{ShaderError, compile_wgsl, validate_wgsl};
+pub use shader::{ShaderError, compile_wgsl, validate_wgsl, validated};

@@ -67,13 +67,23 @@ pub fn compile_wgsl(
     source: &str,
 ) -> Result<(wgpu::ShaderModule, naga::Module), ShaderError> {
     let reflection = validate_wgsl(origin, source)?;
+    let module = validated(device, origin, || {
+        device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(origin),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        })
+    })?;
+    Ok((module, reflection))
+}
+
+/// Runs `build` (creating modules or pipelines) inside a validation error scope: what naga
+/// accepted but wgpu did not (e.g. bindings that differ from the layout) becomes a
+/// [`ShaderError`] at `origin` instead of a panic.
+pub fn validated<R>(device: &wgpu::Device, origin: &str, build: impl FnOnce() -> R) -> Result<R, ShaderError> {
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(origin),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
+    let built = build();
     match pollster::block_on(scope.pop()) {
-        None => Ok((module, reflection)),
+        None => Ok(built),
         Some(e) => Err(ShaderError { origin: origin.to_string(), line: 1, column: 1, message: e.to_string() }),
     }
 }

@@ -44,6 +44,15 @@ fn spread(mut v: u32) -> u32 {
     (v | (v << 1)) & 0x5555_5555
 }
 
+/// A convex corner (a, b, c) tested as an ear, with its bounding box.
+struct Corner<'a> {
+    a: &'a Node,
+    b: &'a Node,
+    c: &'a Node,
+    min: [f64; 2],
+    max: [f64; 2],
+}
+
 /// Which fallback a ring is on.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub(super) enum Pass {
@@ -124,52 +133,57 @@ impl Slicer<'_> {
         }
     }
 
-    /// Whether a node blocks the ear (a, b, c): it lies in or on the triangle, is not a copy of
-    /// a (bridges duplicate points), and is reflex or flat — only those can poke into an ear.
+    /// The convex corner at `ear` as a candidate ear; `None` if reflex or flat.
     #[inline]
-    fn blocks(&self, a: &Node, b: &Node, c: &Node, p: u32) -> bool {
+    fn corner(&self, ear: u32) -> Option<Corner<'_>> {
+        let r = &*self.rings;
+        let (a, b, c) = (r.get(r.prev(ear)), r.get(ear), r.get(r.next(ear)));
+        (area(a, b, c) > 0.0).then(|| Corner {
+            a,
+            b,
+            c,
+            min: [a.x.min(b.x).min(c.x), a.y.min(b.y).min(c.y)],
+            max: [a.x.max(b.x).max(c.x), a.y.max(b.y).max(c.y)],
+        })
+    }
+
+    /// Whether node `p` blocks the ear: it lies in or on the triangle (bounding box first), is
+    /// not a copy of a (bridges duplicate points), and is reflex or flat — only those can poke
+    /// into an ear.
+    #[inline]
+    fn blocks(&self, ear: &Corner<'_>, p: u32) -> bool {
         let n = self.rings.get(p);
-        !(n.x == a.x && n.y == a.y)
+        let (a, b, c) = (ear.a, ear.b, ear.c);
+        n.x >= ear.min[0]
+            && n.x <= ear.max[0]
+            && n.y >= ear.min[1]
+            && n.y <= ear.max[1]
+            && !(n.x == a.x && n.y == a.y)
             && point_in_triangle([a.x, a.y], [b.x, b.y], [c.x, c.y], [n.x, n.y])
             && area(self.rings.get(n.prev), n, self.rings.get(n.next)) <= 0.0
     }
 
     fn is_ear(&self, ear: u32) -> bool {
-        let r = &*self.rings;
-        let (a, b, c) = (r.get(r.prev(ear)), r.get(ear), r.get(r.next(ear)));
-        if area(a, b, c) <= 0.0 {
-            return false;
-        }
-        let (x0, x1) = (a.x.min(b.x).min(c.x), a.x.max(b.x).max(c.x));
-        let (y0, y1) = (a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
-        let mut p = c.next;
-        while p != b.prev {
-            let n = r.get(p);
-            if n.x >= x0 && n.x <= x1 && n.y >= y0 && n.y <= y1 && self.blocks(a, b, c, p) {
+        let Some(corner) = self.corner(ear) else { return false };
+        let mut p = corner.c.next;
+        while p != corner.b.prev {
+            if self.blocks(&corner, p) {
                 return false;
             }
-            p = n.next;
+            p = self.rings.next(p);
         }
         true
     }
 
     fn is_ear_hashed(&self, ear: u32) -> bool {
+        let Some(corner) = self.corner(ear) else { return false };
         let r = &*self.rings;
-        let (ia, ic) = (r.prev(ear), r.next(ear));
-        let (a, b, c) = (r.get(ia), r.get(ear), r.get(ic));
-        if area(a, b, c) <= 0.0 {
-            return false;
-        }
-        let (x0, x1) = (a.x.min(b.x).min(c.x), a.x.max(b.x).max(c.x));
-        let (y0, y1) = (a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
+        let (ia, ic) = (corner.b.prev, corner.b.next);
         let hash = self.hash.expect("hashed ear test without a hash");
-        let (min_z, max_z) = (hash.z(x0, y0), hash.z(x1, y1));
-        let candidate = |p: u32| {
-            let n = r.get(p);
-            p != ia && p != ic && n.x >= x0 && n.x <= x1 && n.y >= y0 && n.y <= y1 && self.blocks(a, b, c, p)
-        };
+        let (min_z, max_z) = (hash.z(corner.min[0], corner.min[1]), hash.z(corner.max[0], corner.max[1]));
+        let candidate = |p: u32| p != ia && p != ic && self.blocks(&corner, p);
         // Walk the z-order list both ways from the ear, alternating, while codes stay in range.
-        let (mut p, mut n) = (b.prev_z, b.next_z);
+        let (mut p, mut n) = (corner.b.prev_z, corner.b.next_z);
         while p != NIL && r.get(p).z >= min_z && n != NIL && r.get(n).z <= max_z {
             if candidate(p) || candidate(n) {
                 return false;

@@ -215,7 +215,7 @@ fn find_bridge(rings: &Rings, hole: u32, search: Search) -> Option<u32> {
     let (mx, my) = (rings.get(m).x, rings.get(m).y);
     let mut tan_min = f64::INFINITY;
     let mut best = m;
-    let mut consider = |p: u32| {
+    let consider = |p: u32| {
         let n = rings.get(p);
         if hx <= n.x && n.x <= mx && hx != n.x && point_in_triangle([hx, hy], [qx, hy], [mx, my], [n.x, n.y]) {
             let tan = (hy - n.y).abs() / (n.x - hx);
@@ -229,19 +229,11 @@ fn find_bridge(rings: &Rings, hole: u32, search: Search) -> Option<u32> {
             }
         }
     };
-    match search {
-        // The sample's order: from the endpoint once around.
-        Search::Ring(_) => {
-            let mut p = m;
-            loop {
-                consider(p);
-                p = rings.next(p);
-                if p == m {
-                    break;
-                }
-            }
-        }
-        Search::Bands(_) => for_each_edge(rings, &search, hy.min(my), hy.max(my), consider),
-    }
+    // Walking the ring, start at the endpoint (the sample's order, which decides exact ties).
+    let around = match search {
+        Search::Ring(_) => Search::Ring(m),
+        bands => bands,
+    };
+    for_each_edge(rings, &around, hy.min(my), hy.max(my), consider);
     Some(best)
 }

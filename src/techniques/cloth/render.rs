@@ -120,44 +120,31 @@ impl Renderer {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let pipeline = |vs: &str, fs: &str, topology| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(vs),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some(vs),
-                    compilation_options: Default::default(),
+        let pipeline = |vertex, fragment, topology| {
+            crate::gpu::raster_pipeline(
+                device,
+                &module,
+                &pipeline_layout,
+                &crate::gpu::RasterDesc {
+                    vertex,
+                    fragment,
                     buffers: &[],
+                    topology,
+                    color: super::FORMAT,
+                    depth: Some((DEPTH, wgpu::CompareFunction::LessEqual)),
                 },
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(fs),
-                    compilation_options: Default::default(),
-                    targets: &[Some(super::FORMAT.into())],
-                }),
-                primitive: wgpu::PrimitiveState { topology, ..Default::default() },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                multiview_mask: None,
-                cache: None,
-            })
+            )
         };
-        let surface = pipeline("vs_surface", "fs_surface", wgpu::PrimitiveTopology::TriangleList);
-        let sphere = pipeline("vs_sphere", "fs_sphere", wgpu::PrimitiveTopology::TriangleList);
-        let lines = pipeline("vs_debug", "fs_debug", wgpu::PrimitiveTopology::LineList);
-        let points = pipeline("vs_debug", "fs_debug", wgpu::PrimitiveTopology::PointList);
-        let insets = pipeline("vs_inset", "fs_inset", wgpu::PrimitiveTopology::TriangleList);
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(ShaderError { origin, line: 1, column: 1, message: e.to_string() });
-        }
+        use wgpu::PrimitiveTopology as T;
+        let (surface, sphere, lines, points, insets) = crate::gpu::validated(device, &origin, || {
+            (
+                pipeline("vs_surface", "fs_surface", T::TriangleList),
+                pipeline("vs_sphere", "fs_sphere", T::TriangleList),
+                pipeline("vs_debug", "fs_debug", T::LineList),
+                pipeline("vs_debug", "fs_debug", T::PointList),
+                pipeline("vs_inset", "fs_inset", T::TriangleList),
+            )
+        })?;
         let uniform = crate::gpu::uniform_buffer::<ClothViewUniforms>(device, "cloth_view");
         Ok(Self { surface, sphere, lines, points, insets, layout, uniform })
     }

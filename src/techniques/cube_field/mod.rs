@@ -112,9 +112,8 @@ impl CubeFieldUniforms {
 /// A cube field node.
 pub struct CubeField {
     pipeline: wgpu::RenderPipeline,
-    uniforms: wgpu::Buffer,
+    block: crate::gpu::UniformBlock,
     instances: wgpu::Buffer,
-    bind_group: wgpu::BindGroup,
     scratch: Vec<CubeInstance>,
 }
 
@@ -122,63 +121,33 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let device = &setup.gpu.device;
     let (origin, source) = setup.shader_source("cube_field.wgsl")?;
     let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("cube_field_layout"),
-        entries: &[crate::gpu::uniform_entry::<CubeFieldUniforms>(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
-    });
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("cube_field_pipeline_layout"),
-        bind_group_layouts: &[Some(&layout)],
-        immediate_size: 0,
-    });
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("cube_field_pipeline"),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: size_of::<CubeInstance>() as u64,
-                step_mode: wgpu::VertexStepMode::Instance,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4],
-            })],
-        },
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
-            targets: &[Some(FORMAT.into())],
-        }),
-        primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: DEPTH,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: wgpu::MultisampleState::default(),
-        multiview_mask: None,
-        cache: None,
-    });
-    if let Some(e) = pollster::block_on(scope.pop()) {
-        return Err(ShaderError { origin, line: 1, column: 1, message: e.to_string() });
-    }
-    let uniforms = crate::gpu::uniform_buffer::<CubeFieldUniforms>(device, "cube_field_uniforms");
+    let block = crate::gpu::UniformBlock::new::<CubeFieldUniforms>(device, "cube_field_uniforms");
+    let pipeline = crate::gpu::validated(device, &origin, || {
+        crate::gpu::raster_pipeline(
+            device,
+            &module,
+            &block.pipeline_layout,
+            &crate::gpu::RasterDesc {
+                vertex: "vs_main",
+                fragment: "fs_main",
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: size_of::<CubeInstance>() as u64,
+                    step_mode: wgpu::VertexStepMode::Instance,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4],
+                })],
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                color: FORMAT,
+                depth: Some((DEPTH, wgpu::CompareFunction::Less)),
+            },
+        )
+    })?;
     let instances = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("cube_field_instances"),
         size: (MAX_CUBES * size_of::<CubeInstance>()) as u64,
         usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("cube_field_bind_group"),
-        layout: &layout,
-        entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() }],
-    });
-    Ok(Box::new(CubeField { pipeline, uniforms, instances, bind_group, scratch: Vec::with_capacity(MAX_CUBES) }))
+    Ok(Box::new(CubeField { pipeline, block, instances, scratch: Vec::with_capacity(MAX_CUBES) }))
 }
 
 impl Technique for CubeField {
@@ -197,11 +166,11 @@ impl Technique for CubeField {
         let count = self.scratch.len() as u32;
         let this: &'r CubeField = self;
         graph.add_pass("cube_field/draw").render_target(color).render_target(depth).record(move |ctx| {
-            ctx.queue.write_buffer(&this.uniforms, 0, bytemuck::bytes_of(&uniforms));
+            ctx.queue.write_buffer(&this.block.buffer, 0, bytemuck::bytes_of(&uniforms));
             ctx.queue.write_buffer(&this.instances, 0, bytemuck::cast_slice(&this.scratch));
             let mut pass = ctx.begin_color_depth_pass(color, depth, wgpu::Color::BLACK);
             pass.set_pipeline(&this.pipeline);
-            pass.set_bind_group(0, &this.bind_group, &[]);
+            pass.set_bind_group(0, &this.block.bind_group, &[]);
             pass.set_vertex_buffer(0, this.instances.slice(..));
             pass.draw(0..36, 0..count);
         });

@@ -116,17 +116,19 @@ impl Sampler {
 
     /// Sample positions from `from` on, centred on the origin, as (x, y, z, insertion index).
     fn instances_from(&self, from: usize, key: &RunKey, out: &mut Vec<[f32; 4]>) {
+        fn centred<const N: usize>(points: &[[f64; N]], from: usize, half: [f32; 3], out: &mut Vec<[f32; 4]>) {
+            out.extend(points[from..].iter().enumerate().map(|(i, p)| {
+                let mut v = [0.0, 0.0, 0.0, (from + i) as f32];
+                for k in 0..N {
+                    v[k] = p[k] as f32 - half[k];
+                }
+                v
+            }));
+        }
         let half = key.extent.map(|e| e / 2.0);
         match self {
-            Sampler::Flat(s) => out.extend(
-                s.points()[from..]
-                    .iter()
-                    .enumerate()
-                    .map(|(i, p)| [p[0] as f32 - half[0], p[1] as f32 - half[1], 0.0, (from + i) as f32]),
-            ),
-            Sampler::Volume(s) => out.extend(s.points()[from..].iter().enumerate().map(|(i, p)| {
-                [p[0] as f32 - half[0], p[1] as f32 - half[1], p[2] as f32 - half[2], (from + i) as f32]
-            })),
+            Sampler::Flat(s) => centred(s.points(), from, half, out),
+            Sampler::Volume(s) => centred(s.points(), from, half, out),
         }
     }
 
@@ -141,10 +143,8 @@ impl Sampler {
 /// A Poisson disk node.
 pub struct Poisson {
     pipeline: wgpu::RenderPipeline,
-    uniforms: wgpu::Buffer,
-    bind_group: wgpu::BindGroup,
-    instances: wgpu::Buffer,
-    capacity: usize,
+    block: crate::gpu::UniformBlock,
+    instances: crate::gpu::GrowableBuffer,
     /// Samples already in `instances`.
     uploaded: usize,
     key: Option<RunKey>,
@@ -156,76 +156,39 @@ pub struct Poisson {
     device: wgpu::Device,
 }
 
-fn instance_buffer(device: &wgpu::Device, capacity: usize) -> wgpu::Buffer {
-    device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("poisson_instances"),
-        size: (capacity * size_of::<[f32; 4]>()) as u64,
-        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
-}
+/// Bytes of one instance: position and insertion index.
+const INSTANCE: u64 = size_of::<[f32; 4]>() as u64;
 
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let device = &setup.gpu.device;
     let (origin, source) = setup.shader_source("poisson.wgsl")?;
     let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("poisson_layout"),
-        entries: &[crate::gpu::uniform_entry::<PoissonUniforms>(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
-    });
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("poisson_pipeline_layout"),
-        bind_group_layouts: &[Some(&layout)],
-        immediate_size: 0,
-    });
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("poisson_pipeline"),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: size_of::<[f32; 4]>() as u64,
-                step_mode: wgpu::VertexStepMode::Instance,
-                attributes: &wgpu::vertex_attr_array![0 => Float32x4],
-            })],
-        },
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
-            targets: &[Some(FORMAT.into())],
-        }),
-        primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: DEPTH,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: wgpu::MultisampleState::default(),
-        multiview_mask: None,
-        cache: None,
-    });
-    if let Some(e) = pollster::block_on(scope.pop()) {
-        return Err(ShaderError { origin, line: 1, column: 1, message: e.to_string() });
-    }
-    let uniforms = crate::gpu::uniform_buffer::<PoissonUniforms>(device, "poisson_uniforms");
-    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("poisson_bind_group"),
-        layout: &layout,
-        entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() }],
-    });
-    let capacity = 4096;
+    let block = crate::gpu::UniformBlock::new::<PoissonUniforms>(device, "poisson_uniforms");
+    let pipeline = crate::gpu::validated(device, &origin, || {
+        crate::gpu::raster_pipeline(
+            device,
+            &module,
+            &block.pipeline_layout,
+            &crate::gpu::RasterDesc {
+                vertex: "vs_main",
+                fragment: "fs_main",
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: INSTANCE,
+                    step_mode: wgpu::VertexStepMode::Instance,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x4],
+                })],
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                color: FORMAT,
+                depth: Some((DEPTH, wgpu::CompareFunction::Less)),
+            },
+        )
+    })?;
+    let instances =
+        crate::gpu::GrowableBuffer::new(device, "poisson_instances", wgpu::BufferUsages::VERTEX, 4096 * INSTANCE);
     Ok(Box::new(Poisson {
         pipeline,
-        uniforms,
-        bind_group,
-        instances: instance_buffer(device, capacity),
-        capacity,
+        block,
+        instances,
         uploaded: 0,
         key: None,
         sampler: None,
@@ -270,14 +233,15 @@ impl Technique for Poisson {
         time: &FrameTime,
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
-        self.sync(params, time);
+        // Runs (and restarts) are decided in `step`; here only a frame drawn before any step.
+        if self.sampler.is_none() {
+            self.sync(params, time);
+        }
         let key = self.key.clone().expect("synced");
         let sampler = self.sampler.as_ref().expect("synced");
         let count = sampler.len();
-        if count > self.capacity {
-            // Grow by doubling; everything is uploaded again into the new buffer.
-            self.capacity = count.next_power_of_two();
-            self.instances = instance_buffer(&self.device, self.capacity);
+        if self.instances.reserve(&self.device, count as u64 * INSTANCE) {
+            // A new buffer: everything is uploaded again.
             self.uploaded = 0;
         }
         self.pending.clear();
@@ -291,15 +255,15 @@ impl Technique for Poisson {
         let uniforms = camera(&key, params, time, w as f32 / h as f32, count);
         let this: &'r Poisson = self;
         graph.add_pass("poisson/draw").render_target(color).render_target(depth).record(move |ctx| {
-            ctx.queue.write_buffer(&this.uniforms, 0, bytemuck::bytes_of(&uniforms));
+            ctx.queue.write_buffer(&this.block.buffer, 0, bytemuck::bytes_of(&uniforms));
             if !this.pending.is_empty() {
-                let offset = (first_new * size_of::<[f32; 4]>()) as u64;
-                ctx.queue.write_buffer(&this.instances, offset, bytemuck::cast_slice(&this.pending));
+                let offset = first_new as u64 * INSTANCE;
+                ctx.queue.write_buffer(this.instances.buffer(), offset, bytemuck::cast_slice(&this.pending));
             }
             let mut pass = ctx.begin_color_depth_pass(color, depth, wgpu::Color::BLACK);
             pass.set_pipeline(&this.pipeline);
-            pass.set_bind_group(0, &this.bind_group, &[]);
-            pass.set_vertex_buffer(0, this.instances.slice(..));
+            pass.set_bind_group(0, &this.block.bind_group, &[]);
+            pass.set_vertex_buffer(0, this.instances.buffer().slice(..));
             pass.draw(0..6, 0..count as u32);
         });
         color

@@ -2,8 +2,8 @@
 //! the same vertices) and the open loop being drawn (line strip).
 
 use crate::geometry::triangulate::Mesh2D;
-use crate::gpu::ShaderError;
-use crate::graph::{PassContext, TextureHandle};
+use crate::gpu::{GrowableBuffer, RasterDesc, ShaderError, UniformBlock};
+use crate::graph::{FrameGraph, PassContext, TextureDesc, TextureHandle};
 use crate::params::ParamSet;
 use crate::time::FrameTime;
 
@@ -52,50 +52,18 @@ struct Vertex {
     uv: [f32; 2],
 }
 
-/// A buffer that grows (by doubling) to fit what is written into it.
-struct Growable {
-    buffer: wgpu::Buffer,
-    usage: wgpu::BufferUsages,
-    label: &'static str,
-    /// Elements written last.
-    len: u32,
-}
-
-impl Growable {
-    fn new(device: &wgpu::Device, label: &'static str, usage: wgpu::BufferUsages) -> Self {
-        Self { buffer: Self::allocate(device, label, usage, 1024), usage, label, len: 0 }
-    }
-
-    fn allocate(device: &wgpu::Device, label: &str, usage: wgpu::BufferUsages, size: u64) -> wgpu::Buffer {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size,
-            usage: usage | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        })
-    }
-
-    fn write<T: bytemuck::Pod>(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, data: &[T]) {
-        let bytes: &[u8] = bytemuck::cast_slice(data);
-        if bytes.len() as u64 > self.buffer.size() {
-            self.buffer = Self::allocate(device, self.label, self.usage, (bytes.len() as u64).next_power_of_two());
-        }
-        queue.write_buffer(&self.buffer, 0, bytes);
-        self.len = data.len() as u32;
-    }
-}
-
 /// Draws a triangulated polygon set.
 pub struct Renderer {
     fill: wgpu::RenderPipeline,
     wire: wgpu::RenderPipeline,
     open_loop: wgpu::RenderPipeline,
-    uniforms: wgpu::Buffer,
-    bind_group: wgpu::BindGroup,
-    vertices: Growable,
-    triangles: Growable,
-    edges: Growable,
-    loop_vertices: Growable,
+    block: UniformBlock,
+    vertices: GrowableBuffer,
+    triangles: GrowableBuffer,
+    edges: GrowableBuffer,
+    loop_vertices: GrowableBuffer,
+    /// Element counts last uploaded: triangle indices, edge indices, loop vertices.
+    counts: [u32; 3],
     device: wgpu::Device,
     queue: wgpu::Queue,
 }
@@ -106,66 +74,45 @@ impl Renderer {
         let device = &setup.gpu.device;
         let (origin, source) = setup.shader_source("polygon_draw.wgsl")?;
         let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("polygon_draw_layout"),
-            entries: &[crate::gpu::uniform_entry::<PolygonUniforms>(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("polygon_draw_pipeline_layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let pipeline = |fragment: &str, topology: wgpu::PrimitiveTopology| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(fragment),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
+        let block = UniformBlock::new::<PolygonUniforms>(device, "polygon_draw_uniforms");
+        let pipeline = |fragment: &str, topology| {
+            crate::gpu::raster_pipeline(
+                device,
+                &module,
+                &block.pipeline_layout,
+                &RasterDesc {
+                    vertex: "vs_main",
+                    fragment,
                     buffers: &[Some(wgpu::VertexBufferLayout {
                         array_stride: size_of::<Vertex>() as u64,
                         step_mode: wgpu::VertexStepMode::Vertex,
                         attributes: &wgpu::vertex_attr_array![0 => Float32x2, 1 => Float32x2],
                     })],
+                    topology,
+                    color: FORMAT,
+                    depth: None,
                 },
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(fragment),
-                    compilation_options: Default::default(),
-                    targets: &[Some(FORMAT.into())],
-                }),
-                primitive: wgpu::PrimitiveState { topology, ..Default::default() },
-                depth_stencil: None,
-                multisample: wgpu::MultisampleState::default(),
-                multiview_mask: None,
-                cache: None,
-            })
+            )
         };
-        let fill = pipeline("fs_fill", wgpu::PrimitiveTopology::TriangleList);
-        let wire = pipeline("fs_wire", wgpu::PrimitiveTopology::LineList);
-        let open_loop = pipeline("fs_loop", wgpu::PrimitiveTopology::LineStrip);
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(ShaderError { origin, line: 1, column: 1, message: e.to_string() });
-        }
-        let uniforms = crate::gpu::uniform_buffer::<PolygonUniforms>(device, "polygon_draw_uniforms");
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("polygon_draw_bind_group"),
-            layout: &layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() }],
-        });
+        let (fill, wire, open_loop) = crate::gpu::validated(device, &origin, || {
+            (
+                pipeline("fs_fill", wgpu::PrimitiveTopology::TriangleList),
+                pipeline("fs_wire", wgpu::PrimitiveTopology::LineList),
+                pipeline("fs_loop", wgpu::PrimitiveTopology::LineStrip),
+            )
+        })?;
         use wgpu::BufferUsages as U;
+        let buffer = |label, usage| GrowableBuffer::new(device, label, usage, 1024);
         Ok(Self {
             fill,
             wire,
             open_loop,
-            uniforms,
-            bind_group,
-            vertices: Growable::new(device, "polygon_draw_vertices", U::VERTEX),
-            triangles: Growable::new(device, "polygon_draw_triangles", U::INDEX),
-            edges: Growable::new(device, "polygon_draw_edges", U::INDEX),
-            loop_vertices: Growable::new(device, "polygon_draw_loop", U::VERTEX),
+            block,
+            vertices: buffer("polygon_draw_vertices", U::VERTEX),
+            triangles: buffer("polygon_draw_triangles", U::INDEX),
+            edges: buffer("polygon_draw_edges", U::INDEX),
+            loop_vertices: buffer("polygon_draw_loop", U::VERTEX),
+            counts: [0; 3],
             device: device.clone(),
             queue: setup.gpu.queue.clone(),
         })
@@ -182,32 +129,54 @@ impl Renderer {
         let edges: Vec<u32> = mesh.indices.chunks_exact(3).flat_map(|t| [t[0], t[1], t[1], t[2], t[2], t[0]]).collect();
         let open: Vec<Vertex> =
             drawing.iter().map(|p| Vertex { position: [p[0] as f32, p[1] as f32], uv: [0.0; 2] }).collect();
-        self.vertices.write(&self.device, &self.queue, &vertices);
-        self.triangles.write(&self.device, &self.queue, &mesh.indices);
-        self.edges.write(&self.device, &self.queue, &edges);
-        self.loop_vertices.write(&self.device, &self.queue, &open);
+        let (device, queue) = (&self.device, &self.queue);
+        self.vertices.write_all(device, queue, &vertices);
+        self.counts = [
+            self.triangles.write_all(device, queue, &mesh.indices),
+            self.edges.write_all(device, queue, &edges),
+            self.loop_vertices.write_all(device, queue, &open),
+        ];
     }
 
-    /// Records the fill, the wireframe (if on) and the open loop into `color`.
-    pub fn record(&self, ctx: &mut PassContext<'_>, color: TextureHandle, uniforms: &PolygonUniforms, wireframe: bool) {
-        ctx.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
+    /// Adds pass `name` drawing the fill, the wireframe (per the `wireframe` parameter) and the
+    /// open loop into a new colour target, which it returns.
+    pub fn add_pass<'r>(
+        &'r self,
+        graph: &mut FrameGraph<'r>,
+        name: &str,
+        params: &ParamSet,
+        time: &FrameTime,
+    ) -> TextureHandle {
+        let color = graph.create_texture(format!("{name}/image"), TextureDesc::full(FORMAT));
+        let (w, h) = graph.texture_size(color);
+        let uniforms = PolygonUniforms::new(params, time, w as f32 / h as f32);
+        let wireframe = params.bool("wireframe");
+        graph.add_pass(format!("{name}/draw")).render_target(color).record(move |ctx| {
+            self.record(ctx, color, &uniforms, wireframe);
+        });
+        color
+    }
+
+    fn record(&self, ctx: &mut PassContext<'_>, color: TextureHandle, uniforms: &PolygonUniforms, wireframe: bool) {
+        let [triangles, edges, open] = self.counts;
+        ctx.queue.write_buffer(&self.block.buffer, 0, bytemuck::bytes_of(uniforms));
         let mut pass = ctx.begin_color_pass(color, wgpu::Color::BLACK);
-        pass.set_bind_group(0, &self.bind_group, &[]);
-        if self.triangles.len > 0 {
-            pass.set_vertex_buffer(0, self.vertices.buffer.slice(..));
+        pass.set_bind_group(0, &self.block.bind_group, &[]);
+        if triangles > 0 {
+            pass.set_vertex_buffer(0, self.vertices.buffer().slice(..));
             pass.set_pipeline(&self.fill);
-            pass.set_index_buffer(self.triangles.buffer.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..self.triangles.len, 0, 0..1);
+            pass.set_index_buffer(self.triangles.buffer().slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..triangles, 0, 0..1);
             if wireframe {
                 pass.set_pipeline(&self.wire);
-                pass.set_index_buffer(self.edges.buffer.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..self.edges.len, 0, 0..1);
+                pass.set_index_buffer(self.edges.buffer().slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..edges, 0, 0..1);
             }
         }
-        if self.loop_vertices.len > 1 {
+        if open > 1 {
             pass.set_pipeline(&self.open_loop);
-            pass.set_vertex_buffer(0, self.loop_vertices.buffer.slice(..));
-            pass.draw(0..self.loop_vertices.len, 0..1);
+            pass.set_vertex_buffer(0, self.loop_vertices.buffer().slice(..));
+            pass.draw(0..open, 0..1);
         }
     }
 }

@@ -13,12 +13,11 @@ pub(crate) mod gpu;
 
 use crate::geometry::triangulate::{Mesh2D, Triangulator};
 use crate::gpu::ShaderError;
-use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
+use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 
 use super::{NodeSetup, Technique, TechniqueInfo};
-pub use gpu::PolygonUniforms;
 
 /// The registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -164,19 +163,11 @@ impl Technique for PolygonDraw {
         time: &FrameTime,
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
-        let color = graph.create_texture("polygon_draw/image", TextureDesc::full(gpu::FORMAT));
-        let (w, h) = graph.texture_size(color);
-        let aspect = w as f32 / h as f32;
-        self.apply_triggers(params, aspect);
+        let (w, h) = graph.output_size();
+        self.apply_triggers(params, w as f32 / h as f32);
         if std::mem::take(&mut self.dirty) {
             self.gpu.upload(&self.mesh, &self.drawing);
         }
-        let uniforms = PolygonUniforms::new(params, time, aspect);
-        let this: &'r PolygonDraw = self;
-        let wireframe = params.bool("wireframe");
-        graph.add_pass("polygon_draw/draw").render_target(color).record(move |ctx| {
-            this.gpu.record(ctx, color, &uniforms, wireframe);
-        });
-        color
+        self.gpu.add_pass(graph, "polygon_draw", params, time)
     }
 }

@@ -9,11 +9,11 @@ use ttf_parser::{Face, OutlineBuilder};
 use crate::geometry::outline::RingBuilder;
 use crate::geometry::triangulate::{Mesh2D, Triangulator};
 use crate::gpu::ShaderError;
-use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
+use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue, Text};
 use crate::time::FrameTime;
 
-use super::polygon_draw::gpu::{FORMAT, PolygonUniforms, Renderer};
+use super::polygon_draw::gpu::Renderer;
 use super::{NodeSetup, Technique, TechniqueInfo};
 
 /// The registry entry.
@@ -158,15 +158,7 @@ impl Technique for TextMesh {
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
         self.rebuild(params);
-        let color = graph.create_texture("text_mesh/image", TextureDesc::full(FORMAT));
-        let (w, h) = graph.texture_size(color);
-        let uniforms = PolygonUniforms::new(params, time, w as f32 / h as f32);
-        let wireframe = params.bool("wireframe");
-        let this: &'r TextMesh = self;
-        graph.add_pass("text_mesh/draw").render_target(color).record(move |ctx| {
-            this.renderer.record(ctx, color, &uniforms, wireframe);
-        });
-        color
+        self.renderer.add_pass(graph, "text_mesh", params, time)
     }
 }
 
