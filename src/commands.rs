@@ -33,7 +33,8 @@ pub struct RunArgs {
     /// Monitor index for fullscreen (see the log for the list).
     #[arg(long)]
     pub monitor: Option<usize>,
-    /// Set a parameter at start: node.param=value (repeatable).
+    /// Set a parameter at start (repeatable): node.param=value — 0.5, true, an option name,
+    /// a vector as 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
     #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
     pub sets: Vec<String>,
     /// OSC listen address; loopback by default, 0.0.0.0:9000 opens it to the network.
@@ -116,7 +117,8 @@ pub struct RenderArgs {
     /// Output folder; frames are written as <scene>_<frame>.png.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
-    /// Set a parameter: node.param=value (repeatable).
+    /// Set a parameter (repeatable): node.param=value — 0.5, true, an option name, a vector as
+    /// 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
     #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
     pub sets: Vec<String>,
     /// Replay a control stream recorded with `run --record-controls`, frame-exactly.
@@ -138,7 +140,8 @@ pub struct BenchArgs {
     /// Frames rendered before measuring.
     #[arg(long, default_value_t = 10)]
     pub warmup: u64,
-    /// Set a parameter: node.param=value (repeatable).
+    /// Set a parameter (repeatable): node.param=value — 0.5, true, an option name, a vector as
+    /// 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
     #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
     pub sets: Vec<String>,
     /// Hold tracks still (measure one parameter set, not an animation).
@@ -206,11 +209,14 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     eprintln!("rendering '{}' on {}", scene.name, device.adapter_label());
     let mut renderer =
         OffscreenRenderer::new(device, assets, scene, args.size, args.dt, args.seed).map_err(|e| e.to_string())?;
-    renderer.seek(args.start);
-    // Events from before the first rendered frame apply at once, in order, before it.
+    // Replayed events apply at their own frames, also those a seek passes over.
     for (frame, events) in script {
-        renderer.schedule(frame.max(args.start), events);
+        renderer.schedule(frame, events);
     }
+    if args.start > 0 {
+        eprintln!("seeking to frame {} (every step runs; nothing before it is drawn)", args.start);
+    }
+    renderer.seek(args.start).map_err(|e| e.to_string())?;
     let bar = indicatif::ProgressBar::new(args.frames);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}")

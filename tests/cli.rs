@@ -49,6 +49,41 @@ fn render_writes_a_png_sequence_of_the_requested_size() {
 }
 
 #[test]
+fn render_start_reaches_the_frame_playing_reaches_and_splits_join() {
+    // A simulation: `--start 30 --frames 1` must be frame 30 of the one-run render, and a
+    // render split as 0..20 + 20..40 (two machines) must equal 0..40 in one run.
+    let (whole, first, second, sought) =
+        (temp_dir("seek-whole"), temp_dir("seek-a"), temp_dir("seek-b"), temp_dir("seek-c"));
+    let render = |dir: &PathBuf, start: &str, frames: &str| {
+        let args = [
+            "render",
+            "cloth",
+            "--size",
+            "64x40",
+            "--start",
+            start,
+            "--frames",
+            frames,
+            "--out",
+            dir.to_str().unwrap(),
+        ];
+        let o = indra(&args);
+        assert!(o.status.success(), "{}", text(&o));
+    };
+    render(&whole, "0", "40");
+    render(&first, "0", "20");
+    render(&second, "20", "20");
+    render(&sought, "30", "1");
+    let png = |dir: &PathBuf, frame: u32| std::fs::read(dir.join(format!("cloth_{frame:05}.png"))).unwrap();
+    for frame in 0..40 {
+        let half = if frame < 20 { &first } else { &second };
+        assert!(png(&whole, frame) == png(half, frame), "frame {frame} of the split render differs");
+    }
+    assert!(png(&whole, 30) == png(&sought, 30), "--start 30 differs from frame 30 played");
+    assert!(png(&whole, 30) != png(&whole, 0), "the cloth did not move: the test would prove nothing");
+}
+
+#[test]
 fn render_set_overrides_a_parameter() {
     let base = temp_dir("set-base");
     let changed = temp_dir("set-changed");

@@ -73,7 +73,7 @@ fn transients_are_reused_within_and_across_frames() {
     assert_eq!(s.transient_bytes_requested, 4 * texture);
     assert_eq!(s.transient_bytes_allocated, 3 * texture);
     assert_eq!(s.textures_created, 3);
-    let pixels = read_texture_rgba8(&gpu.device, &gpu.queue, &first.texture);
+    let pixels = read_texture_rgba8(&gpu.device, &gpu.queue, &first.texture).unwrap();
     assert_eq!(&pixels[..4], &[0, 255, 0, 255], "the output pass ran and wrote green");
 
     let (second, _) = chain_frame(&mut runtime, &gpu);
@@ -159,8 +159,8 @@ fn persistent_ping_pong_state_is_written_even_if_nothing_reads_it() {
         state.swap();
     }
     // After two steps the current state holds the second write, the other the first.
-    let current = read_texture_rgba8(&gpu.device, &gpu.queue, &state.current().texture);
+    let current = read_texture_rgba8(&gpu.device, &gpu.queue, &state.current().texture).unwrap();
     assert_eq!(&current[..4], &[0, 0, 255, 255]);
     let (other, _) = state.write_and_history();
-    assert_eq!(&read_texture_rgba8(&gpu.device, &gpu.queue, &other.texture)[..4], &[255, 0, 0, 255]);
+    assert_eq!(&read_texture_rgba8(&gpu.device, &gpu.queue, &other.texture).unwrap()[..4], &[255, 0, 0, 255]);
 }

@@ -8,9 +8,12 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use indra::assets::Assets;
+use indra::control::{ControlHub, ControlOptions};
 use indra::live::{LiveReload, ReloadReport};
 use indra::offscreen::{OffscreenRenderer, RenderedFrame};
-use indra::scene::load_scene;
+use indra::params::{ControlEvent, ParamValue, ParamWrite, Source, Target};
+use indra::scene::{Player, SceneInstance, load_scene};
+use indra::time::FixedClock;
 
 /// A private copy of the project's scenes/ and shaders/ to edit.
 fn sandbox(name: &str) -> PathBuf {
@@ -33,8 +36,9 @@ fn renderer(root: &Path) -> (OffscreenRenderer, LiveReload) {
     (OffscreenRenderer::new(common::gpu(), &assets, scene, Some((256, 256)), None, None).unwrap(), live)
 }
 
-fn frame0(r: &mut OffscreenRenderer) -> RenderedFrame {
-    r.seek(0);
+/// The next frame. `kleinian_classic` is static (its golden holds at every frame), so each call
+/// shows what is live now.
+fn shown(r: &mut OffscreenRenderer) -> RenderedFrame {
     r.render_next().unwrap()
 }
 
@@ -61,7 +65,7 @@ fn a_broken_shader_keeps_the_last_good_image_and_the_fix_applies() {
     let root = sandbox("shader");
     let (mut r, mut live) = renderer(&root);
     let golden = common::golden();
-    golden.check("kleinian_classic_f0000", (256, 256), &frame0(&mut r).rgba).unwrap();
+    golden.check("kleinian_classic_f0000", (256, 256), &shown(&mut r).rgba).unwrap();
 
     let shader = root.join("shaders/kleinian.wgsl");
     edit(&shader, "    var z = start;", "    var z = start +;");
@@ -69,7 +73,7 @@ fn a_broken_shader_keeps_the_last_good_image_and_the_fix_applies() {
     let report = wait_for_reload(&mut r, &mut live);
     assert_eq!(report.errors.len(), 1, "{report:?}");
     assert!(report.errors[0].contains(&format!("kleinian.wgsl:{line}:")), "{}", report.errors[0]);
-    golden.check("kleinian_classic_f0000", (256, 256), &frame0(&mut r).rgba).expect("the last good shader still runs");
+    golden.check("kleinian_classic_f0000", (256, 256), &shown(&mut r).rgba).expect("the last good shader still runs");
 
     // Saving the same mistake again is not reported twice.
     std::fs::write(&shader, std::fs::read_to_string(&shader).unwrap()).unwrap();
@@ -86,7 +90,7 @@ fn a_broken_shader_keeps_the_last_good_image_and_the_fix_applies() {
     );
     let report = wait_for_reload(&mut r, &mut live);
     assert_eq!((report.applied.len(), report.fixed.len()), (1, 1), "{report:?}");
-    let swapped = frame0(&mut r);
+    let swapped = shown(&mut r);
     let mut reference = load_scene(&common::assets(), "kleinian_classic").unwrap();
     reference.set_from_str("limit_set.hit_color=0.5,0.5,0.5").unwrap();
     reference.set_from_str("limit_set.back_color=1,0,0").unwrap();
@@ -98,18 +102,18 @@ fn a_broken_shader_keeps_the_last_good_image_and_the_fix_applies() {
 fn a_broken_scene_keeps_running_and_the_fix_applies() {
     let root = sandbox("scene");
     let (mut r, mut live) = renderer(&root);
-    let before = frame0(&mut r);
+    let before = shown(&mut r);
     let scene = root.join("scenes/kleinian_classic.ron");
     edit(&scene, "\"scale\": 2.4,", "\"scale\": 2.4,,");
     let report = wait_for_reload(&mut r, &mut live);
     assert_eq!(report.errors.len(), 1, "{report:?}");
     assert!(report.errors[0].contains("kleinian_classic.ron:"), "{}", report.errors[0]);
-    assert!(frame0(&mut r).rgba == before.rgba, "the running scene is untouched");
+    assert!(shown(&mut r).rgba == before.rgba, "the running scene is untouched");
 
     edit(&scene, "\"scale\": 2.4,,", "\"scale\": 3.0,");
     let report = wait_for_reload(&mut r, &mut live);
     assert!(report.scene_changed && report.fixed.len() == 1, "{report:?}");
-    let after = frame0(&mut r);
+    let after = shown(&mut r);
     let mut reference = load_scene(&common::assets(), "kleinian_classic").unwrap();
     reference.set_from_str("limit_set.scale=3.0").unwrap();
     assert!(after.rgba == common::render_scene(reference, (256, 256), 0).rgba, "the edited default is live");
@@ -134,7 +138,7 @@ fn an_atomic_save_by_rename_is_picked_up() {
     // Editors often write a temporary file and rename it over the original.
     let root = sandbox("rename");
     let (mut r, mut live) = renderer(&root);
-    let before = frame0(&mut r);
+    let before = shown(&mut r);
     let scene = root.join("scenes/kleinian_classic.ron");
     let temp = root.join("scenes/.kleinian_classic.ron.tmp");
     std::fs::write(&temp, std::fs::read_to_string(&scene).unwrap().replace("\"scale\": 2.4,", "\"scale\": 2.0,"))
@@ -142,6 +146,84 @@ fn an_atomic_save_by_rename_is_picked_up() {
     std::fs::rename(&temp, &scene).unwrap();
     let report = wait_for_reload(&mut r, &mut live);
     assert!(report.scene_changed, "{report:?}");
-    assert!(frame0(&mut r).rgba != before.rgba);
+    assert!(shown(&mut r).rgba != before.rgba);
+    std::fs::remove_dir_all(root).unwrap();
+}
+
+const TWO_NODES: &str = r#"(
+    name: "show",
+    size: (64, 64),
+    nodes: [
+        (id: "k", technique: "kleinian"),
+        (id: "glow", technique: "star_glow", inputs: { "source": "k" }),
+    ],
+    output: "glow",
+)"#;
+
+/// The edit drops `glow` and puts a new node before `k`, so `k` moves from index 0 to 1.
+const EDITED: &str = r#"(
+    name: "show",
+    size: (64, 64),
+    nodes: [(id: "extra", technique: "kleinian"), (id: "k", technique: "kleinian")],
+    output: "k",
+)"#;
+
+fn write(node: usize, param: usize, value: ParamValue) -> ControlEvent {
+    ControlEvent::Write(ParamWrite { node, param, component: None, value, source: Source::Ui })
+}
+
+#[test]
+fn a_reload_that_drops_a_node_while_its_events_are_queued_learned_and_recorded() {
+    let root = std::env::temp_dir().join(format!("indra-live-drop-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    std::fs::create_dir_all(&root).unwrap();
+    let path = root.join("show.ron");
+    std::fs::write(&path, TWO_NODES).unwrap();
+    let (gpu, assets) = (common::gpu(), common::assets());
+    let scene = load_scene(&assets, path.to_str().unwrap()).unwrap();
+    let (intensity, scale) =
+        (scene.nodes[1].params.index("intensity").unwrap(), scene.nodes[0].params.index("scale").unwrap());
+    let mut player = Player::new(SceneInstance::new(&gpu, &assets, scene, (64, 64)).unwrap(), FixedClock::new(0.02, 1));
+    let options = ControlOptions {
+        osc: None,
+        midi: false,
+        record: Some(root.join("controls.ron")),
+        learn_file: root.join("midi-learn.ron"),
+        presets_dir: root.join("presets"),
+        ..Default::default()
+    };
+    let mut hub = ControlHub::start(&options, player.instance().scene());
+    // While the edit lands: glow's intensity is waiting for MIDI learn, queued, scheduled, and
+    // the recording is running.
+    hub.learn(Target { node: 1, param: intensity, component: None });
+    let mut queued = vec![write(1, intensity, ParamValue::Float(2.0)), write(0, scale, ParamValue::Float(3.0))];
+    player.schedule(5, vec![write(1, intensity, ParamValue::Float(1.0))]);
+    hub.record(0, &queued, player.instance().scene());
+
+    std::fs::write(&path, EDITED).unwrap();
+    let mut live = LiveReload::new(&Assets::new(Some(root.clone()))).unwrap();
+    let report = live.apply(std::slice::from_ref(&path), player.instance_mut(), &gpu, (64, 64));
+    assert!(report.errors.is_empty() && report.scene_changed, "{report:?}");
+    let remap = report.remap.expect("a replaced scene comes with its remap");
+
+    // Queued: glow's write is dropped, k's follows k to index 1.
+    assert_eq!(remap.events(&mut queued), 1);
+    assert_eq!(queued, [write(1, scale, ParamValue::Float(3.0))]);
+    player.remap(&remap);
+    hub.set_scene(player.instance().scene(), Some(&remap));
+    assert_eq!(hub.mapper.learning, None, "learn waits for a parameter that is gone: it stops");
+    // Recording goes on with the new positions; a stale position is left out, never a panic.
+    hub.record(1, &queued, player.instance().scene());
+    hub.record(2, &[write(7, 3, ParamValue::Float(1.0))], player.instance().scene());
+    player.apply(&queued);
+    for _ in 0..8 {
+        player.step(); // frame 5's scheduled write was dropped with its node
+    }
+    let k = player.instance().params(1);
+    assert_eq!(k.target_at(scale), ParamValue::Float(3.0), "the remapped write reached k at its new index");
+    let recorded = std::fs::read_to_string(root.join("controls.ron")).unwrap();
+    let lines: Vec<&str> = recorded.lines().collect();
+    assert_eq!(lines.len(), 3, "{recorded}");
+    assert!(lines[2].contains("frame:1") && lines[2].contains("\"k\"") && lines[2].contains("scale"), "{}", lines[2]);
     std::fs::remove_dir_all(root).unwrap();
 }

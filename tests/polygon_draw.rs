@@ -7,6 +7,7 @@ mod common;
 
 use indra::control::osc::{OscReceiver, OscRouter, Routed};
 use indra::offscreen::{OffscreenRenderer, RenderedFrame};
+use indra::params::ParamValue;
 use indra::scene::{ControlEvent, Scene, load_scene};
 use rosc::{OscMessage, OscType};
 
@@ -79,4 +80,33 @@ fn drawing_over_osc_makes_holes_and_islands() {
     let undone = &frames[undo_frame as usize];
     assert!(!lit(undone, 0.5, 0.47), "island after undo");
     assert!(lit(undone, 0.27, 0.5), "outer fill after undo");
+}
+
+#[test]
+fn mouse_and_keys_come_from_the_declared_roles() {
+    let gpu = common::gpu();
+    let scene = load_scene(&common::assets(), "polygon_draw").unwrap();
+    let instance = indra::scene::SceneInstance::new(&gpu, &common::assets(), scene, SIZE).unwrap();
+    let params = instance.params(0);
+    let written = |events: Vec<ControlEvent>| -> Vec<(String, ParamValue)> {
+        events
+            .into_iter()
+            .map(|e| match e {
+                ControlEvent::Write(w) => (params.decls()[w.param].name.clone(), w.value),
+                other => panic!("{other:?}"),
+            })
+            .collect()
+    };
+    let click = written(instance.pointer([0.25, 0.75], true, indra::params::Source::Ui));
+    assert_eq!(
+        click,
+        [("cursor".to_string(), ParamValue::Vec2([0.25, 0.75])), ("add".to_string(), ParamValue::Trigger(true))]
+    );
+    let right = written(instance.pointer([0.5, 0.5], false, indra::params::Source::Ui));
+    assert_eq!(right[1], ("close".to_string(), ParamValue::Trigger(true)));
+    assert_eq!(
+        written(instance.key('U', indra::params::Source::Ui)),
+        [("undo".to_string(), ParamValue::Trigger(true))]
+    );
+    assert!(instance.key('x', indra::params::Source::Ui).is_empty(), "an undeclared key does nothing");
 }

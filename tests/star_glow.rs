@@ -42,6 +42,7 @@ fn glow(gpu: &Gpu, source: &[[f32; 4]], settings: &[(&str, &str)]) -> Vec<[f32; 
     let frame = runtime.execute(&gpu.device, &gpu.queue, graph, &mut encoder).unwrap();
     gpu.queue.submit([encoder.finish()]);
     read_texture_bytes(&gpu.device, &gpu.queue, &frame.texture)
+        .unwrap()
         .chunks_exact(8)
         .map(|t| std::array::from_fn(|c| f16::from_le_bytes([t[2 * c], t[2 * c + 1]]).to_f32()))
         .collect()

@@ -4,6 +4,7 @@
 //! taken-over parameters back to their tracks, 1–9 recall presets.
 
 mod panel;
+mod surface;
 mod window;
 
 use crate::assets::Assets;

@@ -3,8 +3,9 @@
 
 use crate::control::ControlHub;
 use crate::graph::{FrameStats, PassTiming};
+use crate::params::{ControlEvent, Target};
 use crate::params::{ParamDecl, ParamValue, ParamWrite, Source};
-use crate::scene::{ControlEvent, SceneInstance, Target};
+use crate::scene::SceneInstance;
 use crate::time::FrameTime;
 
 /// What the overlay shows besides parameters.

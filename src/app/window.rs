@@ -16,8 +16,8 @@ use crate::control::{ControlHub, ControlOptions};
 use crate::gpu::{Blit, BlitTarget, Gpu, GpuOptions};
 use crate::graph::GraphRuntime;
 use crate::live::LiveReload;
-use crate::scene::ControlEvent;
-use crate::scene::{Scene, SceneInstance};
+use crate::params::ControlEvent;
+use crate::scene::{Player, Scene, SceneInstance};
 use crate::time::FixedClock;
 
 /// Everything that exists once the window does.
@@ -26,18 +26,16 @@ struct Running {
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
     gpu: Gpu,
-    instance: SceneInstance,
+    /// The scene on its fixed clock: the frame step shared with `render` and the tests.
+    player: Player,
     runtime: GraphRuntime,
     blit: Blit,
-    clock: FixedClock,
     last: Instant,
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
     overlay: Overlay,
     hub: ControlHub,
     live: Option<LiveReload>,
-    /// The time of the last step run (what the next frame shows).
-    last_time: crate::time::FrameTime,
     /// Panel events of the last frame, applied before the next step.
     ui_events: Vec<crate::scene::ControlEvent>,
     /// Last cursor position over the window, in physical pixels.
@@ -93,8 +91,7 @@ impl WindowApp {
         let gpu = pollster::block_on(Gpu::with_instance(wgpu_instance, &self.gpu_options, Some(&surface)))
             .map_err(|e| e.to_string())?;
         let caps = surface.get_capabilities(&gpu.adapter);
-        // egui and our display encode both write sRGB bytes themselves: use a non-sRGB format.
-        let format = caps.formats.iter().copied().find(|f| !f.is_srgb()).unwrap_or(caps.formats[0]);
+        let (format, alpha_mode) = super::surface::choose_surface_format(&caps, &gpu.adapter_label())?;
         let size = window.inner_size();
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -104,7 +101,7 @@ impl WindowApp {
             height: size.height.max(1),
             present_mode: wgpu::PresentMode::AutoVsync,
             desired_maximum_frame_latency: 2,
-            alpha_mode: caps.alpha_modes[0],
+            alpha_mode,
             view_formats: vec![],
         };
         surface.configure(&gpu.device, &config);
@@ -113,7 +110,6 @@ impl WindowApp {
             log::info!("monitor {i}: {}", m.name().unwrap_or_default());
         }
         let clock = FixedClock::new(scene.dt, scene.seed);
-        let last_time = clock.now();
         let size = (config.width, config.height);
         let mut overlay = Overlay::default();
         for n in self.notices.drain(..) {
@@ -153,17 +149,15 @@ impl WindowApp {
             surface,
             config,
             gpu,
-            instance,
+            player: Player::new(instance, clock),
             runtime,
             blit,
-            clock,
             last: Instant::now(),
             egui_state,
             egui_renderer,
             overlay,
             hub,
             live,
-            last_time,
             ui_events: Vec::new(),
             pointer: [0.0, 0.0],
         })
@@ -230,21 +224,15 @@ impl ApplicationHandler for WindowApp {
                 event: KeyEvent { logical_key: Key::Character(c), state: ElementState::Pressed, repeat: false, .. },
                 ..
             } if !consumed => {
-                if c.eq_ignore_ascii_case("r") {
-                    r.ui_events.extend(r.instance.fire_all("reset", crate::params::Source::Ui));
-                }
-                // Drawing scenes: U removes the last polygon, C clears.
-                if c.eq_ignore_ascii_case("u") {
-                    r.ui_events.extend(r.instance.fire_all("undo", crate::params::Source::Ui));
-                }
-                if c.eq_ignore_ascii_case("c") {
-                    r.ui_events.extend(r.instance.fire_all("clear", crate::params::Source::Ui));
+                // Keys the scene's techniques declared (R reset, U undo, C clear, …).
+                if let Some(key) = c.chars().next().filter(char::is_ascii_alphabetic) {
+                    r.ui_events.extend(r.player.instance().key(key, crate::params::Source::Ui));
                 }
                 if let Some(i) = c.parse::<usize>().ok().filter(|i| (1..=9).contains(i))
                     && let Some(name) = r.hub.preset_names().get(i - 1).cloned()
                 {
                     let seconds = f64::from(r.overlay.morph_seconds);
-                    let scene = r.instance.scene().clone();
+                    let scene = r.player.instance().scene().clone();
                     r.ui_events.extend(r.hub.recall(&name, seconds, &scene));
                 }
             }
@@ -259,7 +247,7 @@ impl ApplicationHandler for WindowApp {
                 if let Some(primary) = primary {
                     let (w, h) = (r.config.width.max(1) as f32, r.config.height.max(1) as f32);
                     let view = [r.pointer[0] / w, 1.0 - r.pointer[1] / h];
-                    r.ui_events.extend(r.instance.pointer(view, primary, crate::params::Source::Ui));
+                    r.ui_events.extend(r.player.instance().pointer(view, primary, crate::params::Source::Ui));
                 }
             }
             WindowEvent::RedrawRequested => {
@@ -275,18 +263,15 @@ impl Running {
     /// Steps the clock by real time, renders the scene and the overlay, presents.
     fn frame(&mut self) {
         let now = Instant::now();
-        let steps = self.clock.accumulate((now - self.last).as_secs_f64());
+        let steps = self.player.accumulate((now - self.last).as_secs_f64());
         self.last = now;
         self.reload();
         let mut events = std::mem::take(&mut self.ui_events);
-        events.extend(self.hub.poll(&self.instance, self.last_time.seconds));
-        self.hub.record(self.clock.now().frame, &events, self.instance.scene());
-        self.instance.apply(&events);
+        events.extend(self.hub.poll(self.player.instance(), self.player.last_step().seconds));
+        self.hub.record(self.player.now().frame, &events, self.player.instance().scene());
+        self.player.apply(&events);
         for _ in 0..steps {
-            let now = self.clock.now();
-            self.instance.advance(&now);
-            self.last_time = now;
-            self.clock.step();
+            self.player.step();
         }
         let frame = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(f) | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
@@ -303,8 +288,7 @@ impl Running {
         let size = (self.config.width, self.config.height);
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("window_frame") });
-        let time = self.last_time;
-        match self.instance.encode(&self.gpu, &mut self.runtime, &mut encoder, size, &time) {
+        match self.player.encode(&self.gpu, &mut self.runtime, &mut encoder, size) {
             Ok(output) => {
                 self.blit.record(
                     &self.gpu.device,
@@ -326,8 +310,8 @@ impl Running {
         self.runtime.after_submit();
         self.window.pre_present_notify();
         self.gpu.queue.present(frame);
-        self.hub.after_frame(&self.instance);
-        for m in self.instance.take_messages() {
+        self.hub.after_frame(self.player.instance());
+        for m in self.player.instance_mut().take_messages() {
             self.overlay.report(m);
         }
         for n in std::mem::take(&mut self.hub.notices) {
@@ -339,7 +323,7 @@ impl Running {
     fn reload(&mut self) {
         let Some(live) = self.live.as_mut() else { return };
         let size = (self.config.width, self.config.height);
-        let report = live.poll(&mut self.instance, &self.gpu, size);
+        let report = live.poll(self.player.instance_mut(), &self.gpu, size);
         for e in report.errors {
             self.overlay.report(e);
         }
@@ -349,9 +333,17 @@ impl Running {
         if !report.fixed.is_empty() {
             self.overlay.clear_errors();
         }
+        if let Some(remap) = &report.remap {
+            // Everything that holds parameter positions follows the reload, or lets go.
+            let dropped = remap.events(&mut self.ui_events);
+            if dropped > 0 {
+                log::warn!("{dropped} queued control event(s) dropped: their parameters left the scene");
+            }
+            self.player.remap(remap);
+        }
         if report.scene_changed {
-            self.hub.set_scene(self.instance.scene());
-            self.window.set_title(&format!("indra — {}", self.instance.scene().name));
+            self.hub.set_scene(self.player.instance().scene(), report.remap.as_ref());
+            self.window.set_title(&format!("indra — {}", self.player.instance().scene().name));
         }
     }
 
@@ -364,10 +356,11 @@ impl Running {
     ) -> Vec<wgpu::CommandBuffer> {
         let input = self.egui_state.take_egui_input(&self.window);
         let ctx = self.egui_state.egui_ctx().clone();
-        let (instance, overlay, clock) = (&mut self.instance, &mut self.overlay, &self.clock);
+        let now = self.player.now();
+        let (instance, overlay) = (self.player.instance_mut(), &mut self.overlay);
         let mut events = Vec::new();
         let hub = &mut self.hub;
-        let mut output = ctx.run_ui(input, |ui| events = draw_ui(ui, instance, overlay, hub, clock.now()));
+        let mut output = ctx.run_ui(input, |ui| events = draw_ui(ui, instance, overlay, hub, now));
         self.ui_events.extend(events);
         self.egui_state.handle_platform_output(&self.window, output.platform_output);
         let primitives = ctx.tessellate(output.shapes, output.pixels_per_point);

@@ -5,7 +5,8 @@
 use std::collections::HashMap;
 
 use crate::params::ParamType;
-use crate::scene::{Scene, Target};
+use crate::params::Target;
+use crate::scene::Scene;
 
 /// Engine commands with fixed addresses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -11,7 +11,8 @@ use super::osc::{OscReceiver, OscRouter, Routed};
 use super::oscquery::OscQueryServer;
 use super::presets::PresetStore;
 use super::record::Recorder;
-use crate::scene::{ControlEvent, Scene, SceneInstance, Target};
+use crate::params::{ControlEvent, Remap, Target};
+use crate::scene::{Scene, SceneInstance};
 
 /// Which control sources to open.
 #[derive(Clone, Debug)]
@@ -121,12 +122,17 @@ impl ControlHub {
         }
     }
 
-    /// Rebuilds address and MIDI maps after the scene changed (learned mappings stay).
-    pub fn set_scene(&mut self, scene: &Scene) {
+    /// Rebuilds address and MIDI maps after the scene changed (learned mappings stay, by name).
+    /// A parameter waiting for MIDI learn follows `remap` to its new place, or stops waiting if
+    /// it left the scene.
+    pub fn set_scene(&mut self, scene: &Scene, remap: Option<&Remap>) {
         self.router = OscRouter::new(scene);
         let learning = self.mapper.learning.take();
         self.mapper = MidiMapper::new(scene, &self.learn.load());
-        self.mapper.learning = learning.filter(|t| t.node < scene.nodes.len());
+        self.mapper.learning = learning.and_then(|t| match remap {
+            Some(remap) => remap.target(t),
+            None => scene.nodes.get(t.node).filter(|n| t.param < n.params.decls().len()).map(|_| t),
+        });
         if let Some(f) = self.feedback.as_mut() {
             f.reset();
         }
@@ -261,6 +267,7 @@ impl ControlHub {
         }
         match &self.midi {
             Some(m) if !m.ports.is_empty() => parts.push(format!("MIDI: {}", m.ports.join(", "))),
+            _ if !super::midi::BUILT_IN => parts.push("MIDI: not built in (--no-default-features)".into()),
             _ => parts.push("MIDI: none".into()),
         }
         if let Some(bpm) = self.mapper.clock.bpm() {

@@ -4,10 +4,9 @@
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
-use std::sync::mpsc::{Receiver, channel};
 
-use crate::params::{ParamDecl, ParamType, ParamValue, ParamWrite, Source};
-use crate::scene::{MidiCurve, MidiMapping, Scene, Target, resolve_target};
+use crate::params::{ParamDecl, ParamType, ParamValue, ParamWrite, Source, Target};
+use crate::scene::{MidiCurve, MidiMapping, Scene, resolve_target, ron_options};
 
 /// One decoded MIDI message. Channels are 1–16.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -234,12 +233,13 @@ impl MidiMapper {
     fn value_for(&self, b: &Binding, event: MidiEvent, scene: &Scene) -> Option<ParamValue> {
         let m = &b.mapping;
         let on_channel = |c: u8| m.channel.is_none_or(|want| want == c);
-        let decl = &scene.nodes[b.target.node].params.decls()[b.target.param];
+        let decl = scene.nodes.get(b.target.node)?.params.decls().get(b.target.param)?;
         let position = match event {
             MidiEvent::Cc { channel, controller, value } if on_channel(channel) => match m.cc? {
                 cc if m.fine && controller == cc => f32::from(value) * 128.0 / 16383.0,
                 cc if m.fine && controller == cc + 32 => {
-                    let msb = self.msb[usize::from(channel - 1)][usize::from(cc)];
+                    // Validated at load (fine needs cc < 32); a bad mapping reads no MSB.
+                    let msb = *self.msb[usize::from(channel - 1)].get(usize::from(cc))?;
                     (f32::from(msb) * 128.0 + f32::from(value)) / 16383.0
                 }
                 cc if !m.fine && controller == cc => f32::from(value) / 127.0,
@@ -281,8 +281,8 @@ fn scale(position: f32, m: &MidiMapping, decl: &ParamDecl, component: bool, even
 
 /// The mapping a moved control creates for `target` in learn mode.
 fn learned_mapping(event: MidiEvent, target: Target, scene: &Scene) -> Option<MidiMapping> {
-    let node = &scene.nodes[target.node];
-    let mut name = format!("{}.{}", node.id, node.params.decls()[target.param].name);
+    let node = scene.nodes.get(target.node)?;
+    let mut name = format!("{}.{}", node.id, node.params.decls().get(target.param)?.name);
     if let Some(c) = target.component {
         name.push('.');
         name.push(['x', 'y', 'z', 'w'][c]);
@@ -319,13 +319,42 @@ pub struct LearnStore {
 }
 
 impl LearnStore {
-    /// Mappings saved earlier (none if the file does not exist or does not parse — said once).
+    /// Mappings saved earlier. The file is hand-editable, so it is validated like a scene's
+    /// mappings: a file that does not parse is ignored, and a mapping that is out of range is
+    /// left out, each with one logged line naming the file (see [`LearnStore::load_checked`]).
     pub fn load(&self) -> Vec<MidiMapping> {
-        let Ok(text) = std::fs::read_to_string(&self.path) else { return Vec::new() };
-        ron::from_str(&text).unwrap_or_else(|e| {
-            log::warn!("ignoring MIDI learn file {}: {e}", self.path.display());
-            Vec::new()
-        })
+        let (mappings, problems) = self.load_checked();
+        for p in problems {
+            log::warn!("{p}");
+        }
+        mappings
+    }
+
+    /// The valid mappings of the file, and one sentence for each thing left out.
+    pub fn load_checked(&self) -> (Vec<MidiMapping>, Vec<String>) {
+        let Ok(text) = std::fs::read_to_string(&self.path) else { return (Vec::new(), Vec::new()) };
+        let file = self.path.display();
+        let all: Vec<MidiMapping> = match ron_options().from_str(&text) {
+            Ok(all) => all,
+            Err(e) => {
+                let (line, col) = (e.span.start.line, e.span.start.col);
+                return (Vec::new(), vec![format!("ignoring MIDI learn file {file}:{line}:{col}: {}", e.code)]);
+            }
+        };
+        let mut problems = Vec::new();
+        let valid = all
+            .into_iter()
+            .enumerate()
+            .filter(|(i, m)| match m.problem() {
+                Some(p) => {
+                    problems.push(format!("{file}: mapping {} (to '{}') left out: {p}", i + 1, m.target));
+                    false
+                }
+                None => true,
+            })
+            .map(|(_, m)| m)
+            .collect();
+        (valid, problems)
     }
 
     /// Saves the learned (non-scene) bindings of `mapper`.
@@ -337,46 +366,84 @@ impl LearnStore {
     }
 }
 
-/// Connections to MIDI input ports; bytes arrive on a channel drained by the render loop.
-pub struct MidiInput {
-    _connections: Vec<midir::MidiInputConnection<()>>,
-    bytes: Receiver<Vec<u8>>,
-    /// Names of the connected ports.
-    pub ports: Vec<String>,
-}
+pub use port::MidiInput;
 
-impl MidiInput {
-    /// Connects to every input port (or those whose name contains `filter`). Without a MIDI
-    /// system this returns why, to be logged once; the show goes on.
-    pub fn open(filter: Option<&str>) -> Result<Self, String> {
-        let probe = midir::MidiInput::new("indra")
-            .map_err(|e| format!("MIDI is not available ({e}); continuing without it"))?;
-        let (tx, bytes) = channel();
-        let mut connections = Vec::new();
-        let mut ports = Vec::new();
-        for port in probe.ports() {
-            let name = probe.port_name(&port).unwrap_or_default();
-            if filter.is_some_and(|f| !name.to_lowercase().contains(&f.to_lowercase())) {
-                continue;
-            }
-            let input = midir::MidiInput::new("indra").map_err(|e| e.to_string())?;
-            let tx = tx.clone();
-            match input.connect(&port, "indra-in", move |_, message, _| drop(tx.send(message.to_vec())), ()) {
-                Ok(c) => {
-                    ports.push(name);
-                    connections.push(c);
+/// MIDI ports through midir (ALSA on Linux, CoreMIDI, WinMM).
+#[cfg(feature = "midi")]
+mod port {
+    use std::sync::mpsc::{Receiver, channel};
+
+    /// Connections to MIDI input ports; bytes arrive on a channel drained by the render loop.
+    pub struct MidiInput {
+        _connections: Vec<midir::MidiInputConnection<()>>,
+        bytes: Receiver<Vec<u8>>,
+        /// Names of the connected ports.
+        pub ports: Vec<String>,
+    }
+
+    impl MidiInput {
+        /// Connects to every input port (or those whose name contains `filter`). Without a MIDI
+        /// system this returns why, to be logged once; the show goes on.
+        pub fn open(filter: Option<&str>) -> Result<Self, String> {
+            let probe = midir::MidiInput::new("indra")
+                .map_err(|e| format!("MIDI is not available ({e}); continuing without it"))?;
+            let (tx, bytes) = channel();
+            let mut connections = Vec::new();
+            let mut ports = Vec::new();
+            for port in probe.ports() {
+                let name = probe.port_name(&port).unwrap_or_default();
+                if filter.is_some_and(|f| !name.to_lowercase().contains(&f.to_lowercase())) {
+                    continue;
                 }
-                Err(e) => log::warn!("cannot open MIDI port {name}: {e}"),
+                let input = midir::MidiInput::new("indra").map_err(|e| e.to_string())?;
+                let tx = tx.clone();
+                match input.connect(&port, "indra-in", move |_, message, _| drop(tx.send(message.to_vec())), ()) {
+                    Ok(c) => {
+                        ports.push(name);
+                        connections.push(c);
+                    }
+                    Err(e) => log::warn!("cannot open MIDI port {name}: {e}"),
+                }
             }
+            if ports.is_empty() {
+                log::info!("no MIDI input ports{}", filter.map(|f| format!(" matching '{f}'")).unwrap_or_default());
+            }
+            Ok(Self { _connections: connections, bytes, ports })
         }
-        if ports.is_empty() {
-            log::info!("no MIDI input ports{}", filter.map(|f| format!(" matching '{f}'")).unwrap_or_default());
-        }
-        Ok(Self { _connections: connections, bytes, ports })
-    }
 
-    /// Every message received since the last call.
-    pub fn drain(&self) -> Vec<Vec<u8>> {
-        self.bytes.try_iter().collect()
+        /// Every message received since the last call.
+        pub fn drain(&self) -> Vec<Vec<u8>> {
+            self.bytes.try_iter().collect()
+        }
     }
 }
+
+/// A binary built without the `midi` feature (no sound library linked): there are no ports,
+/// and opening says so once; everything else about MIDI (mappings, learn files) still loads.
+#[cfg(not(feature = "midi"))]
+mod port {
+    /// No MIDI input in this build.
+    pub struct MidiInput {
+        /// Always empty.
+        pub ports: Vec<String>,
+    }
+
+    impl MidiInput {
+        /// Says that this binary has no MIDI.
+        pub fn open(_filter: Option<&str>) -> Result<Self, String> {
+            Err(super::NOT_BUILT_IN.into())
+        }
+
+        /// Nothing ever arrives.
+        pub fn drain(&self) -> Vec<Vec<u8>> {
+            Vec::new()
+        }
+    }
+}
+
+/// What a binary built without the `midi` feature says about MIDI.
+pub const NOT_BUILT_IN: &str =
+    "MIDI is not built into this binary (built with --no-default-features); OSC and the panel still work";
+
+/// Whether this binary can open MIDI ports.
+pub const BUILT_IN: bool = cfg!(feature = "midi");

@@ -14,8 +14,8 @@ use std::time::{Duration, SystemTime};
 use rosc::{OscMessage, OscPacket, OscType};
 
 use super::address::{AddressMap, Command, Route};
-use crate::params::{ParamDecl, ParamType, ParamValue, ParamWrite, Source};
-use crate::scene::{ControlEvent, Scene};
+use crate::params::{ControlEvent, ParamDecl, ParamType, ParamValue, ParamWrite, Source};
+use crate::scene::Scene;
 
 /// What went in and what was rejected, shared between the receiver thread and the render loop.
 #[derive(Debug, Default)]

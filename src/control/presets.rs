@@ -10,8 +10,8 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use crate::params::ParamType;
-use crate::scene::{NodeValues, RawValue, Scene, SceneInstance, raw_from_value, value_from_raw};
+use crate::params::{NodeValues, ParamType, RawValue, raw_from_value, value_from_raw};
+use crate::scene::{Scene, SceneInstance};
 
 /// A preset file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

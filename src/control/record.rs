@@ -10,8 +10,8 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::params::{ParamWrite, Source};
-use crate::scene::{ControlEvent, RawValue, Scene, raw_from_value, value_from_raw};
+use crate::params::{ControlEvent, ParamWrite, RawValue, Source, raw_from_value, value_from_raw};
+use crate::scene::Scene;
 
 /// One line of a control-stream file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -64,10 +64,15 @@ impl Recorder {
     }
 
     /// Writes `events` applied before `frame`, and flushes (a crash loses at most one frame).
+    /// An event whose parameter the scene does not have is left out with a logged line, never
+    /// a panic (events are remapped on reload, so this is a guard, not a path).
     pub fn record(&mut self, frame: u64, events: &[ControlEvent], scene: &Scene) -> Result<(), String> {
         for event in events {
-            let line = Recorded { frame, event: to_recorded(event, scene) };
-            let text = ron::to_string(&line).map_err(|e| e.to_string())?;
+            let Some(event) = to_recorded(event, scene) else {
+                log::warn!("not recorded (no such parameter in '{}'): {event:?}", scene.name);
+                continue;
+            };
+            let text = ron::to_string(&Recorded { frame, event }).map_err(|e| e.to_string())?;
             writeln!(self.out, "{text}").map_err(|e| e.to_string())?;
             self.count += 1;
         }
@@ -78,16 +83,17 @@ impl Recorder {
     }
 }
 
-fn name(scene: &Scene, node: usize, param: usize) -> (String, String) {
-    let n = &scene.nodes[node];
-    (n.id.clone(), n.params.decls()[param].name.clone())
+/// Node id, parameter name and declaration of a position, if the scene has it.
+fn named(scene: &Scene, node: usize, param: usize) -> Option<(String, String, &crate::params::ParamDecl)> {
+    let n = scene.nodes.get(node)?;
+    let decl = n.params.decls().get(param)?;
+    Some((n.id.clone(), decl.name.clone(), decl))
 }
 
-fn to_recorded(event: &ControlEvent, scene: &Scene) -> RecordedEvent {
-    match event {
+fn to_recorded(event: &ControlEvent, scene: &Scene) -> Option<RecordedEvent> {
+    Some(match event {
         ControlEvent::Write(w) => {
-            let (node, param) = name(scene, w.node, w.param);
-            let decl = &scene.nodes[w.node].params.decls()[w.param];
+            let (node, param, decl) = named(scene, w.node, w.param)?;
             let value = match w.component {
                 Some(_) => RawValue::Number(f64::from(w.value.components()[0])),
                 None => raw_from_value(&w.value, decl),
@@ -97,15 +103,12 @@ fn to_recorded(event: &ControlEvent, scene: &Scene) -> RecordedEvent {
         ControlEvent::Morph { values, seconds } => RecordedEvent::Morph {
             values: values
                 .iter()
-                .map(|(n, p, v)| {
-                    let (node, param) = name(scene, *n, *p);
-                    (node, param, raw_from_value(v, &scene.nodes[*n].params.decls()[*p]))
-                })
-                .collect(),
+                .map(|(n, p, v)| named(scene, *n, *p).map(|(node, param, decl)| (node, param, raw_from_value(v, decl))))
+                .collect::<Option<_>>()?,
             seconds: *seconds,
         },
         ControlEvent::ResumeTracks => RecordedEvent::ResumeTracks,
-    }
+    })
 }
 
 /// Reads a recording for `scene`: events by frame. Errors name the line.

@@ -4,6 +4,7 @@
 
 mod binding;
 mod blit;
+mod cache;
 mod compute;
 mod context;
 mod raster;
@@ -12,8 +13,9 @@ mod shader;
 
 pub use binding::{uniform_buffer, uniform_entry, wgsl_struct_size};
 pub use blit::{Blit, BlitTarget, DISPLAY_FORMAT};
+pub use cache::{BindGroupCache, DEFAULT_MAX_AGE};
 pub use compute::ComputeKernel;
 pub use context::{BackendChoice, Gpu, GpuError, GpuOptions, instance_descriptor};
 pub use raster::{GrowableBuffer, RasterDesc, UniformBlock, raster_pipeline};
-pub use readback::{read_texture_bytes, read_texture_rgba8};
+pub use readback::{ReadbackError, read_texture_bytes, read_texture_rgba8};
 pub use shader::{ShaderError, compile_wgsl, validate_wgsl, validated};

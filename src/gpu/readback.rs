@@ -1,9 +1,21 @@
 //! Copying a texture back to the CPU.
 
+/// Why a frame could not be read back: the device was lost (driver reset, GPU removed, out of
+/// memory) while waiting for it. A render ends with this sentence, never a panic.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "the GPU was lost while reading a frame back ({0}); the render stopped — check the driver (e.g. `dmesg`), free GPU memory, and render again from this frame with --start"
+)]
+pub struct ReadbackError(pub String);
+
 /// Reads any single-plane colour texture into tightly packed rows of its texel bytes (e.g. 8
 /// bytes per texel for `Rgba16Float`). Blocks until the GPU is done; for tests, exports and
 /// screenshots, not for the frame loop.
-pub fn read_texture_bytes(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) -> Vec<u8> {
+pub fn read_texture_bytes(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+) -> Result<Vec<u8>, ReadbackError> {
     let (width, height) = (texture.width(), texture.height());
     let texel = texture.format().block_copy_size(None).expect("a colour format with a fixed texel size");
     let tight = width * texel;
@@ -30,18 +42,28 @@ pub fn read_texture_bytes(device: &wgpu::Device, queue: &wgpu::Queue, texture: &
     );
     queue.submit([encoder.finish()]);
     let slice = buffer.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |r| r.expect("readback buffer mapping failed"));
-    device.poll(wgpu::PollType::wait_indefinitely()).expect("device lost during readback");
-    let mapped = slice.get_mapped_range().expect("readback range is mapped");
+    let (sender, mapped) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| drop(sender.send(r)));
+    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| ReadbackError(e.to_string()))?;
+    match mapped.try_recv() {
+        Ok(Ok(())) => {}
+        Ok(Err(e)) => return Err(ReadbackError(e.to_string())),
+        Err(_) => return Err(ReadbackError("the mapping never completed".into())),
+    }
+    let mapped = slice.get_mapped_range().map_err(|e| ReadbackError(e.to_string()))?;
     let mut out = Vec::with_capacity((tight * height) as usize);
     for row in mapped.chunks(padded as usize) {
         out.extend_from_slice(&row[..tight as usize]);
     }
-    out
+    Ok(out)
 }
 
 /// Reads an `Rgba8Unorm` (or `Bgra8Unorm`, returned as stored) texture into tightly packed rows.
-pub fn read_texture_rgba8(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) -> Vec<u8> {
+pub fn read_texture_rgba8(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+) -> Result<Vec<u8>, ReadbackError> {
     debug_assert_eq!(texture.format().block_copy_size(None), Some(4));
     read_texture_bytes(device, queue, texture)
 }

@@ -57,12 +57,34 @@ pub struct FrameGraph<'r> {
     pub(crate) buffers: Vec<VirtualBuffer>,
     pub(crate) passes: Vec<PassDecl<'r>>,
     pub(crate) output: Option<TextureHandle>,
+    /// A frame that only advances simulations (a seek): it has no output, and only passes that
+    /// write persistent state (imports) or have side effects, with what they depend on, run.
+    pub(crate) simulation_only: bool,
 }
 
 impl<'r> FrameGraph<'r> {
     /// An empty graph for a frame whose output is `output_size` texels.
     pub fn new(output_size: (u32, u32)) -> Self {
-        Self { output_size, textures: Vec::new(), buffers: Vec::new(), passes: Vec::new(), output: None }
+        Self {
+            output_size,
+            textures: Vec::new(),
+            buffers: Vec::new(),
+            passes: Vec::new(),
+            output: None,
+            simulation_only: false,
+        }
+    }
+
+    /// A graph for a frame that is stepped but not shown (frames skipped by a seek). Nodes add
+    /// their passes as usual; compiling keeps only the work that changes persistent resources,
+    /// so a stateful node's simulation runs exactly as in a drawn frame, and drawing is culled.
+    pub fn simulation_only(output_size: (u32, u32)) -> Self {
+        Self { simulation_only: true, ..Self::new(output_size) }
+    }
+
+    /// Whether this frame is only stepped, not shown (see [`FrameGraph::simulation_only`]).
+    pub fn is_simulation_only(&self) -> bool {
+        self.simulation_only
     }
 
     /// The frame's output size.
@@ -97,6 +119,9 @@ impl<'r> FrameGraph<'r> {
 
     /// Marks the texture the frame presents; passes that do not contribute to it are culled.
     pub fn set_output(&mut self, texture: TextureHandle) {
+        if self.simulation_only {
+            return;
+        }
         self.output = Some(texture);
     }
 

@@ -47,7 +47,11 @@ impl CompiledGraph {
 /// passes that write the same resource, declaration order is kept (a read-modify-write chain).
 /// Ties are broken by declaration order, so the result is deterministic.
 pub fn compile(graph: &FrameGraph<'_>) -> Result<CompiledGraph, GraphError> {
-    let output = graph.output.ok_or(GraphError::NoOutput)?;
+    let output = match (graph.output, graph.simulation_only) {
+        (_, true) => None,
+        (Some(output), false) => Some(output),
+        (None, false) => return Err(GraphError::NoOutput),
+    };
     let n = graph.passes.len();
     let writers = |r: Resource| -> Vec<usize> {
         (0..n).filter(|&p| graph.passes[p].accesses.iter().any(|&(res, a)| res == r && a != Access::Read)).collect()
@@ -89,14 +93,16 @@ pub fn compile(graph: &FrameGraph<'_>) -> Result<CompiledGraph, GraphError> {
         }
     }
     // The output is read after the last pass (display encode / readback).
-    if let Some((first, _)) = texture_lifetimes[output.0 as usize] {
+    if let Some(output) = output
+        && let Some((first, _)) = texture_lifetimes[output.0 as usize]
+    {
         texture_lifetimes[output.0 as usize] = Some((first, usize::MAX));
     }
     Ok(CompiledGraph { order, texture_lifetimes, buffer_lifetimes })
 }
 
 /// Passes whose work reaches the output, an imported resource, or that have side effects.
-fn live_passes(graph: &FrameGraph<'_>, output: super::TextureHandle, deps: &[BTreeSet<usize>]) -> Vec<bool> {
+fn live_passes(graph: &FrameGraph<'_>, output: Option<super::TextureHandle>, deps: &[BTreeSet<usize>]) -> Vec<bool> {
     let is_root = |p: usize| {
         let pass = &graph.passes[p];
         pass.side_effect
@@ -104,7 +110,8 @@ fn live_passes(graph: &FrameGraph<'_>, output: super::TextureHandle, deps: &[BTr
                 a != Access::Read
                     && match res {
                         Resource::Texture(t) => {
-                            t == output.0 || matches!(graph.textures[t as usize].origin, TextureOrigin::Imported(..))
+                            output.is_some_and(|o| o.0 == t)
+                                || matches!(graph.textures[t as usize].origin, TextureOrigin::Imported(..))
                         }
                         Resource::Buffer(b) => {
                             matches!(graph.buffers[b as usize].origin, BufferOrigin::Imported(..))
@@ -275,6 +282,23 @@ mod tests {
     fn no_output_is_an_error() {
         let g = FrameGraph::new((64, 64));
         assert_eq!(compile(&g).unwrap_err(), GraphError::NoOutput);
+    }
+
+    #[test]
+    fn a_simulation_only_frame_keeps_only_work_on_persistent_state() {
+        let mut g = FrameGraph::simulation_only((64, 64));
+        let state = g.create_buffer("forces", 64);
+        let scratch = g.create_texture("scratch", TextureDesc::full(F));
+        let image = g.create_texture("image", TextureDesc::full(F));
+        // "forces" is transient, but the side-effect step reads it: it must run too.
+        g.add_pass("forces").write_buffer(state).record(|_| {});
+        g.add_pass("step").read_buffer(state).side_effect().record(|_| {});
+        pass(&mut g, "blur", &[], &[scratch]);
+        pass(&mut g, "draw", &[scratch], &[image]);
+        g.set_output(image);
+        assert_eq!(g.output(), None, "a simulation-only frame has no output");
+        let c = compile(&g).unwrap();
+        assert_eq!(names(&g, &c), ["forces", "step"]);
     }
 
     #[test]

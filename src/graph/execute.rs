@@ -68,14 +68,43 @@ impl GraphRuntime {
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        mut graph: FrameGraph<'_>,
+        graph: FrameGraph<'_>,
         encoder: &mut wgpu::CommandEncoder,
     ) -> Result<FrameOutput, GraphError> {
+        let output = graph.output.ok_or(GraphError::NoOutput)?;
+        let output_name = graph.textures[output.0 as usize].name.clone();
+        let (mut textures, stats) = self.record(device, queue, graph, encoder)?;
+        let out = textures[output.0 as usize]
+            .take()
+            .ok_or(GraphError::ReadOfUnwritten { pass: "<output>".into(), resource: output_name })?;
+        Ok(FrameOutput { texture: out.texture, view: out.view, stats })
+    }
+
+    /// Compiles and records a [`FrameGraph::simulation_only`] frame: only the passes that write
+    /// persistent state run. Submit the encoder, then call `after_submit`.
+    pub fn simulate(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        graph: FrameGraph<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> Result<FrameStats, GraphError> {
+        debug_assert!(graph.simulation_only, "simulate takes a simulation-only graph");
+        self.record(device, queue, graph, encoder).map(|(_, stats)| stats)
+    }
+
+    /// Records the live passes of `graph`; returns the resolved textures (the output's included).
+    fn record(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        mut graph: FrameGraph<'_>,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> Result<(Vec<Option<ResolvedTexture>>, FrameStats), GraphError> {
         let started = Instant::now();
         let compiled = compile(&graph)?;
         let compile_time = started.elapsed();
-        let output = graph.output.ok_or(GraphError::NoOutput)?;
-        let usages = texture_usages(&graph, output.0);
+        let usages = texture_usages(&graph, graph.output.map(|o| o.0));
 
         let mut textures: Vec<Option<ResolvedTexture>> = vec![None; graph.textures.len()];
         let mut pool_index: Vec<Option<usize>> = vec![None; graph.textures.len()];
@@ -158,11 +187,7 @@ impl GraphRuntime {
         for b in &mut self.buffers {
             b.in_use = false;
         }
-        let out = textures[output.0 as usize].take().ok_or_else(|| GraphError::ReadOfUnwritten {
-            pass: "<output>".into(),
-            resource: graph.textures[output.0 as usize].name.clone(),
-        })?;
-        Ok(FrameOutput { texture: out.texture, view: out.view, stats })
+        Ok((textures, stats))
     }
 
     /// Call after the frame's encoder was submitted: starts reading back its timestamps.
@@ -246,7 +271,7 @@ fn size_of(t: &ResolvedTexture) -> (u32, u32) {
 }
 
 /// Usage flags of each texture, inferred from how passes access it.
-fn texture_usages(graph: &FrameGraph<'_>, output: u32) -> Vec<wgpu::TextureUsages> {
+fn texture_usages(graph: &FrameGraph<'_>, output: Option<u32>) -> Vec<wgpu::TextureUsages> {
     let mut usages = vec![wgpu::TextureUsages::empty(); graph.textures.len()];
     for pass in &graph.passes {
         for &(res, access) in &pass.accesses {
@@ -260,6 +285,8 @@ fn texture_usages(graph: &FrameGraph<'_>, output: u32) -> Vec<wgpu::TextureUsage
         }
     }
     // The output is encoded for display (sampled) or copied for readback.
-    usages[output as usize] |= wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    if let Some(output) = output {
+        usages[output as usize] |= wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    }
     usages
 }

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use super::watcher::{Watcher, read_stable};
 use crate::assets::{AssetKind, Assets};
 use crate::gpu::{Gpu, validate_wgsl};
+use crate::params::Remap;
 use crate::scene::{SceneInstance, parse_scene};
 
 /// What one poll did.
@@ -19,6 +20,9 @@ pub struct ReloadReport {
     pub fixed: Vec<String>,
     /// Whether the scene's structure changed (control maps must be rebuilt).
     pub scene_changed: bool,
+    /// Where the old scene's parameters are in the new one, when the scene was replaced: apply
+    /// it to everything holding parameter positions (queued events, scripts, MIDI learn).
+    pub remap: Option<Remap>,
 }
 
 /// Watches the asset folders and applies changes to a running scene.
@@ -120,8 +124,9 @@ impl LiveReload {
         }
         let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
         let scene = parse_scene(&path.display().to_string(), &source).map_err(|e| e.to_string())?;
-        instance.replace_scene(scene, gpu, &self.assets, size).map_err(|e| e.to_string())?;
+        let remap = instance.replace_scene(scene, gpu, &self.assets, size).map_err(|e| e.to_string())?;
         report.scene_changed = true;
+        report.remap = Some(remap);
         Ok(true)
     }
 }

@@ -5,4 +5,4 @@ mod golden;
 mod renderer;
 
 pub use golden::{FlipScore, GoldenCheck, flip_score};
-pub use renderer::{OffscreenRenderer, RenderedFrame, write_png};
+pub use renderer::{OffscreenRenderer, RenderError, RenderedFrame, write_png};

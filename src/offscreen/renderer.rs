@@ -1,13 +1,13 @@
 //! Rendering a scene frame by frame without a window.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use crate::assets::Assets;
 use crate::gpu::{Blit, BlitTarget, DISPLAY_FORMAT, Gpu, read_texture_rgba8};
 use crate::graph::{FrameStats, GraphRuntime};
 use crate::live::{LiveReload, ReloadReport};
-use crate::scene::{ControlEvent, Scene, SceneInstance};
+use crate::params::ControlEvent;
+use crate::scene::{Player, Scene, SceneInstance, SeekError};
 use crate::time::{FixedClock, FrameTime};
 
 /// One rendered frame, read back as sRGB-encoded RGBA8 rows.
@@ -22,16 +22,15 @@ pub struct RenderedFrame {
     pub stats: FrameStats,
 }
 
-/// Renders a scene off-screen on a fixed clock: frame n is at time n × dt, whatever the speed.
+/// Renders a scene off-screen on a fixed clock: frame n is at time n × dt, whatever the speed,
+/// through the same frame step as the window ([`Player`]).
 pub struct OffscreenRenderer {
     gpu: Gpu,
-    instance: SceneInstance,
+    player: Player,
     runtime: GraphRuntime,
     blit: Blit,
-    clock: FixedClock,
     size: (u32, u32),
     target: wgpu::Texture,
-    script: BTreeMap<u64, Vec<ControlEvent>>,
 }
 
 impl OffscreenRenderer {
@@ -59,12 +58,12 @@ impl OffscreenRenderer {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        Ok(Self { gpu, instance, runtime, blit, clock, size, target, script: BTreeMap::new() })
+        Ok(Self { gpu, player: Player::new(instance, clock), runtime, blit, size, target })
     }
 
     /// The live scene (to change parameters between frames).
     pub fn instance_mut(&mut self) -> &mut SceneInstance {
-        &mut self.instance
+        self.player.instance_mut()
     }
 
     /// The device.
@@ -77,28 +76,30 @@ impl OffscreenRenderer {
         &self.runtime
     }
 
-    /// Jumps to frame `frame` without rendering the ones before. Stateless scenes render the
-    /// same frame either way; simulations need every step, so use this only before frame 0.
-    pub fn seek(&mut self, frame: u64) {
-        self.clock.seek(frame);
+    /// Advances to frame `frame` without drawing the frames before it: every fixed step runs
+    /// (simulation only, scheduled events at their own frames), so the next rendered frame is
+    /// the same bytes as when played from 0. Forward only.
+    pub fn seek(&mut self, frame: u64) -> Result<(), SeekError> {
+        self.player.seek(&self.gpu, &mut self.runtime, self.size, frame)
     }
 
     /// Schedules control events to apply just before frame `frame` steps (a replayed control
-    /// stream, or a test's script). Events for frames already rendered are ignored.
+    /// stream, or a test's script). Events for frames already stepped are dropped.
     pub fn schedule(&mut self, frame: u64, events: Vec<ControlEvent>) {
-        self.script.entry(frame).or_default().extend(events);
+        self.player.schedule(frame, events);
+    }
+
+    /// The frame the next render draws.
+    pub fn next_frame(&self) -> u64 {
+        self.player.now().frame
     }
 
     /// Records and submits one frame, without reading it back (benchmarks).
     pub fn render_only(&mut self) -> Result<(FrameTime, FrameStats), crate::graph::GraphError> {
-        let time = self.clock.now();
-        if let Some(events) = self.script.remove(&time.frame) {
-            self.instance.apply(&events);
-        }
-        self.instance.advance(&time);
+        let time = self.player.step();
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("offscreen_frame") });
-        let output = self.instance.encode(&self.gpu, &mut self.runtime, &mut encoder, self.size, &time)?;
+        let output = self.player.encode(&self.gpu, &mut self.runtime, &mut encoder, self.size)?;
         let target_view = self.target.create_view(&Default::default());
         self.blit.record(
             &self.gpu.device,
@@ -109,26 +110,40 @@ impl OffscreenRenderer {
         );
         self.gpu.queue.submit([encoder.finish()]);
         self.runtime.after_submit();
-        self.clock.step();
         Ok((time, output.stats))
     }
 
     /// Renders the next frame and reads it back.
-    pub fn render_next(&mut self) -> Result<RenderedFrame, crate::graph::GraphError> {
+    pub fn render_next(&mut self) -> Result<RenderedFrame, RenderError> {
         let (time, stats) = self.render_only()?;
-        let rgba = read_texture_rgba8(&self.gpu.device, &self.gpu.queue, &self.target);
+        let rgba = read_texture_rgba8(&self.gpu.device, &self.gpu.queue, &self.target)?;
         Ok(RenderedFrame { time, rgba, size: self.size, stats })
     }
 
     /// Applies edited shader and scene files picked up by `live` (hot reload, off-screen).
     pub fn poll_reload(&mut self, live: &mut LiveReload) -> ReloadReport {
-        live.poll(&mut self.instance, &self.gpu, self.size)
+        let report = live.poll(self.player.instance_mut(), &self.gpu, self.size);
+        if let Some(remap) = &report.remap {
+            self.player.remap(remap);
+        }
+        report
     }
 
     /// Waits for the GPU and folds outstanding pass timings into the medians.
     pub fn finish_timings(&mut self) {
         self.runtime.drain_timings(&self.gpu.device);
     }
+}
+
+/// Why an off-screen frame could not be produced; each is one sentence for the user.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// The frame's declarations cannot run.
+    #[error(transparent)]
+    Graph(#[from] crate::graph::GraphError),
+    /// The device was lost before the frame came back.
+    #[error(transparent)]
+    Readback(#[from] crate::gpu::ReadbackError),
 }
 
 /// Writes RGBA8 rows as a PNG.

@@ -1,14 +1,20 @@
-//! Typed parameters: values, declarations with ranges, the per-node parameter set, and animation
-//! tracks. Knows nothing of where values come from (UI, files, OSC).
+//! Typed parameters: values, declarations with ranges, the per-node parameter set, animation
+//! tracks, values as files write them, and the address space live sources write through
+//! (targets, control events, remapping across a reload). Knows nothing of where values come from
+//! (UI, files, OSC).
 
+mod address;
 mod morph;
+mod raw;
 mod set;
 mod track;
 mod value;
 mod write;
 
+pub use address::{ControlEvent, NodeValues, Remap, Target};
 pub use morph::Morph;
+pub use raw::{RawValue, coerce, raw_from_value, value_from_raw};
 pub use set::ParamSet;
 pub use track::{Interpolation, Key, LoopMode, Track, mix};
-pub use value::{ParamDecl, ParamType, ParamValue, Text};
+pub use value::{InputRole, ParamDecl, ParamType, ParamValue, Text};
 pub use write::{ParamWrite, Source};

@@ -77,8 +77,9 @@ impl ParamSet {
         self.values.clone_from(&self.targets);
     }
 
-    /// Clears triggers that fired: called once the frame that saw them has been built.
-    pub fn end_frame(&mut self) {
+    /// Clears triggers that fired: called after the fixed step that saw them, so a trigger fires
+    /// for exactly one step whatever the number of steps a displayed frame runs.
+    pub fn end_step(&mut self) {
         for (t, v) in self.targets.iter_mut().zip(self.values.iter_mut()) {
             if matches!(t, ParamValue::Trigger(true)) {
                 *t = ParamValue::Trigger(false);
@@ -181,11 +182,11 @@ mod tests {
     }
 
     #[test]
-    fn a_trigger_fires_for_one_frame() {
+    fn a_trigger_fires_for_one_step() {
         let mut p = set(0.0);
         p.set_at(2, ParamValue::Trigger(true));
         assert!(p.fired("go"));
-        p.end_frame();
+        p.end_step();
         assert!(!p.fired("go"));
     }
 }

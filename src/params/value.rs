@@ -243,6 +243,23 @@ pub struct ParamDecl {
     /// Smoothing time constant in seconds (0: changes apply at once). Only continuous types
     /// (float, vectors, colours) are smoothed.
     pub smoothing: f32,
+    /// What the window's mouse or keyboard does to it, if anything: a technique declares this
+    /// and gets mouse and keys without any change to the app.
+    pub role: Option<InputRole>,
+}
+
+/// How the window's pointer and keys drive a parameter. The window turns input into ordinary
+/// parameter writes, so OSC, MIDI, presets and recordings drive the same parameters the same way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InputRole {
+    /// A vec2 that follows the pointer on each click, in view units (0–1, y up).
+    Pointer,
+    /// A trigger fired by a primary-button click (after the pointer is written).
+    PrimaryClick,
+    /// A trigger fired by a secondary-button click (after the pointer is written).
+    SecondaryClick,
+    /// A trigger fired by a key (a lower-case letter; the key works with or without shift).
+    Key(char),
 }
 
 impl ParamDecl {
@@ -256,7 +273,14 @@ impl ParamDecl {
             doc: doc.into(),
             options: Vec::new(),
             smoothing: 0.0,
+            role: None,
         }
+    }
+
+    /// This declaration driven by the window's pointer or keys as `role` says.
+    pub fn with_role(mut self, role: InputRole) -> Self {
+        self.role = Some(role);
+        self
     }
 
     /// An enum parameter choosing one of `options` (default: option `default`).

@@ -13,28 +13,9 @@ use super::load::Scene;
 use crate::assets::Assets;
 use crate::gpu::{Gpu, ShaderError};
 use crate::graph::{FrameGraph, FrameOutput, GraphError, GraphRuntime};
-use crate::params::{Morph, ParamSet, ParamValue, ParamWrite, Source};
+use crate::params::{ControlEvent, InputRole, Morph, NodeValues, ParamSet, ParamValue, ParamWrite, Remap, Source};
 use crate::techniques::{NodeSetup, Technique};
 use crate::time::FrameTime;
-
-/// Values for (node, param) pairs: a preset, or a morph's destination.
-pub type NodeValues = Vec<(usize, usize, ParamValue)>;
-
-/// Something a controller, the UI or a replay asks of the running scene.
-#[derive(Clone, Debug, PartialEq)]
-pub enum ControlEvent {
-    /// Set one parameter (or component).
-    Write(ParamWrite),
-    /// Move to these values over `seconds` (0: at once) — a preset recall.
-    Morph {
-        /// (node, param, value).
-        values: NodeValues,
-        /// Morph duration.
-        seconds: f64,
-    },
-    /// Give every parameter a live source took over back to its track.
-    ResumeTracks,
-}
 
 /// The running form of a [`Scene`].
 pub struct SceneInstance {
@@ -151,6 +132,16 @@ impl SceneInstance {
         for (node, params) in self.nodes.iter_mut().zip(&self.params) {
             node.step(params, time);
         }
+        // A trigger fires for exactly one fixed step, however many steps a frame runs.
+        for params in &mut self.params {
+            params.end_step();
+        }
+    }
+
+    /// Whether any node records simulation work in its passes that every fixed step needs
+    /// (GPU state). Seeking builds a simulation-only frame for each skipped step only then.
+    pub fn simulates_on_gpu(&self) -> bool {
+        self.nodes.iter().any(|n| n.simulates_on_gpu())
     }
 
     /// Recreates every node whose technique loads shader file `name` (after an edit). Either all
@@ -181,14 +172,15 @@ impl SceneInstance {
     /// Switches to an edited version of the scene. Nodes whose id and technique are unchanged
     /// keep their instance (and simulation state); parameters keep their live values unless the
     /// file changed their default; new nodes are created. If any new node fails to build, the
-    /// running scene stays as it was.
+    /// running scene stays as it was. Returns where each old parameter is now, for everything
+    /// that holds parameter positions across the reload (queued events, scripts, MIDI learn).
     pub fn replace_scene(
         &mut self,
         scene: Scene,
         gpu: &Gpu,
         assets: &Assets,
         output_size: (u32, u32),
-    ) -> Result<(), ShaderError> {
+    ) -> Result<Remap, ShaderError> {
         let kept = |n: &super::SceneNode| {
             self.scene.nodes.iter().position(|o| o.id == n.id && o.technique.name == n.technique.name)
         };
@@ -217,12 +209,17 @@ impl SceneInstance {
             }
             params.push(set);
         }
+        let remap = Remap::between(
+            self.scene.nodes.iter().map(|n| n.id.as_str()).zip(&self.params),
+            scene.nodes.iter().map(|n| n.id.as_str()).zip(&params),
+        );
         self.nodes = fresh.into_iter().map(|n| n.expect("every node kept or created")).collect();
         self.params = params;
         self.scene = scene;
         self.overridden.clear();
         self.morph = None;
-        Ok(())
+        self.pending_morph = None;
+        Ok(remap)
     }
 
     /// What the techniques want the performer to know since the last call, prefixed by node id.
@@ -235,53 +232,33 @@ impl SceneInstance {
             .collect()
     }
 
-    /// Writes that fire every trigger parameter called `name` (e.g. R fires every `reset`).
-    pub fn fire_all(&self, name: &str, source: Source) -> Vec<ControlEvent> {
-        let mut events = Vec::new();
-        for (node, params) in self.params.iter().enumerate() {
-            if let Some(param) =
-                params.index(name).filter(|&p| params.decls()[p].ty() == crate::params::ParamType::Trigger)
-            {
-                events.push(ControlEvent::Write(ParamWrite {
-                    node,
-                    param,
-                    component: None,
-                    value: ParamValue::Trigger(true),
-                    source,
-                }));
-            }
-        }
+    /// Writes for a key press: every trigger declared with [`InputRole::Key`] for this letter
+    /// fires (R resets a cloth and restarts a Poisson run; U and C undo and clear a drawing).
+    pub fn key(&self, key: char, source: Source) -> Vec<ControlEvent> {
+        let key = key.to_ascii_lowercase();
+        self.writes_for(source, |role| (role == InputRole::Key(key)).then_some(ParamValue::Trigger(true)))
+    }
+
+    /// Writes for a click at `position` (view units 0–1, y up): every parameter declared as
+    /// [`InputRole::Pointer`] gets the position, then the triggers declared for that button
+    /// fire. This is how the window's mouse draws, through the same parameters OSC and
+    /// recordings use.
+    pub fn pointer(&self, position: [f32; 2], primary: bool, source: Source) -> Vec<ControlEvent> {
+        let click = if primary { InputRole::PrimaryClick } else { InputRole::SecondaryClick };
+        let mut events =
+            self.writes_for(source, |role| (role == InputRole::Pointer).then_some(ParamValue::Vec2(position)));
+        events.extend(self.writes_for(source, |role| (role == click).then_some(ParamValue::Trigger(true))));
         events
     }
 
-    /// Writes for a click at `position` (view units 0–1, y up): every node that declares a
-    /// vec2 `cursor` gets it set, then its `add` trigger (primary button) or `close` trigger
-    /// (secondary button) fires. This is how the window's mouse draws, through the same
-    /// parameters OSC and recordings use.
-    pub fn pointer(&self, position: [f32; 2], primary: bool, source: Source) -> Vec<ControlEvent> {
-        let trigger = if primary { "add" } else { "close" };
+    /// A write of `value(role)` to every parameter whose declared role gives a value.
+    fn writes_for(&self, source: Source, value: impl Fn(InputRole) -> Option<ParamValue>) -> Vec<ControlEvent> {
         let mut events = Vec::new();
         for (node, params) in self.params.iter().enumerate() {
-            let Some(cursor) =
-                params.index("cursor").filter(|&p| params.decls()[p].ty() == crate::params::ParamType::Vec2)
-            else {
-                continue;
-            };
-            events.push(ControlEvent::Write(ParamWrite {
-                node,
-                param: cursor,
-                component: None,
-                value: ParamValue::Vec2(position),
-                source,
-            }));
-            if let Some(param) = params.index(trigger) {
-                events.push(ControlEvent::Write(ParamWrite {
-                    node,
-                    param,
-                    component: None,
-                    value: ParamValue::Trigger(true),
-                    source,
-                }));
+            for (param, decl) in params.decls().iter().enumerate() {
+                if let Some(value) = decl.role.and_then(&value) {
+                    events.push(ControlEvent::Write(ParamWrite { node, param, component: None, value, source }));
+                }
             }
         }
         events
@@ -289,7 +266,10 @@ impl SceneInstance {
 
     /// Declares this frame: every node adds its passes, the output node's texture is the output.
     pub fn build_graph(&mut self, output_size: (u32, u32), time: &FrameTime) -> FrameGraph<'_> {
-        let mut graph = FrameGraph::new(output_size);
+        self.declare(FrameGraph::new(output_size), time)
+    }
+
+    fn declare<'r>(&'r mut self, mut graph: FrameGraph<'r>, time: &FrameTime) -> FrameGraph<'r> {
         let mut outputs = Vec::with_capacity(self.nodes.len());
         for (i, node) in self.nodes.iter_mut().enumerate() {
             let inputs: Vec<_> = self.scene.nodes[i].inputs.iter().map(|&j| outputs[j]).collect();
@@ -299,8 +279,23 @@ impl SceneInstance {
         graph
     }
 
+    /// Records the simulation work of a step that is not drawn (a seek): every node adds its
+    /// passes to a [`FrameGraph::simulation_only`] graph, which runs only what changes
+    /// persistent state. The caller submits.
+    pub fn encode_simulation(
+        &mut self,
+        gpu: &Gpu,
+        runtime: &mut GraphRuntime,
+        encoder: &mut wgpu::CommandEncoder,
+        output_size: (u32, u32),
+        time: &FrameTime,
+    ) -> Result<(), GraphError> {
+        let graph = self.declare(FrameGraph::simulation_only(output_size), time);
+        runtime.simulate(&gpu.device, &gpu.queue, graph, encoder).map(|_| ())
+    }
+
     /// Builds and records the frame into `encoder`; the caller encodes the output for display
-    /// and submits. Triggers that fired are cleared afterwards.
+    /// and submits.
     pub fn encode(
         &mut self,
         gpu: &Gpu,
@@ -310,10 +305,6 @@ impl SceneInstance {
         time: &FrameTime,
     ) -> Result<FrameOutput, GraphError> {
         let graph = self.build_graph(output_size, time);
-        let result = runtime.execute(&gpu.device, &gpu.queue, graph, encoder);
-        for params in &mut self.params {
-            params.end_frame();
-        }
-        result
+        runtime.execute(&gpu.device, &gpu.queue, graph, encoder)
     }
 }

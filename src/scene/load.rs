@@ -3,9 +3,9 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use super::error::{SceneError, SceneErrors, locate};
-use super::schema::{MidiMapping, RawValue, SceneFile};
+use super::schema::{MidiMapping, SceneFile};
 use crate::assets::{AssetKind, Assets};
-use crate::params::{Key, ParamDecl, ParamSet, ParamType, ParamValue, Track};
+use crate::params::{Key, ParamDecl, ParamSet, ParamType, ParamValue, RawValue, Target, Track, coerce};
 use crate::techniques::{self, TechniqueInfo};
 
 /// A validated scene: every name resolved, every value typed.
@@ -37,17 +37,6 @@ pub struct Scene {
 
 /// A scene's OSC aliases and MIDI mappings, resolved.
 type ControlMaps = (Vec<(String, Target)>, Vec<(MidiMapping, Target)>);
-
-/// A parameter, or one float component of it, of a scene node.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct Target {
-    /// Node index.
-    pub node: usize,
-    /// Parameter index in the node.
-    pub param: usize,
-    /// Component (`t.x` → 0), if any.
-    pub component: Option<usize>,
-}
 
 /// Resolves `node.param` or `node.param.<x|y|z|w|r|g|b|a>` against validated nodes.
 pub fn resolve_target(nodes: &[SceneNode], target: &str) -> Result<Target, String> {
@@ -122,7 +111,10 @@ impl Scene {
         let params = &mut self.nodes[t.node].params;
         match t.component {
             Some(c) => {
-                let x = value.trim().parse::<f32>().map_err(|_| format!("'{value}' is not a number"))?;
+                let x = value
+                    .trim()
+                    .parse::<f32>()
+                    .map_err(|_| format!("'{value}' is not a number (a component takes one)"))?;
                 params.set_component(t.param, c, x);
             }
             None => {
@@ -135,21 +127,33 @@ impl Scene {
     }
 }
 
-/// Parses a command-line value (`1.5`, `2,0`, `true`, an enum option name, any text for text
-/// parameters) for `decl`.
+/// Parses a command-line value for `decl`: `1.5`; a vector as `1.0,0.3,0.1` or as the tuple
+/// a scene file uses, `(1.0, 0.3, 0.1)` or `[1.0, 0.3, 0.1]`; `true`/`false`; an enum option
+/// name (quoted or not); any text for text parameters.
 pub fn parse_value_override(text: &str, decl: &ParamDecl) -> Result<ParamValue, String> {
     let ty = decl.ty();
     if ty == ParamType::Text {
         // Text is taken as written (`--set title.text=HELLO WORLD`).
         return Ok(ParamValue::Text(crate::params::Text::new(text)));
     }
-    let raw = match text.trim() {
+    let trimmed = text.trim();
+    let unwrapped = [('(', ')'), ('[', ']'), ('"', '"')]
+        .iter()
+        .find_map(|&(open, close)| trimmed.strip_prefix(open)?.strip_suffix(close))
+        .unwrap_or(trimmed)
+        .trim();
+    let raw = match unwrapped {
         "true" => RawValue::Bool(true),
         "false" => RawValue::Bool(false),
         name if ty == ParamType::Enum && decl.option_index(name).is_some() => RawValue::Text(name.into()),
         list => RawValue::List(
-            list.split(',')
-                .map(|x| x.trim().parse::<f64>().map_err(|_| format!("'{x}' is not a number")))
+            list.trim_end_matches(',')
+                .split(',')
+                .map(|x| {
+                    x.trim().parse::<f64>().map_err(|_| {
+                        format!("'{}' in '{text}' is not a number (write 0.5, 1,0.5 or (1.0, 0.5))", x.trim())
+                    })
+                })
                 .collect::<Result<_, _>>()?,
         ),
     };
@@ -184,9 +188,7 @@ fn one_error(origin: &str, message: String) -> SceneErrors {
 
 /// Parses and validates scene text; `origin` names it in errors.
 pub fn parse_scene(origin: &str, source: &str) -> Result<Scene, SceneErrors> {
-    // implicit_some: authors write `channel: 1`, not `channel: Some(1)`.
-    let options = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
-    let file: SceneFile = options.from_str(source).map_err(|e| {
+    let file: SceneFile = super::schema::ron_options().from_str(source).map_err(|e| {
         SceneErrors(vec![SceneError {
             origin: origin.into(),
             line: e.span.start.line.max(1),
@@ -281,15 +283,7 @@ impl Validator<'_> {
         let mut midi = Vec::new();
         for m in &file.controls.midi {
             let anchors = ["controls", "midi", m.target.as_str()];
-            let problem = match (m.cc, m.note) {
-                _ if m.channel.is_some_and(|c| !(1..=16).contains(&c)) => Some("channel must be 1–16".to_string()),
-                (Some(_), Some(_)) | (None, None) => Some("give exactly one of cc and note".into()),
-                (Some(cc), None) if cc > 127 || (m.fine && cc > 31) => {
-                    Some(format!("cc {cc} out of range (0–127, or 0–31 for a 14-bit pair)"))
-                }
-                (None, Some(n)) if n > 127 => Some(format!("note {n} out of range (0–127)")),
-                _ => None,
-            };
+            let problem = m.problem();
             match (problem, resolve_target(nodes, &m.target)) {
                 (Some(p), _) => self.error(&anchors, format!("MIDI mapping to '{}': {p}", m.target)),
                 (None, Err(e)) => self.error(&anchors, format!("MIDI mapping: {e}")),
@@ -454,40 +448,6 @@ fn component_index(c: &str, ty: ParamType) -> Option<usize> {
         _ => return None,
     };
     (ty.components() > 1 && i < ty.components()).then_some(i)
-}
-
-/// A value as a file, preset or recording writes it for `decl` (enums by option name).
-pub fn raw_from_value(value: &ParamValue, decl: &ParamDecl) -> RawValue {
-    match value {
-        ParamValue::Bool(b) | ParamValue::Trigger(b) => RawValue::Bool(*b),
-        ParamValue::Enum(i) => RawValue::Text(decl.options.get(*i as usize).cloned().unwrap_or_default()),
-        ParamValue::Text(t) => RawValue::Text(t.as_str().to_string()),
-        ParamValue::Float(x) => RawValue::Number(f64::from(*x)),
-        ParamValue::Int(i) => RawValue::Number(f64::from(*i)),
-        other => RawValue::List(other.components().iter().map(|&c| f64::from(c)).collect()),
-    }
-}
-
-/// A file, preset or recording value as a value of `decl`'s type, if it fits.
-pub fn value_from_raw(raw: &RawValue, decl: &ParamDecl) -> Option<ParamValue> {
-    coerce(raw, decl.ty(), &decl.options)
-}
-
-/// A file value as a typed value: bools only for bool parameters, option names (or indices)
-/// for enums, numbers for the rest.
-fn coerce(raw: &RawValue, ty: ParamType, options: &[String]) -> Option<ParamValue> {
-    match (raw, ty) {
-        (RawValue::Bool(b), ParamType::Bool) => Some(ParamValue::Bool(*b)),
-        (RawValue::Bool(b), ParamType::Trigger) => Some(ParamValue::Trigger(*b)),
-        (RawValue::Text(name), ParamType::Enum) => {
-            options.iter().position(|o| o.eq_ignore_ascii_case(name)).map(|i| ParamValue::Enum(i as u32))
-        }
-        (RawValue::Number(i), ParamType::Enum) if (*i as usize) < options.len() => ty.value_from(&[*i]),
-        (RawValue::Text(text), ParamType::Text) => Some(ParamValue::Text(crate::params::Text::new(text))),
-        (RawValue::Bool(_) | RawValue::Text(_), _)
-        | (_, ParamType::Bool | ParamType::Enum | ParamType::Trigger | ParamType::Text) => None,
-        (raw, ty) => ty.value_from(&raw.numbers()),
-    }
 }
 
 fn mismatch(name: &str, decl: &ParamDecl, raw: &RawValue) -> String {

@@ -4,12 +4,13 @@
 mod error;
 mod instance;
 mod load;
+mod player;
 mod schema;
 
 pub use error::{SceneError, SceneErrors};
-pub use instance::{ControlEvent, NodeValues, SceneInstance};
-pub use load::{
-    BoundTrack, Scene, SceneNode, Target, load_scene, parse_scene, parse_value_override, raw_from_value,
-    resolve_target, value_from_raw,
-};
-pub use schema::{ControlsFile, MidiCurve, MidiMapping, NodeFile, RawValue, SceneFile, TrackFile};
+pub use instance::SceneInstance;
+pub use load::{BoundTrack, Scene, SceneNode, load_scene, parse_scene, parse_value_override, resolve_target};
+pub use player::{Player, SeekError};
+pub use schema::{ControlsFile, MidiCurve, MidiMapping, NodeFile, SceneFile, TrackFile, ron_options};
+// The address space lives in `params/`; re-exported for code that reaches it through scenes.
+pub use crate::params::{ControlEvent, NodeValues, RawValue, Target, raw_from_value, value_from_raw};

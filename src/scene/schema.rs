@@ -24,7 +24,7 @@ use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
-use crate::params::{Interpolation, LoopMode};
+use crate::params::{Interpolation, LoopMode, RawValue};
 
 /// A whole scene file.
 #[derive(Clone, Debug, Deserialize)]
@@ -67,6 +67,12 @@ pub struct ControlsFile {
     pub midi: Vec<MidiMapping>,
 }
 
+/// How every hand-editable RON file (scenes, MIDI learn files) is read: `implicit_some`, so
+/// authors write `channel: 1`, not `channel: Some(1)`.
+pub fn ron_options() -> ron::Options {
+    ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+}
+
 /// A MIDI control change (7-bit, or 14-bit when `fine`) or note bound to a parameter.
 #[derive(Clone, Debug, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
@@ -94,6 +100,25 @@ pub struct MidiMapping {
     /// 14-bit: the controller's LSB comes on `cc + 32`.
     #[serde(default)]
     pub fine: bool,
+}
+
+impl MidiMapping {
+    /// What is wrong with this mapping on its own (before its target is resolved), if anything:
+    /// the same check for scene files and for the hand-editable MIDI learn file.
+    pub fn problem(&self) -> Option<String> {
+        match (self.cc, self.note) {
+            _ if self.channel.is_some_and(|c| !(1..=16).contains(&c)) => Some("channel must be 1–16".to_string()),
+            (Some(_), Some(_)) | (None, None) => Some("give exactly one of cc and note".into()),
+            (Some(cc), None) if cc > 127 || (self.fine && cc > 31) => {
+                Some(format!("cc {cc} out of range (0–127, or 0–31 for a 14-bit pair)"))
+            }
+            (None, Some(n)) if n > 127 => Some(format!("note {n} out of range (0–127)")),
+            _ if self.range.is_some_and(|(lo, hi)| !lo.is_finite() || !hi.is_finite()) => {
+                Some("range must be two finite numbers".into())
+            }
+            _ => None,
+        }
+    }
 }
 
 /// How a 0–1 control position maps onto a range.
@@ -153,30 +178,4 @@ pub struct TrackFile {
     pub time_scale: f32,
     /// (time in seconds, value) pairs.
     pub keys: Vec<(f32, RawValue)>,
-}
-
-/// A value as written in a file, before the declared type gives it meaning.
-#[derive(Clone, Debug, PartialEq, Deserialize, serde::Serialize)]
-#[serde(untagged)]
-pub enum RawValue {
-    /// `true` / `false`.
-    Bool(bool),
-    /// `1.9` or `50`.
-    Number(f64),
-    /// `(1.0, 0.5)` or `[1.0, 0.5]`.
-    List(Vec<f64>),
-    /// `"Additive"`: an enum option by name.
-    Text(String),
-}
-
-impl RawValue {
-    /// The numbers it holds (bools as 0/1).
-    pub fn numbers(&self) -> Vec<f64> {
-        match self {
-            RawValue::Bool(b) => vec![if *b { 1.0 } else { 0.0 }],
-            RawValue::Number(x) => vec![*x],
-            RawValue::List(v) => v.clone(),
-            RawValue::Text(_) => Vec::new(),
-        }
-    }
 }

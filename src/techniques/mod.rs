@@ -82,6 +82,13 @@ pub trait Technique {
     /// Advances the simulation by one fixed step (no-op for stateless techniques).
     fn step(&mut self, _params: &ParamSet, _time: &FrameTime) {}
 
+    /// Whether `add_passes` records simulation work that every fixed step needs (state on the
+    /// GPU, like cloth). Frames skipped by a seek then still build a simulation-only graph, so
+    /// frame N is the same bytes played or sought. CPU state advanced in `step` needs nothing.
+    fn simulates_on_gpu(&self) -> bool {
+        false
+    }
+
     /// Things to tell the performer since the last call (e.g. "the cloth blew up and was reset").
     fn take_messages(&mut self) -> Vec<String> {
         Vec::new()

@@ -21,7 +21,7 @@ pub fn assets() -> Assets {
 /// Renders frame `frame` of `scene` at `size`.
 pub fn render_scene(scene: Scene, size: (u32, u32), frame: u64) -> RenderedFrame {
     let mut r = OffscreenRenderer::new(gpu(), &assets(), scene, Some(size), None, None).expect("scene builds");
-    r.seek(frame);
+    r.seek(frame).expect("seek reaches the frame");
     r.render_next().expect("frame renders")
 }
 

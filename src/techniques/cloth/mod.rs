@@ -156,6 +156,10 @@ impl Technique for Cloth {
         self.pending.push(ClothUniforms::from_params(params, time, state.res));
     }
 
+    fn simulates_on_gpu(&self) -> bool {
+        true
+    }
+
     fn take_messages(&mut self) -> Vec<String> {
         std::mem::take(&mut self.messages)
     }

@@ -1,6 +1,6 @@
 //! Cloth parameters and the uniform block built from them.
 
-use crate::params::{ParamDecl, ParamSet, ParamValue};
+use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 
 /// Solvers, in the order of the `solver` enum parameter.
@@ -76,7 +76,8 @@ pub fn params() -> Vec<ParamDecl> {
         ParamDecl::new("camera_distance", Float(10.0), Some((0.5, 100.0)), "camera distance in front of the cloth")
             .with_unit("m"),
         ParamDecl::new("fov", Float(60.0), Some((5.0, 120.0)), "vertical field of view").with_unit("°"),
-        ParamDecl::trigger("reset", "put the cloth back to its rest pose (R in the window)"),
+        ParamDecl::trigger("reset", "put the cloth back to its rest pose (R in the window)")
+            .with_role(InputRole::Key('r')),
     ]
 }
 

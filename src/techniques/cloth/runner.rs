@@ -42,6 +42,7 @@ impl Runner {
         for _ in 0..frames {
             let time = self.clock.now();
             self.cloth.step(&self.params, &time);
+            self.params.end_step();
             let mut graph = FrameGraph::new((64, 64));
             let out = self.cloth.add_passes(&mut graph, &self.params, &time, &[]);
             graph.set_output(out);
@@ -50,7 +51,6 @@ impl Runner {
                 log::error!("cloth frame: {e}");
             }
             self.gpu.queue.submit([encoder.finish()]);
-            self.params.end_frame();
             self.clock.step();
         }
     }

@@ -7,9 +7,7 @@
 
 pub mod reference;
 
-use std::collections::HashMap;
-
-use crate::gpu::{ComputeKernel, ShaderError};
+use crate::gpu::{BindGroupCache, ComputeKernel, ShaderError};
 use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
@@ -112,7 +110,7 @@ pub struct Kleinian {
     layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     /// Bind groups by output texture id: steady-state frames create none.
-    bind_groups: HashMap<u64, wgpu::BindGroup>,
+    bind_groups: BindGroupCache<u64>,
 }
 
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
@@ -136,7 +134,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let (origin, source) = setup.shader_source("kleinian.wgsl")?;
     let kernel = ComputeKernel::new(device, &origin, &source, "render", &[&layout])?;
     let uniforms = crate::gpu::uniform_buffer::<KleinianUniforms>(device, "kleinian_uniforms");
-    Ok(Box::new(Kleinian { kernel, layout, uniforms, bind_groups: HashMap::new() }))
+    Ok(Box::new(Kleinian { kernel, layout, uniforms, bind_groups: BindGroupCache::default() }))
 }
 
 impl Technique for Kleinian {
@@ -150,14 +148,10 @@ impl Technique for Kleinian {
         let output = graph.create_texture("kleinian/image", TextureDesc::full(OUTPUT_FORMAT));
         let size = graph.texture_size(output);
         let uniforms = KleinianUniforms::from_params(params, time, size);
+        self.bind_groups.begin_frame();
         graph.add_pass("kleinian/limit_set").write(output).record(move |ctx| {
             ctx.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
-            let key = ctx.texture_id(output);
-            // Old entries would keep evicted pool textures alive after resizes.
-            if self.bind_groups.len() > 8 && !self.bind_groups.contains_key(&key) {
-                self.bind_groups.clear();
-            }
-            let bind_group = self.bind_groups.entry(key).or_insert_with(|| {
+            let bind_group = self.bind_groups.get_or_create(ctx.texture_id(output), || {
                 ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("kleinian_bind_group"),
                     layout: &self.layout,

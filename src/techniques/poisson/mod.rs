@@ -8,7 +8,7 @@
 use crate::geometry::poisson::{PoissonDisk, PoissonSettings, Step};
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
-use crate::params::{ParamDecl, ParamSet, ParamValue};
+use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 
 use super::{NodeSetup, Technique, TechniqueInfo};
@@ -39,7 +39,8 @@ pub fn params() -> Vec<ParamDecl> {
         ParamDecl::new("steps_per_step", Int(2), Some((0.0, 100000.0)), "sampler steps per fixed time step"),
         ParamDecl::new("draw_scale", Float(1.0), Some((0.05, 2.0)), "drawn radius = radius × draw_scale / 2"),
         ParamDecl::new("orbit_speed", Float(10.0), Some((-360.0, 360.0)), "3-D camera orbit").with_unit("°/s"),
-        ParamDecl::trigger("restart", "start sampling again from one seed point"),
+        ParamDecl::trigger("restart", "start sampling again from one seed point (R in the window)")
+            .with_role(InputRole::Key('r')),
     ]
 }
 

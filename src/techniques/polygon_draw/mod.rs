@@ -14,7 +14,7 @@ pub(crate) mod gpu;
 use crate::geometry::triangulate::{Mesh2D, Triangulator};
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, TextureHandle};
-use crate::params::{ParamDecl, ParamSet, ParamValue};
+use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 
 use super::{NodeSetup, Technique, TechniqueInfo};
@@ -34,11 +34,14 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 pub fn params() -> Vec<ParamDecl> {
     use ParamValue::*;
     vec![
-        ParamDecl::new("cursor", Vec2([0.5, 0.5]), Some((0.0, 1.0)), "where `add` puts a vertex: view position, y up"),
-        ParamDecl::trigger("add", "append a vertex at the cursor to the polygon being drawn"),
-        ParamDecl::trigger("close", "close the polygon being drawn and re-triangulate everything"),
-        ParamDecl::trigger("undo", "remove the last closed polygon"),
-        ParamDecl::trigger("clear", "remove every polygon"),
+        ParamDecl::new("cursor", Vec2([0.5, 0.5]), Some((0.0, 1.0)), "where `add` puts a vertex: view position, y up")
+            .with_role(InputRole::Pointer),
+        ParamDecl::trigger("add", "append a vertex at the cursor to the polygon being drawn (left click)")
+            .with_role(InputRole::PrimaryClick),
+        ParamDecl::trigger("close", "close the polygon being drawn and re-triangulate everything (right click)")
+            .with_role(InputRole::SecondaryClick),
+        ParamDecl::trigger("undo", "remove the last closed polygon (U in the window)").with_role(InputRole::Key('u')),
+        ParamDecl::trigger("clear", "remove every polygon (C in the window)").with_role(InputRole::Key('c')),
         ParamDecl::choice("start", &["book", "empty"], 0, "start with the book's nested test shapes, or nothing"),
         ParamDecl::new("wireframe", Bool(true), None, "draw the triangle edges over the fill"),
         ParamDecl::new("checker", Int(8), Some((1.0, 64.0)), "checker cells across the UV range"),
@@ -71,6 +74,8 @@ pub struct PolygonDraw {
     started: Option<u32>,
     /// Whether the GPU buffers are behind the polygons.
     dirty: bool,
+    /// Width / height of the output, to map the cursor (view units) to world units.
+    aspect: f32,
     messages: Vec<String>,
 }
 
@@ -83,6 +88,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         mesh: Mesh2D::default(),
         started: None,
         dirty: true,
+        aspect: setup.output_size.0 as f32 / setup.output_size.1.max(1) as f32,
         messages: Vec::new(),
     }))
 }
@@ -110,8 +116,9 @@ impl PolygonDraw {
         self.dirty = true;
     }
 
-    /// Applies this frame's triggers (once per frame, whatever the number of fixed steps).
-    fn apply_triggers(&mut self, params: &ParamSet, aspect: f32) {
+    /// Applies the triggers of one fixed step (each fires for exactly one step).
+    fn apply_triggers(&mut self, params: &ParamSet) {
+        let aspect = self.aspect;
         let start = params.choice("start");
         let mut changed = false;
         if self.started != Some(start) {
@@ -152,6 +159,10 @@ impl PolygonDraw {
 }
 
 impl Technique for PolygonDraw {
+    fn step(&mut self, params: &ParamSet, _time: &FrameTime) {
+        self.apply_triggers(params);
+    }
+
     fn take_messages(&mut self) -> Vec<String> {
         std::mem::take(&mut self.messages)
     }
@@ -164,7 +175,11 @@ impl Technique for PolygonDraw {
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
         let (w, h) = graph.output_size();
-        self.apply_triggers(params, w as f32 / h as f32);
+        self.aspect = w as f32 / h.max(1) as f32;
+        // A frame drawn before any step still shows the start shapes.
+        if self.started.is_none() {
+            self.apply_triggers(params);
+        }
         if std::mem::take(&mut self.dirty) {
             self.gpu.upload(&self.mesh, &self.drawing);
         }

@@ -15,9 +15,8 @@
 mod passes;
 
 use std::cell::RefCell;
-use std::collections::HashMap;
 
-use crate::gpu::{ComputeKernel, ShaderError};
+use crate::gpu::{BindGroupCache, ComputeKernel, ShaderError};
 use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
@@ -146,14 +145,16 @@ pub struct StarGlow {
     sampler: wgpu::Sampler,
     /// One uniform buffer per pass slot of a frame (the most a frame can declare), reused.
     uniforms: Vec<wgpu::Buffer>,
-    /// Bind groups by (slot, texture ids): steady-state frames create none.
-    bind_groups: RefCell<HashMap<(usize, [u64; 4]), wgpu::BindGroup>>,
+    /// Bind groups by (slot, kernel id, texture ids): steady-state frames create none.
+    bind_groups: RefCell<BindGroupCache<(usize, [u64; 4])>>,
 }
 
 /// A pipeline and the layout of its one bind group.
 struct Kernel {
     compute: ComputeKernel,
     layout: wgpu::BindGroupLayout,
+    /// Identifies the kernel in bind-group keys (a slot changes kernels when the layout flips).
+    id: u64,
 }
 
 struct Kernels {
@@ -217,7 +218,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         let layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(&label), entries: &entries });
         let compute = ComputeKernel::new(device, &origin, &source, entry, &[&layout])?;
-        Ok(Kernel { compute, layout })
+        Ok(Kernel { compute, layout, id: crate::graph::next_resource_id() })
     };
     use Binding::*;
     let kernels = Kernels {
@@ -239,7 +240,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     });
     let uniforms =
         (0..MAX_PASSES).map(|_| crate::gpu::uniform_buffer::<StarGlowUniforms>(device, "star_glow_uniforms")).collect();
-    Ok(Box::new(StarGlow { kernels, sampler, uniforms, bind_groups: RefCell::new(HashMap::new()) }))
+    Ok(Box::new(StarGlow { kernels, sampler, uniforms, bind_groups: RefCell::default() }))
 }
 
 impl Technique for StarGlow {
@@ -256,6 +257,7 @@ impl Technique for StarGlow {
             return source;
         }
         let plan = passes::Plan::new(params, Layout::choose(params));
+        self.bind_groups.get_mut().begin_frame();
         let this: &'r StarGlow = self;
         plan.declare(this, graph, source)
     }

@@ -228,19 +228,13 @@ impl StarGlow {
         reads: &[(Binding, TextureHandle)],
         write: (Binding, TextureHandle),
     ) -> wgpu::BindGroup {
-        // The kernel is part of the key: a slot changes kernels when the layout parameter flips.
-        let mut ids = [kernel as *const Kernel as u64, 0, 0, 0];
+        let mut ids = [kernel.id, 0, 0, 0];
         for (i, (_, t)) in reads.iter().chain([&write]).enumerate() {
             ids[i + 1] = ctx.texture_id(*t);
         }
-        let mut cache = self.bind_groups.borrow_mut();
-        // Old entries would keep evicted pool textures alive after resizes.
-        if cache.len() > 4 * super::MAX_PASSES && !cache.contains_key(&(slot, ids)) {
-            cache.clear();
-        }
-        cache
-            .entry((slot, ids))
-            .or_insert_with(|| {
+        self.bind_groups
+            .borrow_mut()
+            .get_or_create((slot, ids), || {
                 let mut entries = vec![
                     wgpu::BindGroupEntry { binding: 0, resource: self.uniforms[slot].as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },

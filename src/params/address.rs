@@ -1,0 +1,148 @@
+//! The parameter address space: where a parameter is (node and parameter index, what control
+//! events carry), what a live source asks of the running scene, and how positions carry over a
+//! hot reload by stable identity (node id and parameter name), so nothing held across a reload —
+//! queued events, a recording, MIDI learn, a replay script — ever points at the wrong parameter
+//! or past the end.
+
+use super::{ParamSet, ParamValue, ParamWrite};
+
+/// A parameter, or one float component of it, of a scene node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Target {
+    /// Node index.
+    pub node: usize,
+    /// Parameter index in the node.
+    pub param: usize,
+    /// Component (`t.x` → 0), if any.
+    pub component: Option<usize>,
+}
+
+/// Values for (node, param) pairs: a preset, or a morph's destination.
+pub type NodeValues = Vec<(usize, usize, ParamValue)>;
+
+/// Something a controller, the UI or a replay asks of the running scene.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ControlEvent {
+    /// Set one parameter (or component).
+    Write(ParamWrite),
+    /// Move to these values over `seconds` (0: at once) — a preset recall.
+    Morph {
+        /// (node, param, value).
+        values: NodeValues,
+        /// Morph duration.
+        seconds: f64,
+    },
+    /// Give every parameter a live source took over back to its track.
+    ResumeTracks,
+}
+
+impl ControlEvent {
+    /// This event for the reloaded scene `remap` leads to: positions moved to where the same
+    /// node id and parameter name now are; writes to parameters that are gone are dropped (None),
+    /// a morph keeps the values that still have a place.
+    pub fn remapped(&self, remap: &Remap) -> Option<ControlEvent> {
+        match self {
+            ControlEvent::Write(w) => {
+                let (node, param) = remap.param(w.node, w.param)?;
+                Some(ControlEvent::Write(ParamWrite { node, param, ..*w }))
+            }
+            ControlEvent::Morph { values, seconds } => Some(ControlEvent::Morph {
+                values: values.iter().filter_map(|&(n, p, v)| remap.param(n, p).map(|(n, p)| (n, p, v))).collect(),
+                seconds: *seconds,
+            }),
+            ControlEvent::ResumeTracks => Some(ControlEvent::ResumeTracks),
+        }
+    }
+}
+
+/// How the parameter positions of one version of a scene map onto the next (a hot reload): by
+/// node id and parameter name, and only where the parameter kept its type.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Remap {
+    /// Old node → old parameter → new (node, parameter), if it still exists.
+    map: Vec<Vec<Option<(usize, usize)>>>,
+}
+
+impl Remap {
+    /// The map from `old` nodes to `new` nodes, each given as (node id, its parameters).
+    pub fn between<'a>(
+        old: impl IntoIterator<Item = (&'a str, &'a ParamSet)>,
+        new: impl IntoIterator<Item = (&'a str, &'a ParamSet)> + Clone,
+    ) -> Self {
+        let map = old
+            .into_iter()
+            .map(|(id, params)| {
+                let moved = new.clone().into_iter().enumerate().find(|(_, (new_id, _))| *new_id == id);
+                params
+                    .decls()
+                    .iter()
+                    .map(|decl| {
+                        let (n, (_, new_params)) = moved?;
+                        let p = new_params.index(&decl.name)?;
+                        (new_params.decls()[p].ty() == decl.ty()).then_some((n, p))
+                    })
+                    .collect()
+            })
+            .collect();
+        Self { map }
+    }
+
+    /// Where parameter `param` of old node `node` is now, if anywhere.
+    pub fn param(&self, node: usize, param: usize) -> Option<(usize, usize)> {
+        *self.map.get(node)?.get(param)?
+    }
+
+    /// Where an old target is now, if anywhere (components keep their index).
+    pub fn target(&self, t: Target) -> Option<Target> {
+        self.param(t.node, t.param).map(|(node, param)| Target { node, param, component: t.component })
+    }
+
+    /// Remaps `events` in order, dropping those whose parameter is gone; returns how many were
+    /// dropped (for one logged notice).
+    pub fn events(&self, events: &mut Vec<ControlEvent>) -> usize {
+        let before = events.len();
+        *events = events.iter().filter_map(|e| e.remapped(self)).collect();
+        before - events.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::{ParamDecl, Source};
+
+    fn set(names: &[&str]) -> ParamSet {
+        ParamSet::new(names.iter().map(|n| ParamDecl::new(n, ParamValue::Float(0.0), None, "")).collect())
+    }
+
+    #[test]
+    fn positions_follow_ids_and_names_and_vanished_ones_drop() {
+        let (a, b) = (set(&["x", "y"]), set(&["z"]));
+        let (b2, a2) = (set(&["z"]), set(&["y", "w"]));
+        // Old: [a, b]; new: [b, a] with a's "x" gone and "y" moved to index 0.
+        let remap = Remap::between([("a", &a), ("b", &b)], [("b", &b2), ("a", &a2)]);
+        assert_eq!(remap.param(0, 0), None);
+        assert_eq!(remap.param(0, 1), Some((1, 0)));
+        assert_eq!(remap.param(1, 0), Some((0, 0)));
+        assert_eq!(remap.param(5, 0), None, "out of range is gone, never a panic");
+        let write = |node, param| {
+            ControlEvent::Write(ParamWrite {
+                node,
+                param,
+                component: None,
+                value: ParamValue::Float(1.0),
+                source: Source::Ui,
+            })
+        };
+        let mut events = vec![write(0, 0), write(0, 1), ControlEvent::ResumeTracks, write(7, 7)];
+        assert_eq!(remap.events(&mut events), 2);
+        assert_eq!(events, [write(1, 0), ControlEvent::ResumeTracks]);
+    }
+
+    #[test]
+    fn a_parameter_that_changed_type_is_not_carried_over() {
+        let old = set(&["x"]);
+        let new = ParamSet::new(vec![ParamDecl::new("x", ParamValue::Int(0), None, "")]);
+        assert_eq!(Remap::between([("n", &old)], [("n", &new)]).param(0, 0), None);
+    }
+}
