@@ -99,6 +99,25 @@ fn a_broken_shader_keeps_the_last_good_image_and_the_fix_applies() {
 }
 
 #[test]
+fn a_shader_edit_that_moves_a_binding_is_a_located_error_and_the_show_goes_on() {
+    let root = sandbox("binding");
+    let (mut r, mut live) = renderer(&root);
+    let before = shown(&mut r);
+    let shader = root.join("shaders/kleinian.wgsl");
+    edit(&shader, "@group(0) @binding(1) var output", "@group(0) @binding(2) var output");
+    let line = std::fs::read_to_string(&shader).unwrap().lines().position(|l| l.contains("var output")).unwrap() + 1;
+    let report = wait_for_reload(&mut r, &mut live);
+    assert_eq!(report.errors.len(), 1, "{report:?}");
+    let e = &report.errors[0];
+    assert!(
+        e.contains(&format!("kleinian.wgsl:{line}:")) && e.contains("'output'") && e.contains("@binding(1)"),
+        "{e}"
+    );
+    assert!(shown(&mut r).rgba == before.rgba, "the last good shader still runs");
+    std::fs::remove_dir_all(root).unwrap();
+}
+
+#[test]
 fn a_broken_scene_keeps_running_and_the_fix_applies() {
     let root = sandbox("scene");
     let (mut r, mut live) = renderer(&root);

@@ -1,6 +1,10 @@
 //! Small constructors for what every technique declares the same way: a uniform block's
-//! bind-group entry and its buffer, and the size naga gives a WGSL struct (to check a
-//! `#[repr(C)]` mirror against).
+//! bind-group entry and its buffer; and checks of the Rust side against the WGSL through naga's
+//! reflection — the size of a struct (to check a `#[repr(C)]` mirror against) and the binding
+//! number of each resource by name (so layouts and shaders cannot drift apart, also when a
+//! performer edits a shader live).
+
+use super::ShaderError;
 
 /// A bind-group layout entry for a uniform block of `T` at `binding`.
 pub fn uniform_entry<T>(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
@@ -33,4 +37,51 @@ pub fn wgsl_struct_size(source: &str, name: &str) -> Option<u32> {
         naga::TypeInner::Struct { span, .. } => Some(*span),
         _ => None,
     })
+}
+
+/// Checks that each `(name, binding)` the Rust side binds in group 0 is a global of that name at
+/// that binding in `source`. The error points at the WGSL declaration and says both numbers.
+pub fn check_bindings(origin: &str, source: &str, expected: &[(&str, u32)]) -> Result<(), ShaderError> {
+    let module = super::validate_wgsl(origin, source)?;
+    for &(name, binding) in expected {
+        let found = module.global_variables.iter().find(|(_, g)| g.name.as_deref() == Some(name));
+        let error = |line, column, message| ShaderError { origin: origin.into(), line, column, message };
+        let Some((handle, global)) = found else {
+            return Err(error(
+                1,
+                1,
+                format!(
+                    "the engine binds '{name}' at @group(0) @binding({binding}), but the shader declares no '{name}'"
+                ),
+            ));
+        };
+        let at = global.binding.as_ref().map(|b| (b.group, b.binding));
+        if at != Some((0, binding)) {
+            let location = module.global_variables.get_span(handle).location(source);
+            let declared = at.map_or("no binding".to_string(), |(g, b)| format!("@group({g}) @binding({b})"));
+            return Err(error(
+                location.line_number,
+                location.line_position,
+                format!("'{name}' is declared at {declared}; the engine binds it at @group(0) @binding({binding})"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SHADER: &str = "@group(0) @binding(0) var<uniform> u: vec4<f32>;\n@group(0) @binding(2) var<storage, read> data: array<f32>;\n@compute @workgroup_size(1) fn main() { _ = u; _ = data[0]; }\n";
+
+    #[test]
+    fn bindings_are_checked_by_name_with_the_declaration_located() {
+        assert!(check_bindings("s.wgsl", SHADER, &[("u", 0), ("data", 2)]).is_ok());
+        let moved = check_bindings("s.wgsl", SHADER, &[("data", 1)]).unwrap_err();
+        assert_eq!(moved.line, 2, "the declaration of data: {moved}");
+        assert!(moved.message.contains("@binding(2)") && moved.message.contains("@binding(1)"), "{moved}");
+        let missing = check_bindings("s.wgsl", SHADER, &[("gone", 3)]).unwrap_err();
+        assert!(missing.message.contains("no 'gone'"), "{missing}");
+    }
 }

@@ -54,6 +54,18 @@ impl<K: Hash + Eq, V> BindGroupCache<K, V> {
     }
 }
 
+/// `cache[&key]`: the entry made for `key` earlier this frame.
+///
+/// # Panics
+/// If none was made: bind groups are made while a frame is planned, before passes bind them.
+impl<K: Hash + Eq, V> std::ops::Index<&K> for BindGroupCache<K, V> {
+    type Output = V;
+
+    fn index(&self, key: &K) -> &V {
+        self.get(key).expect("a bind group is made (get_or_create) before a pass binds it")
+    }
+}
+
 impl<K: Hash + Eq, V> Default for BindGroupCache<K, V> {
     fn default() -> Self {
         Self::new(DEFAULT_MAX_AGE)

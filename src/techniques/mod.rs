@@ -66,14 +66,18 @@ pub struct NodeSetup<'a> {
 }
 
 impl NodeSetup<'_> {
-    /// Loads a shader file's text and origin, turning a missing file into a located error.
-    pub fn shader_source(&self, file: &str) -> Result<(String, String), ShaderError> {
-        self.assets.load(AssetKind::Shader, file).map(|a| (a.origin, a.source)).map_err(|message| ShaderError {
-            origin: file.into(),
-            line: 1,
-            column: 1,
-            message,
-        })
+    /// Loads a shader file's text and origin, turning a missing file into a located error, and
+    /// checks that each `(name, binding)` the technique binds in group 0 is where the WGSL
+    /// declares it (naga reflection): layouts and shaders cannot drift apart, also when a shader
+    /// is edited live — a mismatch is a located error and the last good version keeps running.
+    pub fn shader_source(&self, file: &str, bindings: &[(&str, u32)]) -> Result<(String, String), ShaderError> {
+        let (origin, source) = self
+            .assets
+            .load(AssetKind::Shader, file)
+            .map(|a| (a.origin, a.source))
+            .map_err(|message| ShaderError { origin: file.into(), line: 1, column: 1, message })?;
+        crate::gpu::check_bindings(&origin, &source, bindings)?;
+        Ok((origin, source))
     }
 }
 

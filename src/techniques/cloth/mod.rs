@@ -90,7 +90,9 @@ impl Cloth {
                 storage(5, false),
             ],
         });
-        let (origin, source) = setup.shader_source("cloth.wgsl")?;
+        // Binding order = the order of `State::bind_group`'s entries and of the layout above.
+        let bindings = [("u", 0), ("prev", 1), ("cur", 2), ("next", 3), ("status", 4), ("normals", 5)];
+        let (origin, source) = setup.shader_source("cloth.wgsl", &bindings)?;
         let kernel = |entry| ComputeKernel::new(device, &origin, &source, entry, &[&layout]);
         let kernels = Kernels {
             verlet: kernel("verlet")?,

@@ -95,7 +95,8 @@ impl Renderer {
     /// Builds the four pipelines from `shaders/cloth_render.wgsl`.
     pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
         let device = &setup.gpu.device;
-        let (origin, source) = setup.shader_source("cloth_render.wgsl")?;
+        let (origin, source) =
+            setup.shader_source("cloth_render.wgsl", &[("view", 0), ("positions", 1), ("normals", 2)])?;
         let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
         let storage = |binding| wgpu::BindGroupLayoutEntry {
             binding,
@@ -173,7 +174,7 @@ impl Renderer {
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&view.uniforms));
         let cur = state.cur;
         let (buffer, normals) = (state.particles()[cur].clone(), state.normals.clone());
-        state.draw_groups.entry(cur).or_insert_with(|| {
+        state.draw_groups.get_or_create(cur, || {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("cloth_draw_bind_group"),
                 layout: &self.layout,

@@ -2,12 +2,12 @@
 //! previous / current / scratch (so no step copies), normals, the NaN flag, and the plan of one
 //! frame's dispatches with their bind groups made ahead of time.
 
-use std::collections::HashMap;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 
 use super::ClothUniforms;
 use super::render::Renderer;
+use crate::gpu::BindGroupCache;
 use crate::graph::{BufferHandle, FrameGraph};
 
 /// (uniform slot, previous, current, next): which buffers a simulation dispatch binds.
@@ -99,7 +99,7 @@ pub struct State {
     /// Where the flag is read back.
     pub status_readback: wgpu::Buffer,
     /// Simulation bind groups by key.
-    pub bind_groups: HashMap<Key, wgpu::BindGroup>,
+    pub bind_groups: BindGroupCache<Key>,
     /// The NaN watch.
     pub nan: NanWatch,
     /// Surface triangle indices (particle numbers).
@@ -109,7 +109,7 @@ pub struct State {
     /// Spring line indices and the ranges of the three kinds (made on first debug draw).
     pub lines: Option<(wgpu::Buffer, [std::ops::Range<u32>; 3])>,
     /// Draw bind groups by current-buffer index.
-    pub draw_groups: HashMap<usize, wgpu::BindGroup>,
+    pub draw_groups: BindGroupCache<usize>,
 }
 
 fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
@@ -145,12 +145,12 @@ impl State {
             normals_id: crate::graph::next_resource_id(),
             status,
             status_readback,
-            bind_groups: HashMap::new(),
+            bind_groups: BindGroupCache::default(),
             nan: NanWatch::new(),
             surface_indices,
             surface_count,
             lines: None,
-            draw_groups: HashMap::new(),
+            draw_groups: BindGroupCache::default(),
         }
     }
 
@@ -182,6 +182,8 @@ impl State {
         steps: &[ClothUniforms],
         substeps: u32,
     ) -> Vec<Dispatch> {
+        self.bind_groups.begin_frame();
+        self.draw_groups.begin_frame();
         let mut out = Vec::new();
         for (slot, u) in steps.iter().enumerate() {
             for _ in 0..substeps {
@@ -220,7 +222,7 @@ impl State {
         let (slot, prev, cur, next) = key;
         let particles = &self.particles;
         let (status, normals) = (&self.status, &self.normals);
-        self.bind_groups.entry(key).or_insert_with(|| {
+        self.bind_groups.get_or_create(key, || {
             let entries: Vec<wgpu::BindGroupEntry> = [
                 uniforms[slot].as_entire_binding(),
                 particles[prev].as_entire_binding(),

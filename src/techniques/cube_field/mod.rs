@@ -119,7 +119,7 @@ pub struct CubeField {
 
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let device = &setup.gpu.device;
-    let (origin, source) = setup.shader_source("cube_field.wgsl")?;
+    let (origin, source) = setup.shader_source("cube_field.wgsl", &[("u", 0)])?;
     let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
     let block = crate::gpu::UniformBlock::new::<CubeFieldUniforms>(device, "cube_field_uniforms");
     let pipeline = crate::gpu::validated(device, &origin, || {

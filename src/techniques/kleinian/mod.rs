@@ -113,14 +113,18 @@ pub struct Kleinian {
     bind_groups: BindGroupCache<u64>,
 }
 
+/// Bindings of `shaders/kleinian.wgsl` (checked against the WGSL by name at creation).
+const PARAMS_BINDING: u32 = 0;
+const OUTPUT_BINDING: u32 = 1;
+
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let device = &setup.gpu.device;
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("kleinian_layout"),
         entries: &[
-            crate::gpu::uniform_entry::<KleinianUniforms>(0, wgpu::ShaderStages::COMPUTE),
+            crate::gpu::uniform_entry::<KleinianUniforms>(PARAMS_BINDING, wgpu::ShaderStages::COMPUTE),
             wgpu::BindGroupLayoutEntry {
-                binding: 1,
+                binding: OUTPUT_BINDING,
                 visibility: wgpu::ShaderStages::COMPUTE,
                 ty: wgpu::BindingType::StorageTexture {
                     access: wgpu::StorageTextureAccess::WriteOnly,
@@ -131,7 +135,8 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
             },
         ],
     });
-    let (origin, source) = setup.shader_source("kleinian.wgsl")?;
+    let (origin, source) =
+        setup.shader_source("kleinian.wgsl", &[("params", PARAMS_BINDING), ("output", OUTPUT_BINDING)])?;
     let kernel = ComputeKernel::new(device, &origin, &source, "render", &[&layout])?;
     let uniforms = crate::gpu::uniform_buffer::<KleinianUniforms>(device, "kleinian_uniforms");
     Ok(Box::new(Kleinian { kernel, layout, uniforms, bind_groups: BindGroupCache::default() }))
@@ -156,9 +161,9 @@ impl Technique for Kleinian {
                     label: Some("kleinian_bind_group"),
                     layout: &self.layout,
                     entries: &[
-                        wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: PARAMS_BINDING, resource: self.uniforms.as_entire_binding() },
                         wgpu::BindGroupEntry {
-                            binding: 1,
+                            binding: OUTPUT_BINDING,
                             resource: wgpu::BindingResource::TextureView(ctx.view(output)),
                         },
                     ],

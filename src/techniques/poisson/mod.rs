@@ -162,7 +162,7 @@ const INSTANCE: u64 = size_of::<[f32; 4]>() as u64;
 
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let device = &setup.gpu.device;
-    let (origin, source) = setup.shader_source("poisson.wgsl")?;
+    let (origin, source) = setup.shader_source("poisson.wgsl", &[("u", 0)])?;
     let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
     let block = crate::gpu::UniformBlock::new::<PoissonUniforms>(device, "poisson_uniforms");
     let pipeline = crate::gpu::validated(device, &origin, || {

@@ -72,7 +72,7 @@ impl Renderer {
     /// Builds the three pipelines from `polygon_draw.wgsl`.
     pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
         let device = &setup.gpu.device;
-        let (origin, source) = setup.shader_source("polygon_draw.wgsl")?;
+        let (origin, source) = setup.shader_source("polygon_draw.wgsl", &[("u", 0)])?;
         let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
         let block = UniformBlock::new::<PolygonUniforms>(device, "polygon_draw_uniforms");
         let pipeline = |fragment: &str, topology| {

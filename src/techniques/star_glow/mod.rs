@@ -202,7 +202,11 @@ impl Binding {
 
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let device = &setup.gpu.device;
-    let (origin, source) = setup.shader_source("star_glow.wgsl")?;
+    use Binding::*;
+    let names = [("tex_a", TexA), ("tex_b", TexB), ("dst", Dst), ("src_layers", SrcLayers), ("dst_layers", DstLayers)];
+    let bindings: Vec<(&str, u32)> =
+        [("u", 0), ("linear_clamp", 1)].into_iter().chain(names.map(|(n, b)| (n, b as u32))).collect();
+    let (origin, source) = setup.shader_source("star_glow.wgsl", &bindings)?;
     let kernel = |entry: &str, bindings: &[Binding]| -> Result<Kernel, ShaderError> {
         let mut entries = vec![
             crate::gpu::uniform_entry::<StarGlowUniforms>(0, wgpu::ShaderStages::COMPUTE),
@@ -220,7 +224,6 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         let compute = ComputeKernel::new(device, &origin, &source, entry, &[&layout])?;
         Ok(Kernel { compute, layout, id: crate::graph::next_resource_id() })
     };
-    use Binding::*;
     let kernels = Kernels {
         bright: kernel("bright", &[TexA, Dst])?,
         streak: kernel("streak", &[TexA, Dst])?,
