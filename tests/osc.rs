@@ -306,7 +306,7 @@ fn oscquery_serves_every_parameter_with_type_range_and_value() {
                 other => {
                     let got: Vec<f32> =
                         leaf["VALUE"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap() as f32).collect();
-                    assert_eq!(got, other.components(), "{}", decl.name);
+                    assert_eq!(got, other.components().to_vec(), "{}", decl.name);
                     assert_eq!(leaf["TYPE"].as_str().unwrap().len(), other.components().len());
                 }
             }

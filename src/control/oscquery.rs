@@ -35,7 +35,7 @@ fn value_json(value: &ParamValue, decl: &ParamDecl) -> Value {
         ParamValue::Enum(_) => json!([decl.format(value)]),
         ParamValue::Text(t) => json!([t.as_str()]),
         ParamValue::Trigger(_) => json!([]),
-        other => json!(other.components()),
+        other => json!(&*other.components()),
     }
 }
 

@@ -16,5 +16,5 @@ pub use morph::Morph;
 pub use raw::{RawValue, coerce, raw_from_value, value_from_raw};
 pub use set::ParamSet;
 pub use track::{Interpolation, Key, LoopMode, Track, mix};
-pub use value::{InputRole, ParamDecl, ParamType, ParamValue, Text};
+pub use value::{Components, InputRole, ParamDecl, ParamType, ParamValue, Text};
 pub use write::{ParamWrite, Source};

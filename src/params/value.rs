@@ -164,18 +164,18 @@ impl ParamValue {
         }
     }
 
-    /// All components as floats (bool → 0/1).
-    pub fn components(&self) -> Vec<f32> {
+    /// All components as floats (bool → 0/1), inline: reading a parameter allocates nothing.
+    pub fn components(&self) -> Components {
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
         match *self {
-            ParamValue::Float(x) => vec![x],
-            ParamValue::Int(i) => vec![i as f32],
-            ParamValue::Bool(b) => vec![if b { 1.0 } else { 0.0 }],
-            ParamValue::Vec2(v) => v.to_vec(),
-            ParamValue::Vec3(v) => v.to_vec(),
-            ParamValue::Vec4(v) | ParamValue::Color(v) => v.to_vec(),
-            ParamValue::Enum(i) => vec![i as f32],
-            ParamValue::Trigger(b) => vec![if b { 1.0 } else { 0.0 }],
-            ParamValue::Text(_) => Vec::new(),
+            ParamValue::Float(x) => Components::new(&[x]),
+            ParamValue::Int(i) => Components::new(&[i as f32]),
+            ParamValue::Bool(b) | ParamValue::Trigger(b) => Components::new(&[flag(b)]),
+            ParamValue::Vec2(v) => Components::new(&v),
+            ParamValue::Vec3(v) => Components::new(&v),
+            ParamValue::Vec4(v) | ParamValue::Color(v) => Components::new(&v),
+            ParamValue::Enum(i) => Components::new(&[i as f32]),
+            ParamValue::Text(_) => Components::new(&[]),
         }
     }
 
@@ -222,6 +222,46 @@ impl fmt::Display for ParamValue {
                 write!(f, "({})", parts.join(", "))
             }
         }
+    }
+}
+
+/// The float components of a value (up to four), held inline; derefs to a slice.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Components {
+    values: [f32; 4],
+    len: usize,
+}
+
+impl Components {
+    /// The first (at most four) of `values`.
+    pub fn new(values: &[f32]) -> Self {
+        let len = values.len().min(4);
+        let mut inline = [0.0; 4];
+        inline[..len].copy_from_slice(&values[..len]);
+        Self { values: inline, len }
+    }
+}
+
+impl std::ops::Deref for Components {
+    type Target = [f32];
+
+    fn deref(&self) -> &[f32] {
+        &self.values[..self.len]
+    }
+}
+
+impl IntoIterator for Components {
+    type Item = f32;
+    type IntoIter = std::iter::Take<std::array::IntoIter<f32, 4>>;
+
+    fn into_iter(self) -> Self::IntoIter {
+        self.values.into_iter().take(self.len)
+    }
+}
+
+impl std::ops::DerefMut for Components {
+    fn deref_mut(&mut self) -> &mut [f32] {
+        &mut self.values[..self.len]
     }
 }
 
@@ -366,6 +406,14 @@ mod tests {
         assert_eq!(t.as_str().len(), 62);
         assert_eq!(t.as_str(), "é".repeat(31));
         assert_eq!(ParamValue::Text(Text::new("hi")).to_string(), "\"hi\"");
+    }
+
+    #[test]
+    fn components_are_inline_and_as_long_as_the_type() {
+        let c = ParamValue::Vec3([1.0, 2.0, 3.0]).components();
+        assert_eq!((&*c, c.into_iter().count()), (&[1.0, 2.0, 3.0][..], 3));
+        assert!(ParamValue::Text(Text::new("x")).components().is_empty());
+        assert_eq!(&*ParamValue::Trigger(true).components(), &[1.0]);
     }
 
     #[test]
