@@ -140,6 +140,10 @@ pub struct BenchArgs {
     /// Frames rendered before measuring.
     #[arg(long, default_value_t = 10)]
     pub warmup: u64,
+    /// Seek to this frame first (simulations run every step before it, undrawn), e.g. to
+    /// measure a cloth that has settled rather than one at rest.
+    #[arg(long, default_value_t = 0)]
+    pub start: u64,
     /// Set a parameter (repeatable): node.param=value — 0.5, true, an option name, a vector as
     /// 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
     #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
@@ -315,6 +319,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     let mut renderer =
         OffscreenRenderer::new(device, assets, scene, Some(args.size), None, None).map_err(|e| e.to_string())?;
     renderer.instance_mut().animate = !args.no_animation;
+    renderer.seek(args.start).map_err(|e| e.to_string())?;
     for _ in 0..args.warmup {
         renderer.render_only().map_err(|e| e.to_string())?;
     }
@@ -336,7 +341,14 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     let wall_median = walls.get(walls.len() / 2).copied().unwrap_or(0.0);
     say!("scene      {name}");
     say!("adapter    {adapter}");
-    say!("size       {}x{}   frames {} (+{} warm-up)", args.size.0, args.size.1, args.frames, args.warmup);
+    say!(
+        "size       {}x{}   frames {} (+{} warm-up) from frame {}",
+        args.size.0,
+        args.size.1,
+        args.frames,
+        args.warmup,
+        args.start
+    );
     for s in &args.sets {
         say!("set        {s}");
     }

@@ -150,12 +150,15 @@ fn bench_prints_pass_medians_and_frame_time() {
         "6",
         "--warmup",
         "2",
+        "--start",
+        "30",
         "--set",
         "limit_set.samples=2",
     ]);
     assert!(o.status.success(), "{}", text(&o));
     let t = text(&o);
     assert!(t.contains("frame wall time (median)") && t.contains("set        limit_set.samples=2"), "{t}");
+    assert!(t.contains("from frame 30"), "{t}");
     assert!(t.contains("kleinian/limit_set") || t.contains("wall-clock only"), "{t}");
 }
 
