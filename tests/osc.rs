@@ -236,6 +236,40 @@ fn a_hundred_thousand_hostile_packets_never_panic() {
     assert_eq!(malformed + batches.len() as u64, sent, "every packet is either a batch or counted malformed");
 }
 
+/// `inner` wrapped in `levels` bundles, as raw bytes (built by hand: rosc would recurse).
+fn nested_bundles(inner: &[u8], levels: usize) -> Vec<u8> {
+    let mut packet = inner.to_vec();
+    for _ in 0..levels {
+        let mut outer = b"#bundle\0".to_vec();
+        outer.extend_from_slice(&[0, 0, 0, 0, 0, 0, 0, 1]);
+        outer.extend_from_slice(&(packet.len() as u32).to_be_bytes());
+        outer.extend_from_slice(&packet);
+        packet = outer;
+    }
+    packet
+}
+
+#[test]
+fn crafted_deep_nesting_is_malformed_and_the_show_goes_on() {
+    // The packets that aborted the show: 2,500 nested bundles (≈ 50 KB, the OSC thread's stack)
+    // and 15,000 nested arrays in a message to a real address (the render thread's stack).
+    let k = scene("kleinian");
+    let scale = packet("/indra/limit_set/scale", vec![OscType::Float(3.0)]);
+    let bundles = nested_bundles(&scale, 2_500);
+    assert!(bundles.len() < 65_000, "fits one datagram: {}", bundles.len());
+    let mut arrays = b"/indra/limit_set/scale\0\0,".to_vec();
+    arrays.extend(std::iter::repeat_n(b'[', 15_000).chain(std::iter::repeat_n(b']', 15_000)));
+    arrays.push(0);
+    while !arrays.len().is_multiple_of(4) {
+        arrays.push(0);
+    }
+    let (routed, rx) = send_and_route(&k, &[bundles, arrays, nested_bundles(&scale, 4)]);
+    let [_, _, malformed, ..] = rx.counters().snapshot();
+    assert_eq!(malformed, 2, "both crafted packets are counted as malformed");
+    assert_eq!(routed.len(), 1, "a sane nested bundle still applies");
+    assert_eq!(write_value(&routed[0]), ParamValue::Float(3.0));
+}
+
 #[test]
 fn feedback_sends_changed_values_to_the_controller() {
     let gpu = common::gpu();

@@ -9,6 +9,7 @@ pub mod feedback;
 pub mod hub;
 pub mod midi;
 pub mod osc;
+mod osc_guard;
 pub mod oscquery;
 pub mod presets;
 pub mod record;

@@ -54,6 +54,8 @@ pub struct Batch {
 /// Decodes one UDP payload into batches: a message is a batch; a bundle (with nested bundles
 /// flattened under the outermost time tag that is in the future) is one batch.
 pub fn decode(bytes: &[u8]) -> Result<Vec<Batch>, String> {
+    // Before rosc: its decoder (and dropping or printing what it builds) recurses per level.
+    super::osc_guard::check_nesting(bytes)?;
     let (rest, packet) = rosc::decoder::decode_udp(bytes).map_err(|e| format!("{e:?}"))?;
     if !rest.is_empty() {
         return Err(format!("{} trailing bytes after the packet", rest.len()));
@@ -160,12 +162,45 @@ impl Drop for OscReceiver {
     }
 }
 
+/// Distinct problems logged at most (each once); after that a flood of distinct bad addresses
+/// is only counted, so neither memory nor the log grows with it.
+const MAX_LOGGED_KINDS: usize = 64;
+/// Longest message logged, in characters (addresses and arguments come from the network).
+const MAX_LOGGED_CHARS: usize = 200;
+
 fn log_once(logged: &Mutex<HashSet<String>>, kind: &str, message: &str) {
-    if let Ok(mut seen) = logged.lock()
-        && seen.insert(kind.to_string())
-    {
-        log::warn!("OSC: {message} (further ones are only counted)");
+    let Ok(mut seen) = logged.lock() else { return };
+    if seen.contains(truncate(kind)) || seen.len() > MAX_LOGGED_KINDS {
+        return;
     }
+    if seen.len() == MAX_LOGGED_KINDS {
+        seen.insert(String::new());
+        log::warn!("OSC: {MAX_LOGGED_KINDS} kinds of problems logged; from now on they are only counted");
+        return;
+    }
+    seen.insert(truncate(kind).to_string());
+    log::warn!("OSC: {} (further ones are only counted)", truncate(message));
+}
+
+/// At most [`MAX_LOGGED_CHARS`] characters of `text`, cut at a character boundary.
+fn truncate(text: &str) -> &str {
+    text.char_indices().nth(MAX_LOGGED_CHARS).map_or(text, |(i, _)| &text[..i])
+}
+
+/// The argument types of a message, shallowly (`f, i, [3 values]`): never the nested values.
+fn describe_args(args: &[OscType]) -> String {
+    let one = |a: &OscType| match a {
+        OscType::Array(array) => format!("[{} values]", array.content.len()),
+        OscType::String(s) => format!("{:?}", s.chars().take(20).collect::<String>()),
+        OscType::Blob(b) => format!("blob of {} bytes", b.len()),
+        // The rest hold no nested or unbounded data.
+        other => format!("{other:?}"),
+    };
+    let mut parts: Vec<String> = args.iter().take(8).map(one).collect();
+    if args.len() > 8 {
+        parts.push(format!("… {} more", args.len() - 8));
+    }
+    parts.join(", ")
 }
 
 fn receive_loop(
@@ -261,7 +296,7 @@ impl OscRouter {
             None => {
                 rx.log_once(
                     &format!("args {}", msg.addr),
-                    &format!("{} does not take the arguments {:?}", msg.addr, msg.args),
+                    &format!("{} does not take the arguments ({})", msg.addr, describe_args(&msg.args)),
                 );
                 counters.bad_arguments.fetch_add(1, Ordering::Relaxed)
             }

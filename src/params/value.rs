@@ -203,7 +203,8 @@ impl ParamValue {
         if matches!(self, ParamValue::Bool(_) | ParamValue::Trigger(_) | ParamValue::Text(_)) {
             return *self;
         }
-        let c: Vec<f32> = self.components().iter().map(|x| x.clamp(lo, hi)).collect();
+        // max/min, not clamp: a range that is somehow not finite must never panic the show.
+        let c: Vec<f32> = self.components().iter().map(|x| x.max(lo).min(hi)).collect();
         ParamValue::from_components(self.ty(), &c)
     }
 }

@@ -311,6 +311,10 @@ impl Validator<'_> {
             let key = format!("\"{name}\"");
             match decls.iter_mut().find(|d| &d.name == name) {
                 None => self.error(&[anchor, "ranges", &key], unknown_param(technique, name, &names)),
+                Some(_) if !lo.is_finite() || !hi.is_finite() => self.error(
+                    &[anchor, "ranges", &key],
+                    format!("range of '{name}' must be two finite numbers: ({lo}, {hi})"),
+                ),
                 Some(_) if lo >= hi => {
                     self.error(&[anchor, "ranges", &key], format!("range of '{name}' is empty: ({lo}, {hi})"))
                 }
@@ -522,6 +526,18 @@ mod tests {
         assert!(e.message.contains("float"), "{e}");
         let e = first_error(&GOOD.replace("\"scale\": 2.0", "\"iterations\": 2.5"));
         assert!(e.message.contains("int"), "{e}");
+    }
+
+    #[test]
+    fn a_range_with_nan_or_infinity_is_a_located_error_not_a_panic() {
+        for bad in ["(NaN, 3.0)", "(0.1, inf)", "(-inf, 3.0)"] {
+            let src = GOOD.replace(
+                "params: { \"scale\": 2.0,",
+                &format!("ranges: {{ \"scale\": {bad} }}, params: {{ \"scale\": 2.0,"),
+            );
+            let e = first_error(&src);
+            assert!(e.message.contains("two finite numbers") && e.line > 1, "{bad}: {e}");
+        }
     }
 
     #[test]
