@@ -9,7 +9,7 @@ use indra::gpu::{Gpu, GpuOptions};
 use indra::params::ParamSet;
 use indra::scene::parse_value_override;
 use indra::techniques::Technique;
-use indra::techniques::cloth::runner::{Runner, top_row_strain};
+use indra::techniques::cloth::runner::{runner, top_row_strain};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -36,12 +36,12 @@ fn main() {
     let gpu = Gpu::headless(&GpuOptions::default()).expect("a GPU");
     println!("{} — {res}² {solver}, {substeps} substeps, 60 steps/s", gpu.adapter_label());
     let assets = Assets::new(Some(env!("CARGO_MANIFEST_DIR").into()));
-    let mut runner = Runner::new(gpu, &assets, params, 1.0 / 60.0).expect("cloth builds");
+    let mut runner = runner(gpu, &assets, params, 1.0 / 60.0).expect("cloth builds");
     for second in 1..=seconds {
         runner.run(60);
-        let p = runner.cloth.positions();
+        let p = runner.node.positions();
         let finite = p.iter().all(|q| q.iter().all(|c| c.is_finite()));
-        let resets = runner.cloth.take_messages().len();
+        let resets = runner.node.take_messages().len();
         println!(
             "t = {second:>3} s: top-row strain {:.2}%  finite {finite}  resets {resets}",
             top_row_strain(&p, res, rest) * 100.0

@@ -7,7 +7,7 @@ mod common;
 use indra::params::{ParamSet, ParamValue};
 use indra::scene::{load_scene, parse_value_override};
 use indra::techniques::Technique;
-use indra::techniques::cloth::runner::{Runner, top_row_strain};
+use indra::techniques::cloth::runner::{Runner, runner, top_row_strain};
 use indra::techniques::cloth::{ClothUniforms, reference, rest_pose};
 
 /// A 16×16 cloth (rest 0.1, damping 2) with `settings` applied, stepping `dt` per frame.
@@ -18,7 +18,7 @@ fn rig(settings: &[(&str, &str)], dt: f32) -> Runner {
         params.set_at(i, parse_value_override(value, &params.decls()[i]).unwrap());
     }
     params.snap();
-    Runner::new(common::gpu(), &common::assets(), params, dt).unwrap()
+    runner(common::gpu(), &common::assets(), params, dt).unwrap()
 }
 
 fn set(r: &mut Runner, name: &str, value: ParamValue) {
@@ -37,7 +37,7 @@ fn pinned_particles_never_move_and_nothing_ends_inside_the_sphere() {
     let rest = rest_pose(16, 0.1, 1.0, 0);
     for _ in 0..5 {
         rig.run(20);
-        let p = rig.cloth.positions();
+        let p = rig.node.positions();
         for i in 0..16 {
             assert_eq!(p[i], rest[i], "pinned particle {i} moved");
         }
@@ -55,7 +55,7 @@ fn a_cloth_at_rest_stays_at_rest() {
             rig(&[("gravity", "0,0,0"), ("sphere", "false"), ("wind_strength", "0"), ("solver", solver)], 0.01);
         rig.run(60);
         let rest = rest_pose(16, 0.1, 1.0, 0);
-        for (a, b) in rig.cloth.positions().iter().zip(&rest) {
+        for (a, b) in rig.node.positions().iter().zip(&rest) {
             assert!(distance(*a, *b) < 1e-5, "{solver}: {a:?} drifted from {b:?}");
         }
     }
@@ -65,7 +65,7 @@ fn a_cloth_at_rest_stays_at_rest() {
 fn a_symmetric_setup_stays_symmetric() {
     let mut rig = rig(&[("sphere_center", "0,-0.5,0.4"), ("sphere_travel", "0"), ("sphere_radius", "0.4")], 0.01);
     rig.run(80);
-    let p = rig.cloth.positions();
+    let p = rig.node.positions();
     for j in 0..16 {
         for i in 0..16 {
             let (a, b) = (p[j * 16 + i], p[j * 16 + 15 - i]);
@@ -91,11 +91,11 @@ fn one_gpu_substep_matches_the_cpu_reference() {
         0.005,
     );
     rig.run(10); // springs stretched, particles moving, some against the sphere
-    let (prev, cur) = (rig.cloth.previous_positions(), rig.cloth.positions());
+    let (prev, cur) = (rig.node.previous_positions(), rig.node.positions());
     let u = ClothUniforms::from_params(&rig.params, &rig.time(), 8);
     let expected = reference::verlet_step(&u, &prev, &cur);
     rig.run(1);
-    let got = rig.cloth.positions();
+    let got = rig.node.positions();
     for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
         assert!(distance(*g, *e) < 2e-5, "particle {i}: GPU {g:?} CPU {e:?}");
     }
@@ -107,11 +107,11 @@ fn xpbd_holds_a_heavy_cloth_stiff_where_verlet_stretches() {
     let settings = [("resolution", "32"), ("sphere", "false"), ("substeps", "16"), ("rest_length", "0.05")];
     let mut xpbd = rig(&[settings.as_slice(), &[("solver", "XPBD")]].concat(), 1.0 / 60.0);
     xpbd.run(120);
-    let strain = top_row_strain(&xpbd.cloth.positions(), 32, 0.05);
+    let strain = top_row_strain(&xpbd.node.positions(), 32, 0.05);
     assert!(strain < 0.10, "XPBD top-row strain {strain}");
     let mut verlet = rig(&[settings.as_slice(), &[("solver", "Verlet"), ("stiffness", "2000")]].concat(), 1.0 / 60.0);
     verlet.run(120);
-    let soft = top_row_strain(&verlet.cloth.positions(), 32, 0.05);
+    let soft = top_row_strain(&verlet.node.positions(), 32, 0.05);
     assert!(soft > strain * 2.0, "explicit springs of a stable stiffness stretch more: Verlet {soft} vs XPBD {strain}");
 }
 
@@ -121,20 +121,20 @@ fn a_blow_up_is_detected_and_the_cloth_resets_itself() {
     let mut messages = Vec::new();
     for _ in 0..30 {
         rig.run(1);
-        messages.extend(rig.cloth.take_messages());
+        messages.extend(rig.node.take_messages());
     }
     assert!(messages.iter().any(|m| m.contains("blew up")), "{messages:?}");
-    assert!(rig.cloth.positions().iter().all(|p| p.iter().all(|c| c.is_finite())));
+    assert!(rig.node.positions().iter().all(|p| p.iter().all(|c| c.is_finite())));
 }
 
 #[test]
 fn the_reset_trigger_restores_the_rest_pose() {
     let mut rig = rig(&[], 0.01);
     rig.run(30);
-    assert_ne!(rig.cloth.positions(), rest_pose(16, 0.1, 1.0, 0));
+    assert_ne!(rig.node.positions(), rest_pose(16, 0.1, 1.0, 0));
     set(&mut rig, "reset", ParamValue::Trigger(true));
-    rig.cloth.step(&rig.params, &rig.time());
-    assert_eq!(rig.cloth.positions(), rest_pose(16, 0.1, 1.0, 0));
+    rig.node.step(&rig.params, &rig.time());
+    assert_eq!(rig.node.positions(), rest_pose(16, 0.1, 1.0, 0));
 }
 
 fn golden_frames(scene: &str, frames: &[u64], sets: &[&str]) {

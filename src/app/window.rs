@@ -40,6 +40,8 @@ struct Running {
     ui_events: Vec<crate::scene::ControlEvent>,
     /// Last cursor position over the window, in physical pixels.
     pointer: [f32; 2],
+    /// Whether the left button is held over the scene (drag roles follow the pointer).
+    dragging: bool,
 }
 
 /// The winit handler; creates the window on `resumed`, as winit 0.30 asks.
@@ -160,6 +162,7 @@ impl WindowApp {
             live,
             ui_events: Vec::new(),
             pointer: [0.0, 0.0],
+            dragging: false,
         })
     }
 }
@@ -236,18 +239,30 @@ impl ApplicationHandler for WindowApp {
                     r.ui_events.extend(r.hub.recall(&name, seconds, &scene));
                 }
             }
-            WindowEvent::CursorMoved { position, .. } => r.pointer = [position.x as f32, position.y as f32],
-            // Clicks the panel did not take go to the scene (drawing nodes add/close points).
-            WindowEvent::MouseInput { state: ElementState::Pressed, button, .. } if !consumed => {
+            WindowEvent::CursorMoved { position, .. } => {
+                r.pointer = [position.x as f32, position.y as f32];
+                if r.dragging {
+                    let view = r.view_position();
+                    r.ui_events.extend(r.player.instance().pointer_moved(view, crate::params::Source::Ui));
+                }
+            }
+            // Clicks the panel did not take go to the scene (drawing nodes add/close points,
+            // fluids are stirred while the left button is held).
+            WindowEvent::MouseInput { state, button, .. } if !consumed || state == ElementState::Released => {
+                let view = r.view_position();
+                let source = crate::params::Source::Ui;
+                let pressed = state == ElementState::Pressed;
+                if button == winit::event::MouseButton::Left && r.dragging != pressed {
+                    r.dragging = pressed;
+                    r.ui_events.extend(r.player.instance().drag(view, pressed, source));
+                }
                 let primary = match button {
                     winit::event::MouseButton::Left => Some(true),
                     winit::event::MouseButton::Right => Some(false),
                     _ => None,
                 };
-                if let Some(primary) = primary {
-                    let (w, h) = (r.config.width.max(1) as f32, r.config.height.max(1) as f32);
-                    let view = [r.pointer[0] / w, 1.0 - r.pointer[1] / h];
-                    r.ui_events.extend(r.player.instance().pointer(view, primary, crate::params::Source::Ui));
+                if let Some(primary) = primary.filter(|_| pressed) {
+                    r.ui_events.extend(r.player.instance().pointer(view, primary, source));
                 }
             }
             WindowEvent::RedrawRequested => {
@@ -260,6 +275,12 @@ impl ApplicationHandler for WindowApp {
 }
 
 impl Running {
+    /// The pointer in view units (0–1, y up), as pointer parameters take it.
+    fn view_position(&self) -> [f32; 2] {
+        let (w, h) = (self.config.width.max(1) as f32, self.config.height.max(1) as f32);
+        [self.pointer[0] / w, 1.0 - self.pointer[1] / h]
+    }
+
     /// Steps the clock by real time, renders the scene and the overlay, presents.
     fn frame(&mut self) {
         let now = Instant::now();

@@ -17,5 +17,5 @@ pub use cache::{BindGroupCache, DEFAULT_MAX_AGE};
 pub use compute::ComputeKernel;
 pub use context::{BackendChoice, Gpu, GpuError, GpuOptions, instance_descriptor};
 pub use raster::{GrowableBuffer, RasterDesc, UniformBlock, raster_pipeline};
-pub use readback::{ReadbackError, read_texture_bytes, read_texture_rgba8};
+pub use readback::{ReadbackError, read_buffer, read_texture_bytes, read_texture_rgba8};
 pub use shader::{ShaderError, compile_wgsl, validate_wgsl, validated};

@@ -41,6 +41,37 @@ pub fn read_texture_bytes(
         texture.size(),
     );
     queue.submit([encoder.finish()]);
+    let mapped = map_read(device, &buffer)?;
+    let mut out = Vec::with_capacity((tight * height) as usize);
+    for row in mapped.chunks(padded as usize) {
+        out.extend_from_slice(&row[..tight as usize]);
+    }
+    Ok(out)
+}
+
+/// Reads `size` bytes of `buffer` from `offset` (it needs COPY_SRC). Blocks until the GPU is
+/// done; for tests and tools.
+pub fn read_buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    offset: u64,
+    size: u64,
+) -> Result<Vec<u8>, ReadbackError> {
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback_staging"),
+        size,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback_copy") });
+    encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
+    queue.submit([encoder.finish()]);
+    Ok(map_read(device, &staging)?.to_vec())
+}
+
+/// Maps a MAP_READ buffer after the submitted work that fills it, or says the device is lost.
+fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<wgpu::BufferView, ReadbackError> {
     let slice = buffer.slice(..);
     let (sender, mapped) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| drop(sender.send(r)));
@@ -50,12 +81,7 @@ pub fn read_texture_bytes(
         Ok(Err(e)) => return Err(ReadbackError(e.to_string())),
         Err(_) => return Err(ReadbackError("the mapping never completed".into())),
     }
-    let mapped = slice.get_mapped_range().map_err(|e| ReadbackError(e.to_string()))?;
-    let mut out = Vec::with_capacity((tight * height) as usize);
-    for row in mapped.chunks(padded as usize) {
-        out.extend_from_slice(&row[..tight as usize]);
-    }
-    Ok(out)
+    slice.get_mapped_range().map_err(|e| ReadbackError(e.to_string()))
 }
 
 /// Reads an `Rgba8Unorm` (or `Bgra8Unorm`, returned as stored) texture into tightly packed rows.

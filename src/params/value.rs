@@ -301,6 +301,9 @@ pub enum InputRole {
     SecondaryClick,
     /// A trigger fired by a key (a lower-case letter; the key works with or without shift).
     Key(char),
+    /// A bool that is true while the primary button is held; the pointer parameters follow the
+    /// mouse while it is (stirring a fluid, painting).
+    Drag,
 }
 
 impl ParamDecl {

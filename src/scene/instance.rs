@@ -251,6 +251,33 @@ impl SceneInstance {
         events
     }
 
+    /// Writes for the primary button going down (`held`) or up: every [`InputRole::Drag`] bool
+    /// follows it, and pointer parameters get `position`.
+    pub fn drag(&self, position: [f32; 2], held: bool, source: Source) -> Vec<ControlEvent> {
+        let mut events = self.pointer_moved(position, source);
+        events.extend(self.writes_for(source, |role| (role == InputRole::Drag).then_some(ParamValue::Bool(held))));
+        events
+    }
+
+    /// Writes for the pointer moving while the primary button is held: pointer parameters of
+    /// nodes that declare a [`InputRole::Drag`] follow it (a drawing's cursor does not move
+    /// without a click).
+    pub fn pointer_moved(&self, position: [f32; 2], source: Source) -> Vec<ControlEvent> {
+        let mut events = Vec::new();
+        for (node, params) in self.params.iter().enumerate() {
+            if !params.decls().iter().any(|d| d.role == Some(InputRole::Drag)) {
+                continue;
+            }
+            for (param, decl) in params.decls().iter().enumerate() {
+                if decl.role == Some(InputRole::Pointer) {
+                    let value = ParamValue::Vec2(position);
+                    events.push(ControlEvent::Write(ParamWrite { node, param, component: None, value, source }));
+                }
+            }
+        }
+        events
+    }
+
     /// A write of `value(role)` to every parameter whose declared role gives a value.
     fn writes_for(&self, source: Source, value: impl Fn(InputRole) -> Option<ParamValue>) -> Vec<ControlEvent> {
         let mut events = Vec::new();

@@ -7,9 +7,11 @@
 
 pub mod cloth;
 pub mod cube_field;
+pub mod grid_fluid;
 pub mod kleinian;
 pub mod poisson;
 pub mod polygon_draw;
+pub mod runner;
 pub mod star_glow;
 pub mod text_mesh;
 
@@ -28,6 +30,7 @@ pub const REGISTRY: &[TechniqueInfo] = &[
     poisson::INFO,
     polygon_draw::INFO,
     text_mesh::INFO,
+    grid_fluid::INFO,
 ];
 
 /// Finds a technique by the name scenes use.

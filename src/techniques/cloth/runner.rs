@@ -1,59 +1,17 @@
-//! Driving one cloth node headless, step by step, the way the runtime does (step, add passes,
-//! execute, submit) — for tests and measurement tools that need the particle positions.
+//! A cloth node driven headless (see [`crate::techniques::runner`]) and the strain measure the
+//! tests and `examples/cloth_strain` read from it.
 
 use super::Cloth;
-use crate::gpu::Gpu;
-use crate::graph::{FrameGraph, GraphRuntime};
+use crate::gpu::{Gpu, ShaderError};
 use crate::params::ParamSet;
-use crate::techniques::{NodeSetup, Technique};
-use crate::time::{FixedClock, FrameTime};
+use crate::techniques::runner::NodeRunner;
 
 /// A cloth node with its own graph runtime and clock.
-pub struct Runner {
-    gpu: Gpu,
-    /// The node.
-    pub cloth: Cloth,
-    /// Its parameters (change them between frames).
-    pub params: ParamSet,
-    runtime: GraphRuntime,
-    clock: FixedClock,
-}
+pub type Runner = NodeRunner<Cloth>;
 
-impl Runner {
-    /// A runner for `params` on `gpu`, stepping `dt` seconds per frame.
-    pub fn new(
-        gpu: Gpu,
-        assets: &crate::assets::Assets,
-        params: ParamSet,
-        dt: f32,
-    ) -> Result<Self, crate::gpu::ShaderError> {
-        let cloth = Cloth::new(&NodeSetup { gpu: &gpu, assets, id: "cloth", output_size: (64, 64) })?;
-        let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
-        Ok(Self { gpu, cloth, params, runtime, clock: FixedClock::new(dt, 1) })
-    }
-
-    /// The time of the next frame.
-    pub fn time(&self) -> FrameTime {
-        self.clock.now()
-    }
-
-    /// Runs `frames` fixed steps, each recorded and submitted like a frame (64×64 image).
-    pub fn run(&mut self, frames: u32) {
-        for _ in 0..frames {
-            let time = self.clock.now();
-            self.cloth.step(&self.params, &time);
-            self.params.end_step();
-            let mut graph = FrameGraph::new((64, 64));
-            let out = self.cloth.add_passes(&mut graph, &self.params, &time, &[]);
-            graph.set_output(out);
-            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-            if let Err(e) = self.runtime.execute(&self.gpu.device, &self.gpu.queue, graph, &mut encoder) {
-                log::error!("cloth frame: {e}");
-            }
-            self.gpu.queue.submit([encoder.finish()]);
-            self.clock.step();
-        }
-    }
+/// A runner for `params` on `gpu`, stepping `dt` seconds per frame.
+pub fn runner(gpu: Gpu, assets: &crate::assets::Assets, params: ParamSet, dt: f32) -> Result<Runner, ShaderError> {
+    NodeRunner::new(gpu, assets, params, dt, Cloth::new)
 }
 
 /// The largest strain of the vertical structural springs hanging from the top row.

@@ -1,0 +1,336 @@
+//! A 2-D grid fluid (stable fluids, Stam 1999) stirred by a cursor: the displacement source of
+//! chapter 6, whose output texture any node can read (the tessellated surface takes it as its
+//! height). The cursor and the `drag` gate are ordinary parameters, so the window's mouse, a
+//! TouchOSC XY pad, MIDI, presets and recordings stir it the same way.
+//!
+//! Per fixed step, as the book's sample orders it: velocity (add the cursor's splat, diffuse,
+//! project, self-advect, project), then density (add, diffuse, advect, dissipate). Diffusion and
+//! pressure are Jacobi iterations between two slots; the walls are a closed, no-slip box.
+//! Fixes of the sample's solver (seed-reference §9 item 22) are listed in the shader.
+//!
+//! Units: the box is N cells wide; velocities are in cells per second; `viscosity` and `diffusion`
+//! keep the sample's numbers (100, 10) in units of 1e-5 box² per second, so that a = dt·ν·N²·1e-5
+//! (the sample's a = dt·ν·N² made diffusion pure neighbour averaging).
+//!
+//! Book: [UGP4 ch.6] (sakota), the displacement source; [UGP1] grid fluid. Shader:
+//! `shaders/grid_fluid.wgsl`.
+
+mod plan;
+
+pub use plan::{Field, FluidDispatch, Kernel, Planned, step_dispatches};
+
+use std::cell::RefCell;
+
+use crate::gpu::{BindGroupCache, ComputeKernel, ShaderError};
+use crate::graph::{Extent, FrameGraph, TextureDesc, TextureHandle};
+use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
+use crate::time::FrameTime;
+
+use super::{NodeSetup, Technique, TechniqueInfo};
+
+/// The registry entry.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "grid_fluid",
+    chapter: "6: Tessellation & Displacement (displacement source)",
+    summary: "a 2-D stable-fluids grid stirred by a cursor; its density is a height map",
+    params,
+    inputs: &[],
+    shaders: &["grid_fluid.wgsl"],
+    create,
+};
+
+/// The output format (density in R, G and B).
+pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// Parameters with the sample's defaults (seed-reference §6).
+pub fn params() -> Vec<ParamDecl> {
+    use ParamValue::*;
+    vec![
+        ParamDecl::new("resolution", Int(256), Some((16.0, 1024.0)), "grid cells per side (restarts the fluid)"),
+        ParamDecl::new("cursor", Vec2([0.5, 0.5]), Some((0.0, 1.0)), "where the fluid is stirred: box position, y up")
+            .with_role(InputRole::Pointer),
+        ParamDecl::new("drag", Bool(false), None, "stir while true (the left mouse button in the window)")
+            .with_role(InputRole::Drag),
+        ParamDecl::new("viscosity", Float(100.0), Some((0.0, 5000.0)), "velocity diffusion, 1e-5 box²/s"),
+        ParamDecl::new("diffusion", Float(10.0), Some((0.0, 5000.0)), "density diffusion, 1e-5 box²/s"),
+        ParamDecl::new("velocity_coef", Float(4.0), Some((0.0, 50.0)), "how strongly cursor motion pushes the fluid"),
+        ParamDecl::new("density_coef", Float(6.0), Some((0.0, 100.0)), "density added per second under the cursor"),
+        ParamDecl::new("radius", Float(0.072), Some((0.005, 0.5)), "source radius, box units"),
+        ParamDecl::new("sweeps", Int(2), Some((1.0, 64.0)), "Jacobi sweeps of the diffusion solves"),
+        ParamDecl::new("pressure_iterations", Int(40), Some((1.0, 400.0)), "Jacobi iterations of the pressure solve"),
+        ParamDecl::new("dissipation", Float(0.1), Some((0.0, 10.0)), "density lost per second (0: none)"),
+        ParamDecl::trigger("reset", "clear the fluid (R in the window)").with_role(InputRole::Key('r')),
+    ]
+}
+
+/// The kernels (one pipeline per entry point) and their two layouts.
+struct Kernels {
+    by_kind: Vec<ComputeKernel>,
+    /// Dispatch uniforms + fields.
+    simulate: wgpu::BindGroupLayout,
+    /// The same + the output image.
+    image: wgpu::BindGroupLayout,
+}
+
+/// A grid fluid node.
+pub struct GridFluid {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    kernels: Kernels,
+    /// All fields, N² floats each (see [`Field`]); imported into the graph each frame.
+    fields: Option<(wgpu::Buffer, u64, u32)>,
+    /// One 256-byte uniform block per dispatch of the frame, bound at a dynamic offset.
+    uniforms: wgpu::Buffer,
+    /// Bind groups by (fields id, output texture id or 0, uniform buffer size).
+    bind_groups: RefCell<BindGroupCache<(u64, u64, u64)>>,
+    /// Dispatches queued by `step`, recorded by the next `add_passes`.
+    pending: Vec<Planned>,
+    /// The cursor at the previous step, while dragging (its motion is the velocity impulse).
+    last_cursor: Option<[f32; 2]>,
+}
+
+/// Bytes between uniform blocks (wgpu's minimum uniform offset alignment).
+const BLOCK: u64 = 256;
+
+fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
+    Ok(Box::new(GridFluid::new(setup)?))
+}
+
+impl GridFluid {
+    /// Builds the pipelines; the fields are made on the first step, at the resolution asked for.
+    pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
+        let device = &setup.gpu.device;
+        let uniform = wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: wgpu::BufferSize::new(size_of::<FluidDispatch>() as u64),
+            },
+            count: None,
+        };
+        let fields = wgpu::BindGroupLayoutEntry {
+            binding: 1,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let output = wgpu::BindGroupLayoutEntry {
+            binding: 2,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format: FORMAT,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
+            count: None,
+        };
+        // The simulation kernels never touch the image: they bind no texture, so a simulation-only
+        // frame (a seek) needs none.
+        let simulate = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("grid_fluid_simulate_layout"),
+            entries: &[uniform, fields],
+        });
+        let image = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("grid_fluid_output_layout"),
+            entries: &[uniform, fields, output],
+        });
+        let (origin, source) = setup.shader_source("grid_fluid.wgsl", &[("d", 0), ("fields", 1), ("output", 2)])?;
+        let by_kind = Kernel::ALL
+            .iter()
+            .map(|k| {
+                let layout = if *k == Kernel::WriteOutput { &image } else { &simulate };
+                ComputeKernel::new(device, &origin, &source, k.entry(), &[layout])
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Self {
+            device: device.clone(),
+            queue: setup.gpu.queue.clone(),
+            kernels: Kernels { by_kind, simulate, image },
+            fields: None,
+            uniforms: uniform_blocks(device, 512),
+            bind_groups: RefCell::default(),
+            pending: Vec::new(),
+            last_cursor: None,
+        })
+    }
+
+    /// The grid side the fields were made for (0 before the first step).
+    pub fn resolution(&self) -> u32 {
+        self.fields.as_ref().map_or(0, |f| f.2)
+    }
+
+    /// Reads one field back (N² floats, row 0 at the bottom; blocking, for tests and tools).
+    pub fn read_field(&self, field: Field) -> Vec<f32> {
+        let Some((buffer, _, n)) = &self.fields else { return Vec::new() };
+        let bytes = u64::from(*n) * u64::from(*n) * 4;
+        crate::gpu::read_buffer(&self.device, &self.queue, buffer, field as u64 * bytes, bytes)
+            .map(|b| bytemuck::cast_slice(&b).to_vec())
+            .unwrap_or_default()
+    }
+
+    /// Writes one field (N² floats; for tests that start from a known state).
+    pub fn write_field(&self, field: Field, values: &[f32]) {
+        if let Some((buffer, _, n)) = &self.fields {
+            let bytes = u64::from(*n) * u64::from(*n) * 4;
+            self.queue.write_buffer(buffer, field as u64 * bytes, bytemuck::cast_slice(values));
+        }
+    }
+
+    /// (Re)creates zeroed fields if the resolution changed or a reset was asked for.
+    fn ensure_fields(&mut self, params: &ParamSet) {
+        let n = params.int("resolution").clamp(16, 1024) as u32;
+        if self.resolution() == n && !params.fired("reset") {
+            return;
+        }
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("grid_fluid_fields"),
+            size: u64::from(n) * u64::from(n) * 4 * Field::COUNT as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.fields = Some((buffer, crate::graph::next_resource_id(), n));
+        self.pending.clear();
+        self.last_cursor = None;
+    }
+}
+
+/// A uniform buffer of `blocks` dispatch blocks.
+fn uniform_blocks(device: &wgpu::Device, blocks: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("grid_fluid_dispatches"),
+        size: blocks * BLOCK,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+impl Technique for GridFluid {
+    fn simulates_on_gpu(&self) -> bool {
+        true
+    }
+
+    fn step(&mut self, params: &ParamSet, time: &FrameTime) {
+        self.ensure_fields(params);
+        let n = self.resolution();
+        let cursor = params.vec2("cursor");
+        let dragging = params.bool("drag");
+        // The cursor's motion since the last step, only while dragging (a press does not jump).
+        let motion = match (dragging, self.last_cursor) {
+            (true, Some(last)) => [cursor[0] - last[0], cursor[1] - last[1]],
+            _ => [0.0, 0.0],
+        };
+        self.last_cursor = dragging.then_some(cursor);
+        self.pending.extend(step_dispatches(n, params, time.dt, dragging.then_some((cursor, motion))));
+    }
+
+    fn add_passes<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        params: &ParamSet,
+        _time: &FrameTime,
+        _inputs: &[TextureHandle],
+    ) -> TextureHandle {
+        self.ensure_fields(params);
+        let n = self.resolution();
+        let mut dispatches = std::mem::take(&mut self.pending);
+        dispatches.push(FluidDispatch::output(n));
+        let blocks = dispatches.len() as u64;
+        if self.uniforms.size() < blocks * BLOCK {
+            self.uniforms = uniform_blocks(&self.device, blocks.next_power_of_two());
+        }
+        let mut bytes = vec![0u8; (blocks * BLOCK) as usize];
+        for (i, d) in dispatches.iter().enumerate() {
+            let at = i * BLOCK as usize;
+            bytes[at..at + size_of::<FluidDispatch>()].copy_from_slice(bytemuck::bytes_of(&d.1));
+        }
+        self.queue.write_buffer(&self.uniforms, 0, &bytes);
+        self.bind_groups.get_mut().begin_frame();
+
+        let this: &'r GridFluid = self;
+        let (buffer, buffer_id, _) = this.fields.as_ref().expect("ensured");
+        let fields = graph.import_buffer("grid_fluid/fields", buffer, *buffer_id);
+        let output = graph.create_texture(
+            "grid_fluid/density",
+            TextureDesc { extent: Extent::Absolute(n, n), format: FORMAT, layers: None },
+        );
+        let (simulate, last) = dispatches.split_at(dispatches.len() - 1);
+        let (simulate, last) = (simulate.to_vec(), last[0]);
+        let steps = simulate.len() as u32;
+        graph.add_pass("grid_fluid/simulate").write_buffer(fields).record(move |ctx| {
+            let group = this.bind_group(ctx, fields, None);
+            let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("grid_fluid/simulate"),
+                timestamp_writes: None,
+            });
+            for (i, d) in simulate.iter().enumerate() {
+                this.dispatch(&mut pass, &group, i as u32, d.0, n);
+            }
+        });
+        graph.add_pass("grid_fluid/output").read_buffer(fields).write(output).record(move |ctx| {
+            let group = this.bind_group(ctx, fields, Some(output));
+            let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("grid_fluid/output"),
+                timestamp_writes: None,
+            });
+            this.dispatch(&mut pass, &group, steps, last.0, n);
+        });
+        output
+    }
+}
+
+impl GridFluid {
+    /// The bind group of the dispatch uniforms and the fields, and of `output` if given.
+    fn bind_group(
+        &self,
+        ctx: &crate::graph::PassContext<'_>,
+        fields: crate::graph::BufferHandle,
+        output: Option<TextureHandle>,
+    ) -> wgpu::BindGroup {
+        let key = (ctx.buffer_id(fields), output.map_or(0, |t| ctx.texture_id(t)), self.uniforms.size());
+        let mut cache = self.bind_groups.borrow_mut();
+        cache
+            .get_or_create(key, || {
+                let mut entries = vec![
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &self.uniforms,
+                            offset: 0,
+                            size: wgpu::BufferSize::new(size_of::<FluidDispatch>() as u64),
+                        }),
+                    },
+                    wgpu::BindGroupEntry { binding: 1, resource: ctx.buffer(fields).as_entire_binding() },
+                ];
+                if let Some(t) = output {
+                    entries.push(wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(ctx.view(t)),
+                    });
+                }
+                let layout = if output.is_some() { &self.kernels.image } else { &self.kernels.simulate };
+                self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("grid_fluid_bind_group"),
+                    layout,
+                    entries: &entries,
+                })
+            })
+            .clone()
+    }
+
+    fn dispatch(&self, pass: &mut wgpu::ComputePass<'_>, group: &wgpu::BindGroup, block: u32, kernel: Kernel, n: u32) {
+        let k = &self.kernels.by_kind[kernel as usize];
+        pass.set_pipeline(&k.pipeline);
+        pass.set_bind_group(0, group, &[block * BLOCK as u32]);
+        let [x, y, z] = k.workgroups([n, n, 1]);
+        pass.dispatch_workgroups(x, y, z);
+    }
+}
+
+#[cfg(test)]
+mod tests;
