@@ -375,6 +375,9 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         say!("(this adapter has no TIMESTAMP_QUERY_INSIDE_ENCODERS: wall-clock only)");
     }
     say!("{:<28} {:>9.3} ms  ({:.1} fps)", "frame wall time (median)", wall_median, 1e3 / wall_median.max(1e-9));
+    for line in renderer.instance_mut().bench_reports() {
+        say!("node       {line}");
+    }
     if let Some(s) = stats {
         say!(
             "graph      passes {}/{} executed, transient {} KiB requested / {} KiB allocated, compile {:.1} µs",

@@ -222,6 +222,16 @@ impl SceneInstance {
         Ok(remap)
     }
 
+    /// Every node's figures for `indra bench`, prefixed by node id.
+    pub fn bench_reports(&mut self) -> Vec<String> {
+        let ids = self.scene.nodes.iter().map(|n| n.id.as_str());
+        self.nodes
+            .iter_mut()
+            .zip(ids)
+            .flat_map(|(n, id)| n.bench_report().into_iter().map(move |r| format!("{id}: {r}")))
+            .collect()
+    }
+
     /// What the techniques want the performer to know since the last call, prefixed by node id.
     pub fn take_messages(&mut self) -> Vec<String> {
         let ids = self.scene.nodes.iter().map(|n| n.id.as_str());

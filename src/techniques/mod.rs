@@ -8,11 +8,13 @@
 pub mod cloth;
 pub mod cube_field;
 pub mod grid_fluid;
+pub mod height_image;
 pub mod kleinian;
 pub mod poisson;
 pub mod polygon_draw;
 pub mod runner;
 pub mod star_glow;
+pub mod tessellation;
 pub mod text_mesh;
 
 use crate::assets::{AssetKind, Assets};
@@ -31,6 +33,8 @@ pub const REGISTRY: &[TechniqueInfo] = &[
     polygon_draw::INFO,
     text_mesh::INFO,
     grid_fluid::INFO,
+    tessellation::INFO,
+    height_image::INFO,
 ];
 
 /// Finds a technique by the name scenes use.
@@ -94,6 +98,12 @@ pub trait Technique {
     /// frame N is the same bytes played or sought. CPU state advanced in `step` needs nothing.
     fn simulates_on_gpu(&self) -> bool {
         false
+    }
+
+    /// Figures for `indra bench` to print after measuring (e.g. triangles generated). May read
+    /// back from the GPU: never called in the frame loop.
+    fn bench_report(&mut self) -> Vec<String> {
+        Vec::new()
     }
 
     /// Things to tell the performer since the last call (e.g. "the cloth blew up and was reset").

@@ -1,0 +1,508 @@
+//! Chapter 6: tessellation and displacement. wgpu has no hull or domain stage, so the book's
+//! pipeline is rebuilt from compute and an indirect draw: per-edge factors with the book's
+//! edge-length formula and culling, a level per patch, a GPU prefix sum, and a vertex shader that
+//! evaluates the refined lattice, displaced by any texture of the frame graph (the grid fluid, an
+//! image, the Kleinian limit set). Edges shared by two patches are subdivided once, and boundary
+//! points are placed from the edge's own integers, so displaced neighbours never open a crack.
+//!
+//! Fixes of the sample (seed-reference §9 items 20–24): outward or inward displacement is a
+//! parameter; normals come from the height field's gradient (the flat normal is wrong once
+//! displaced); the height is sampled with filtering in the plane's own UV.
+//!
+//! Integer spacing: levels change by whole steps (no geomorphing yet).
+//!
+//! Book: [UGP4 ch.6] "Tessellation & Displacement" (sakota). Shader: `shaders/tessellation.wgsl`.
+
+mod params;
+pub mod reference;
+
+pub use params::{CHANNELS, PLANE_SIZE, TessUniforms, VIEWS, camera, edge_count, frustum_planes, model, params};
+
+use std::cell::RefCell;
+
+use crate::gpu::{BindGroupCache, ComputeKernel, ShaderError};
+use crate::graph::{BufferHandle, FrameGraph, PassContext, TextureDesc, TextureHandle};
+use crate::params::ParamSet;
+use crate::time::FrameTime;
+
+use super::{NodeSetup, Technique, TechniqueInfo};
+
+/// The registry entry.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "tessellation",
+    chapter: "6: Tessellation & Displacement",
+    summary: "a plane tessellated on the GPU by screen-space edge length and displaced by an input texture",
+    params,
+    inputs: &["height"],
+    shaders: &["tessellation.wgsl"],
+    create,
+};
+
+/// The colour format.
+pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Samples per pixel of the surface (resolved before anything downstream sees it).
+pub const MSAA: u32 = 4;
+
+/// The per-frame buffers for one grid size.
+struct Buffers {
+    grid: u32,
+    factors: (wgpu::Buffer, u64),
+    levels: (wgpu::Buffer, u64),
+    offsets: (wgpu::Buffer, u64),
+    /// Indirect draw arguments, then the triangle total.
+    args: (wgpu::Buffer, u64),
+    compute_group: wgpu::BindGroup,
+}
+
+/// Multisampled colour and depth targets for one output size.
+struct Targets {
+    size: (u32, u32),
+    color: wgpu::TextureView,
+    depth: wgpu::TextureView,
+}
+
+/// A tessellation node.
+pub struct Tessellation {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    uniforms: wgpu::Buffer,
+    /// The uniforms alone (group 0 of the draw and of the boundary test).
+    uniform_group: wgpu::BindGroup,
+    compute_layout: wgpu::BindGroupLayout,
+    draw_layout: wgpu::BindGroupLayout,
+    boundary_layout: wgpu::BindGroupLayout,
+    edges: ComputeKernel,
+    patches: ComputeKernel,
+    scan: ComputeKernel,
+    boundaries: ComputeKernel,
+    draw: wgpu::RenderPipeline,
+    sampler: wgpu::Sampler,
+    buffers: Option<Buffers>,
+    targets: Option<Targets>,
+    /// Draw bind groups by height texture id.
+    draw_groups: RefCell<BindGroupCache<u64>>,
+    /// The last frame's uniforms (tests compare against the CPU reference with them).
+    last: Option<TessUniforms>,
+}
+
+fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
+    Ok(Box::new(Tessellation::new(setup)?))
+}
+
+fn storage(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl Tessellation {
+    /// Builds the pipelines; buffers follow the grid size, targets the output size.
+    pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
+        let device = &setup.gpu.device;
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let all = compute | wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let compute_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("tessellation_compute_layout"),
+            entries: &[
+                crate::gpu::uniform_entry::<TessUniforms>(0, all),
+                storage(1, compute, false),
+                storage(2, compute, false),
+                storage(3, compute, false),
+                storage(4, compute, false),
+            ],
+        });
+        // What the draw (and the boundary test) bind in group 0: the uniforms alone, since the
+        // same buffers are bound read-only in group 1 (read-write and read-only may not meet).
+        let uniform_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("tessellation_uniform_layout"),
+            entries: &[crate::gpu::uniform_entry::<TessUniforms>(0, all)],
+        });
+        let read = wgpu::ShaderStages::VERTEX | compute;
+        let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("tessellation_draw_layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: read,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: read,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+                storage(2, read, true),
+                storage(3, read, true),
+                storage(4, read, true),
+            ],
+        });
+        let boundary_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("tessellation_boundary_layout"),
+            entries: &[storage(0, compute, false)],
+        });
+        let bindings = [("u", 0), ("edge_factors", 1), ("patch_levels", 2), ("offsets", 3), ("draw_args", 4)];
+        let (origin, source) = setup.shader_source("tessellation.wgsl", &bindings)?;
+        let kernel =
+            |entry, layouts: &[&wgpu::BindGroupLayout]| ComputeKernel::new(device, &origin, &source, entry, layouts);
+        let edges = kernel("edges", &[&compute_layout])?;
+        let patches = kernel("patches", &[&compute_layout])?;
+        let scan = kernel("scan", &[&compute_layout])?;
+        let boundaries = kernel("evaluate_boundaries", &[&uniform_layout, &draw_layout, &boundary_layout])?;
+        let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
+        let draw = crate::gpu::validated(device, &origin, || {
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("tessellation_draw_pipeline_layout"),
+                bind_group_layouts: &[Some(&uniform_layout), Some(&draw_layout)],
+                immediate_size: 0,
+            });
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("tessellation/draw"),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(FORMAT.into())],
+                }),
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: wgpu::MultisampleState { count: MSAA, ..Default::default() },
+                multiview_mask: None,
+                cache: None,
+            })
+        })?;
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("tessellation_height_sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let uniforms = crate::gpu::uniform_buffer::<TessUniforms>(device, "tessellation_uniforms");
+        let uniform_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("tessellation_uniform_group"),
+            layout: &uniform_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() }],
+        });
+        Ok(Self {
+            device: device.clone(),
+            queue: setup.gpu.queue.clone(),
+            uniforms,
+            uniform_group,
+            compute_layout,
+            draw_layout,
+            boundary_layout,
+            edges,
+            patches,
+            scan,
+            boundaries,
+            draw,
+            sampler,
+            buffers: None,
+            targets: None,
+            draw_groups: RefCell::default(),
+            last: None,
+        })
+    }
+
+    /// The uniforms of the last frame added (None before the first).
+    pub fn uniforms(&self) -> Option<TessUniforms> {
+        self.last
+    }
+
+    /// Every edge's factor as the GPU computed it in the last submitted frame (blocking).
+    pub fn read_factors(&self) -> Vec<f32> {
+        self.read(|b| &b.factors.0).map(|b| bytemuck::cast_slice(&b).to_vec()).unwrap_or_default()
+    }
+
+    /// Every patch's level (0: culled) from the last submitted frame (blocking).
+    pub fn read_levels(&self) -> Vec<u32> {
+        self.read(|b| &b.levels.0).map(|b| bytemuck::cast_slice(&b).to_vec()).unwrap_or_default()
+    }
+
+    /// Triangles the last submitted frame drew (blocking).
+    pub fn read_triangles(&self) -> u32 {
+        self.read(|b| &b.args.0).map(|b| bytemuck::cast_slice::<u8, u32>(&b)[4]).unwrap_or(0)
+    }
+
+    fn read(&self, which: impl Fn(&Buffers) -> &wgpu::Buffer) -> Option<Vec<u8>> {
+        let buffer = which(self.buffers.as_ref()?);
+        crate::gpu::read_buffer(&self.device, &self.queue, buffer, 0, buffer.size()).ok()
+    }
+
+    /// The displaced position of every boundary lattice point of every patch, as the vertex
+    /// shader places it, for the last submitted frame and `height`: (patch · 3 + edge) · 65 +
+    /// index, w = 1 where a point exists (blocking; the crack test).
+    pub fn boundary_points(&self, height: &wgpu::TextureView) -> Vec<[f32; 4]> {
+        let Some(b) = &self.buffers else { return Vec::new() };
+        let patches = 2 * b.grid * b.grid;
+        let out = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("tessellation_boundaries"),
+            size: u64::from(patches) * 3 * 65 * 16,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("tessellation_boundary_group"),
+            layout: &self.boundary_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: out.as_entire_binding() }],
+        });
+        let draw_group = self.make_draw_group(height, b);
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.boundaries.pipeline);
+            pass.set_bind_group(0, &self.uniform_group, &[]);
+            pass.set_bind_group(1, &draw_group, &[]);
+            pass.set_bind_group(2, &group, &[]);
+            pass.dispatch_workgroups(patches * 3, 1, 1);
+        }
+        self.queue.submit([encoder.finish()]);
+        crate::gpu::read_buffer(&self.device, &self.queue, &out, 0, out.size())
+            .map(|bytes| bytemuck::cast_slice(&bytes).to_vec())
+            .unwrap_or_default()
+    }
+
+    /// (Re)creates the per-frame buffers for `grid`.
+    fn ensure_buffers(&mut self, grid: u32) {
+        if self.buffers.as_ref().is_some_and(|b| b.grid == grid) {
+            return;
+        }
+        let patches = u64::from(2 * grid * grid);
+        let make = |label, bytes: u64, usage| {
+            let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(16),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | usage,
+                mapped_at_creation: false,
+            });
+            (buffer, crate::graph::next_resource_id())
+        };
+        let none = wgpu::BufferUsages::empty();
+        let factors = make("tessellation_edge_factors", u64::from(edge_count(grid)) * 4, none);
+        let levels = make("tessellation_patch_levels", patches * 4, none);
+        let offsets = make("tessellation_offsets", (patches + 1) * 4, none);
+        let args = make("tessellation_draw_args", 5 * 4, wgpu::BufferUsages::INDIRECT);
+        let compute_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("tessellation_compute_group"),
+            layout: &self.compute_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: factors.0.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: levels.0.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: offsets.0.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: args.0.as_entire_binding() },
+            ],
+        });
+        self.buffers = Some(Buffers { grid, factors, levels, offsets, args, compute_group });
+        // Old draw groups bind the old buffers.
+        *self.draw_groups.get_mut() = BindGroupCache::default();
+    }
+
+    /// (Re)creates the multisampled targets for `size`.
+    fn ensure_targets(&mut self, size: (u32, u32)) {
+        if self.targets.as_ref().is_some_and(|t| t.size == size) {
+            return;
+        }
+        let target = |label, format| {
+            self.device
+                .create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: MSAA,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                    view_formats: &[],
+                })
+                .create_view(&Default::default())
+        };
+        self.targets = Some(Targets {
+            size,
+            color: target("tessellation_msaa_color", FORMAT),
+            depth: target("tessellation_msaa_depth", DEPTH),
+        });
+    }
+
+    fn make_draw_group(&self, height: &wgpu::TextureView, b: &Buffers) -> wgpu::BindGroup {
+        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("tessellation_draw_group"),
+            layout: &self.draw_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(height) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                wgpu::BindGroupEntry { binding: 2, resource: b.factors.0.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: b.levels.0.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: b.offsets.0.as_entire_binding() },
+            ],
+        })
+    }
+
+    /// Records the draw: multisampled, resolved into `color`.
+    fn record_draw(&self, ctx: &mut PassContext<'_>, height: TextureHandle, color: TextureHandle, clear: [f32; 4]) {
+        let (Some(b), Some(t)) = (&self.buffers, &self.targets) else { return };
+        let group = self
+            .draw_groups
+            .borrow_mut()
+            .get_or_create(ctx.texture_id(height), || self.make_draw_group(ctx.view(height), b))
+            .clone();
+        let resolve = ctx.view(color).clone();
+        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("tessellation/draw"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &t.color,
+                depth_slice: None,
+                resolve_target: Some(&resolve),
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: f64::from(clear[0]),
+                        g: f64::from(clear[1]),
+                        b: f64::from(clear[2]),
+                        a: 1.0,
+                    }),
+                    store: wgpu::StoreOp::Discard,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &t.depth,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        pass.set_pipeline(&self.draw);
+        pass.set_bind_group(0, &self.uniform_group, &[]);
+        pass.set_bind_group(1, &group, &[]);
+        pass.draw_indirect(&b.args.0, 0);
+    }
+}
+
+impl Technique for Tessellation {
+    fn add_passes<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        params: &ParamSet,
+        _time: &FrameTime,
+        inputs: &[TextureHandle],
+    ) -> TextureHandle {
+        let height = inputs[0];
+        // Nothing here is state: a frame that is only stepped (a seek) needs none of it.
+        if graph.is_simulation_only() {
+            return height;
+        }
+        let size = graph.output_size();
+        let u = TessUniforms::from_params(params, size);
+        self.ensure_buffers(u.grid);
+        self.ensure_targets(size);
+        self.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        self.last = Some(u);
+        self.draw_groups.get_mut().begin_frame();
+
+        let this: &'r Tessellation = self;
+        let b = this.buffers.as_ref().expect("ensured");
+        let import = |graph: &mut FrameGraph<'r>, name: &str, (buffer, id): &(wgpu::Buffer, u64)| -> BufferHandle {
+            graph.import_buffer(name, buffer, *id)
+        };
+        let factors = import(graph, "tessellation/edge_factors", &b.factors);
+        let levels = import(graph, "tessellation/patch_levels", &b.levels);
+        let offsets = import(graph, "tessellation/offsets", &b.offsets);
+        let args = import(graph, "tessellation/draw_args", &b.args);
+        let (edges, patches) = (u.edge_count, u.patch_count);
+        graph
+            .add_pass("tessellation/refine")
+            .write_buffer(factors)
+            .write_buffer(levels)
+            .write_buffer(offsets)
+            .write_buffer(args)
+            .record(move |ctx| {
+                let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("tessellation/refine"),
+                    timestamp_writes: None,
+                });
+                this.edges.dispatch(&mut pass, &[&b.compute_group], [edges, 1, 1]);
+                this.patches.dispatch(&mut pass, &[&b.compute_group], [patches, 1, 1]);
+                this.scan.dispatch(&mut pass, &[&b.compute_group], [256, 1, 1]);
+            });
+        let color = graph.create_texture("tessellation/image", TextureDesc::full(FORMAT));
+        let clear = u.background;
+        graph
+            .add_pass("tessellation/draw")
+            .read(height)
+            .read_buffer(factors)
+            .read_buffer(levels)
+            .read_buffer(offsets)
+            .read_buffer(args)
+            .render_target(color)
+            .record(move |ctx| this.record_draw(ctx, height, color, clear));
+        color
+    }
+
+    fn bench_report(&mut self) -> Vec<String> {
+        let Some(u) = self.last else { return Vec::new() };
+        vec![format!(
+            "{} triangles from {} patches (grid {}, edge target {} px, {}×{} output)",
+            self.read_triangles(),
+            u.patch_count,
+            u.grid,
+            u.edge_px,
+            self.targets.as_ref().map_or(0, |t| t.size.0),
+            u.screen_height
+        )]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_uniform_block_matches_the_wgsl_struct() {
+        let source = include_str!("../../../shaders/tessellation.wgsl");
+        assert_eq!(crate::gpu::wgsl_struct_size(source, "Tess"), Some(size_of::<TessUniforms>() as u32));
+    }
+
+    #[test]
+    fn the_mesh_numbering_covers_every_edge_twice_inside_and_once_on_the_border() {
+        for grid in [1, 3, 10] {
+            let mut uses = vec![0u32; edge_count(grid) as usize];
+            for p in 0..2 * grid * grid {
+                let (v, e) = reference::patch(grid, p);
+                for k in 0..3 {
+                    let (a, b) = reference::edge_vertices(grid, e[k]);
+                    let (x, y) = (v[k].min(v[(k + 1) % 3]), v[k].max(v[(k + 1) % 3]));
+                    assert_eq!((a, b), (x, y), "grid {grid} patch {p} edge {k}");
+                    uses[e[k] as usize] += 1;
+                }
+            }
+            let border = 4 * grid as usize;
+            assert_eq!(uses.iter().filter(|&&n| n == 1).count(), border);
+            assert!(uses.iter().all(|&n| n == 1 || n == 2));
+        }
+    }
+}
