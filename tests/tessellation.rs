@@ -176,7 +176,7 @@ fn check_golden(scene: &str, frames: &[u64]) {
 
 #[test]
 fn golden_tessellation_fluid_while_it_is_stirred() {
-    check_golden("tessellation_fluid", &[60, 200]);
+    check_golden("tessellation_fluid", &[45, 90]);
 }
 
 #[test]
