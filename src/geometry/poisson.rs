@@ -1,6 +1,7 @@
 //! Poisson disk sampling in N dimensions by Bridson's algorithm ("Fast Poisson Disk Sampling in
 //! Arbitrary Dimensions", SIGGRAPH 2007 sketch) [UGP4 ch.7], with the sample's mistakes fixed
-//! (seed-reference §7, §9): the neighbourhood is ±2 cells in *every* dimension, candidates are
+//! (seed-reference §7, §9): the neighbourhood reaches ⌈√N⌉ cells in *every* dimension (cells are
+//! r/√N wide, so ±2 cells cover r only up to N = 4), candidates are
 //! uniform in the annulus *volume* between r and 2r for any N (the sample used the 2-D law in 3-D),
 //! and there is no fixed point cap. Step-wise: each [`PoissonDisk::step`] processes one active
 //! point, so a scene can show the set growing.
@@ -50,6 +51,39 @@ pub struct PoissonDisk<const N: usize> {
     points: Vec<[f64; N]>,
     active: Vec<usize>,
     rng: SplitMix64,
+    /// Cell offsets that can hold a sample nearer than r (see [`neighbourhood`]).
+    offsets: Vec<[i64; N]>,
+    /// Below this many samples, a candidate is checked against every sample instead of the grid
+    /// (cheaper in high dimensions, where the neighbourhood has thousands of cells).
+    scan_below: usize,
+}
+
+/// The cell offsets around a cell that can hold a sample nearer than r: within ⌈√N⌉ cells on
+/// every axis (a cell is r/√N wide), and whose nearest point is nearer than r, i.e.
+/// Σ max(|o| − 1, 0)² < N in cells.
+fn neighbourhood<const N: usize>() -> Vec<[i64; N]> {
+    let reach = (N as f64).sqrt().ceil() as i64;
+    let mut out = Vec::new();
+    let mut offset = [-reach; N];
+    loop {
+        let gap: i64 = offset.iter().map(|&o| (o.abs() - 1).max(0).pow(2)).sum();
+        if gap < N as i64 {
+            out.push(offset);
+        }
+        // Odometer over {−reach..reach}^N.
+        let mut d = 0;
+        loop {
+            if d == N {
+                return out;
+            }
+            offset[d] += 1;
+            if offset[d] <= reach {
+                break;
+            }
+            offset[d] = -reach;
+            d += 1;
+        }
+    }
 }
 
 impl<const N: usize> PoissonDisk<N> {
@@ -72,7 +106,10 @@ impl<const N: usize> PoissonDisk<N> {
             points: Vec::new(),
             active: Vec::new(),
             rng,
+            offsets: neighbourhood(),
+            scan_below: 0,
         };
+        sampler.scan_below = sampler.offsets.len();
         sampler.insert(first);
         sampler
     }
@@ -140,33 +177,19 @@ impl<const N: usize> PoissonDisk<N> {
         Some(p)
     }
 
-    /// Whether `p` is at least r from every sample: checks the ±2 cells around it on every axis
-    /// (a cell is r/√N wide, so 2 cells cover r for any N).
+    /// Whether `p` is at least r from every sample: checks the cells of the neighbourhood, or
+    /// every sample when there are fewer samples than cells to visit (high N).
     fn is_free(&self, p: &[f64; N]) -> bool {
-        let home = self.cell_of(p);
         let r2 = self.settings.radius * self.settings.radius;
-        let mut offset = [-2i64; N];
-        loop {
-            if let Some(cell) = self.neighbour(&home, &offset) {
-                let s = self.grid[cell];
-                if s != 0 && self.distance2(p, &self.points[s as usize - 1]) < r2 {
-                    return false;
-                }
-            }
-            // Odometer over {−2..2}^N.
-            let mut d = 0;
-            loop {
-                if d == N {
-                    return true;
-                }
-                offset[d] += 1;
-                if offset[d] <= 2 {
-                    break;
-                }
-                offset[d] = -2;
-                d += 1;
-            }
+        if self.points.len() < self.scan_below {
+            return self.points.iter().all(|q| self.distance2(p, q) >= r2);
         }
+        let home = self.cell_of(p);
+        self.offsets.iter().all(|offset| {
+            let Some(cell) = self.neighbour(&home, offset) else { return true };
+            let s = self.grid[cell];
+            s == 0 || self.distance2(p, &self.points[s as usize - 1]) >= r2
+        })
     }
 
     fn cell_of(&self, p: &[f64; N]) -> [usize; N] {
@@ -252,6 +275,45 @@ mod tests {
         let torus = run([1.0, 1.0], r, true);
         assert!(min_distance(&torus, [1.0; 2], true) >= r, "periodic, across the seams too");
         assert!(p2.len() > 200 && p3.len() > 200 && p4.len() > 50, "{} {} {}", p2.len(), p3.len(), p4.len());
+    }
+
+    #[test]
+    fn minimum_distance_and_coverage_hold_in_5_to_8_dimensions() {
+        // The settings that broke with a ±2-cell neighbourhood: N = 5, r = 0.3 gave 0.2858 and
+        // N = 6, r = 0.4 gave 0.3751. `grid`: every check goes through the grid neighbourhood.
+        fn check<const N: usize>(r: f64, grid: bool) -> usize {
+            let mut sampler = PoissonDisk::new(PoissonSettings::new([1.0; N], r, 42));
+            if grid {
+                sampler.scan_below = 0;
+            }
+            let points = sampler.generate();
+            assert!(min_distance(&points, [1.0; N], false) >= r, "{N}-D, r = {r}");
+            let mut rng = SplitMix64::new(9);
+            for _ in 0..400 {
+                let q: [f64; N] = std::array::from_fn(|_| rng.unit());
+                let nearest = points
+                    .iter()
+                    .map(|p| p.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt())
+                    .fold(f64::INFINITY, f64::min);
+                assert!(nearest <= 2.0 * r, "{N}-D probe {nearest} from every sample (r = {r})");
+            }
+            points.len()
+        }
+        let counts = [
+            check::<5>(0.3, true),
+            check::<6>(0.4, true),
+            check::<5>(0.3, false),
+            check::<7>(0.5, false),
+            check::<8>(0.6, false),
+        ];
+        assert!(counts.iter().all(|&n| n > 20), "{counts:?}");
+    }
+
+    #[test]
+    fn the_neighbourhood_reaches_root_n_cells_and_skips_far_corners() {
+        assert_eq!(neighbourhood::<2>().len(), 25 - 4, "±2 without the four far corners");
+        assert!(neighbourhood::<5>().iter().any(|o| o.contains(&3)), "N = 5 reaches 3 cells");
+        assert!(neighbourhood::<3>().iter().all(|o| o.iter().all(|c| c.abs() <= 2)));
     }
 
     #[test]
