@@ -201,3 +201,25 @@ fn a_bad_image_path_is_one_message_and_the_show_goes_on() {
     assert_eq!(messages.len(), 1, "{messages:?}");
     assert!(messages[0].contains("no/such/heights.png") && messages[0].starts_with("map:"), "{}", messages[0]);
 }
+
+#[test]
+fn a_drag_stirs_the_fluid_under_the_pointer_on_the_plane() {
+    let scene = load_scene(&common::assets(), "tessellation_fluid").unwrap();
+    let size = (320, 180);
+    let mut r = OffscreenRenderer::new(common::gpu(), &common::assets(), scene, Some(size), None, None).unwrap();
+    r.render_next().unwrap();
+    let instance = r.instance_mut();
+    let (fluid, surface) = (0, 1);
+    let u = tessellation::TessUniforms::from_params(instance.params(surface), size);
+    let view = [0.4, 0.3];
+    let expected = tessellation::pick(&u, view).expect("the plane is under the pointer");
+    let events = instance.drag(view, true, indra::params::Source::Ui);
+    let cursor = instance.params(fluid).index("cursor").unwrap();
+    let written = events.iter().find_map(|e| match e {
+        indra::params::ControlEvent::Write(w) if w.node == fluid && w.param == cursor => Some(w.value),
+        _ => None,
+    });
+    let Some(ParamValue::Vec2(at)) = written else { panic!("no cursor write in {events:?}") };
+    assert!((at[0] - expected[0]).abs() < 1e-5 && (at[1] - expected[1]).abs() < 1e-5, "{at:?} vs {expected:?}");
+    assert!((at[0] - view[0]).abs() > 0.01 || (at[1] - view[1]).abs() > 0.01, "mapped, not the raw screen position");
+}

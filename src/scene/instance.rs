@@ -246,7 +246,7 @@ impl SceneInstance {
     /// fires (R resets a cloth and restarts a Poisson run; U and C undo and clear a drawing).
     pub fn key(&self, key: char, source: Source) -> Vec<ControlEvent> {
         let key = key.to_ascii_lowercase();
-        self.writes_for(source, |role| (role == InputRole::Key(key)).then_some(ParamValue::Trigger(true)))
+        self.writes_for(source, |_, role| (role == InputRole::Key(key)).then_some(ParamValue::Trigger(true)))
     }
 
     /// Writes for a click at `position` (view units 0–1, y up): every parameter declared as
@@ -255,9 +255,10 @@ impl SceneInstance {
     /// recordings use.
     pub fn pointer(&self, position: [f32; 2], primary: bool, source: Source) -> Vec<ControlEvent> {
         let click = if primary { InputRole::PrimaryClick } else { InputRole::SecondaryClick };
-        let mut events =
-            self.writes_for(source, |role| (role == InputRole::Pointer).then_some(ParamValue::Vec2(position)));
-        events.extend(self.writes_for(source, |role| (role == click).then_some(ParamValue::Trigger(true))));
+        let mut events = self.writes_for(source, |node, role| {
+            (role == InputRole::Pointer).then(|| ParamValue::Vec2(self.pointer_for(node, position)))
+        });
+        events.extend(self.writes_for(source, |_, role| (role == click).then_some(ParamValue::Trigger(true))));
         events
     }
 
@@ -265,7 +266,7 @@ impl SceneInstance {
     /// follows it, and pointer parameters get `position`.
     pub fn drag(&self, position: [f32; 2], held: bool, source: Source) -> Vec<ControlEvent> {
         let mut events = self.pointer_moved(position, source);
-        events.extend(self.writes_for(source, |role| (role == InputRole::Drag).then_some(ParamValue::Bool(held))));
+        events.extend(self.writes_for(source, |_, role| (role == InputRole::Drag).then_some(ParamValue::Bool(held))));
         events
     }
 
@@ -280,7 +281,7 @@ impl SceneInstance {
             }
             for (param, decl) in params.decls().iter().enumerate() {
                 if decl.role == Some(InputRole::Pointer) {
-                    let value = ParamValue::Vec2(position);
+                    let value = ParamValue::Vec2(self.pointer_for(node, position));
                     events.push(ControlEvent::Write(ParamWrite { node, param, component: None, value, source }));
                 }
             }
@@ -288,12 +289,25 @@ impl SceneInstance {
         events
     }
 
-    /// A write of `value(role)` to every parameter whose declared role gives a value.
-    fn writes_for(&self, source: Source, value: impl Fn(InputRole) -> Option<ParamValue>) -> Vec<ControlEvent> {
+    /// Where a pointer at `view` (0–1 on the output, y up) points for node `node`: if a node that
+    /// takes `node`'s texture draws it on a surface, the point of that texture under the pointer
+    /// (a stroke lands under the cursor on the tessellated plane); else `view` itself.
+    fn pointer_for(&self, node: usize, view: [f32; 2]) -> [f32; 2] {
+        self.scene
+            .nodes
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| n.inputs.contains(&node))
+            .find_map(|(consumer, _)| self.nodes[consumer].map_pointer(view))
+            .unwrap_or(view)
+    }
+
+    /// A write of `value(node, role)` to every parameter whose declared role gives a value.
+    fn writes_for(&self, source: Source, value: impl Fn(usize, InputRole) -> Option<ParamValue>) -> Vec<ControlEvent> {
         let mut events = Vec::new();
         for (node, params) in self.params.iter().enumerate() {
             for (param, decl) in params.decls().iter().enumerate() {
-                if let Some(value) = decl.role.and_then(&value) {
+                if let Some(value) = decl.role.and_then(|role| value(node, role)) {
                     events.push(ControlEvent::Write(ParamWrite { node, param, component: None, value, source }));
                 }
             }

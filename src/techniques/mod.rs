@@ -100,6 +100,13 @@ pub trait Technique {
         false
     }
 
+    /// Where a pointer at `view` (0–1 on the output, y up) lands in this node's input texture
+    /// (UV 0–1, y up), if the node draws its input on a surface — so that a cursor-driven
+    /// upstream node (a fluid) is stirred under the pointer. `None`: not such a node, or a miss.
+    fn map_pointer(&self, _view: [f32; 2]) -> Option<[f32; 2]> {
+        None
+    }
+
     /// Figures for `indra bench` to print after measuring (e.g. triangles generated). May read
     /// back from the GPU: never called in the frame loop.
     fn bench_report(&mut self) -> Vec<String> {

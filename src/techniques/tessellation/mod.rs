@@ -463,6 +463,10 @@ impl Technique for Tessellation {
         color
     }
 
+    fn map_pointer(&self, view: [f32; 2]) -> Option<[f32; 2]> {
+        self.last.and_then(|u| pick(&u, view))
+    }
+
     fn bench_report(&mut self) -> Vec<String> {
         let Some(u) = self.last else { return Vec::new() };
         vec![format!(
@@ -477,9 +481,51 @@ impl Technique for Tessellation {
     }
 }
 
+/// The UV (0–1, y up) of the undisplaced plane under a pointer at `view` (0–1 on the output, y
+/// up) for the camera of `u`, if the ray through it hits the plane inside its bounds.
+pub fn pick(u: &TessUniforms, view: [f32; 2]) -> Option<[f32; 2]> {
+    use glam::{Mat4, Vec3, Vec4};
+    let inverse = Mat4::from_cols_array_2d(&u.view_proj).inverse();
+    let (x, y) = (view[0] * 2.0 - 1.0, view[1] * 2.0 - 1.0);
+    let unproject = |z: f32| {
+        let p = inverse * Vec4::new(x, y, z, 1.0);
+        p.truncate() / p.w
+    };
+    let (near, far) = (unproject(0.0), unproject(1.0));
+    let model = Mat4::from_cols_array_2d(&u.model);
+    let (origin, normal) = (model.transform_point3(Vec3::ZERO), model.transform_vector3(Vec3::Y));
+    let direction = far - near;
+    let along = normal.dot(direction);
+    if along.abs() < 1e-9 {
+        return None;
+    }
+    let t = normal.dot(origin - near) / along;
+    let local = model.inverse().transform_point3(near + direction * t);
+    let uv = [local.x / u.plane_size + 0.5, local.z / u.plane_size + 0.5];
+    ((0.0..=1.0).contains(&t) && uv.iter().all(|c| (0.0..=1.0).contains(c))).then_some(uv)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_pointer_over_a_plane_point_picks_that_points_uv() {
+        let mut params = ParamSet::new(super::params());
+        params.set_at(params.index("camera_yaw").unwrap(), crate::params::ParamValue::Float(25.0));
+        params.snap();
+        let u = TessUniforms::from_params(&params, (640, 360));
+        let (model, view_proj) =
+            (glam::Mat4::from_cols_array_2d(&u.model), glam::Mat4::from_cols_array_2d(&u.view_proj));
+        for uv in [[0.3f32, 0.6], [0.5, 0.5], [0.9, 0.1]] {
+            let local = glam::Vec3::new((uv[0] - 0.5) * PLANE_SIZE, 0.0, (uv[1] - 0.5) * PLANE_SIZE);
+            let clip = view_proj * model.transform_point3(local).extend(1.0);
+            let view = [(clip.x / clip.w + 1.0) / 2.0, (clip.y / clip.w + 1.0) / 2.0];
+            let picked = pick(&u, view).expect("the point is on screen");
+            assert!((picked[0] - uv[0]).abs() < 1e-4 && (picked[1] - uv[1]).abs() < 1e-4, "{uv:?} → {picked:?}");
+        }
+        assert_eq!(pick(&u, [0.5, 0.999]), None, "above the plane: a miss");
+    }
 
     #[test]
     fn the_uniform_block_matches_the_wgsl_struct() {
