@@ -110,7 +110,7 @@ fn wrong_arguments_and_unknown_addresses_are_counted_not_applied() {
         ],
     );
     assert!(routed.is_empty());
-    let [packets, _, malformed, unknown, bad, applied] = rx.counters().snapshot();
+    let [packets, _, malformed, unknown, bad, applied, _] = rx.counters().snapshot();
     assert_eq!((packets, malformed, unknown, bad, applied), (4, 1, 1, 2, 0));
 }
 
@@ -159,6 +159,34 @@ fn a_future_time_tag_waits_until_due() {
     assert!(receive(&mut rx, 1).is_empty(), "not yet due");
     std::thread::sleep(Duration::from_millis(450));
     assert_eq!(rx.drain(SystemTime::now()).len(), 1);
+}
+
+#[test]
+fn far_future_and_flooding_bundles_are_dropped_and_counted() {
+    let mut rx = OscReceiver::bind("127.0.0.1:0").unwrap();
+    let tx = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let msg = OscPacket::Message(OscMessage { addr: "/indra/limit_set/scale".into(), args: vec![OscType::Float(2.0)] });
+    let tagged = |timetag: OscTime| {
+        rosc::encoder::encode(&OscPacket::Bundle(OscBundle { timetag, content: vec![msg.clone()] })).unwrap()
+    };
+    let bundle = |due: SystemTime| tagged(OscTime::try_from(due).unwrap());
+    // A tag in 2100, past the 2036 NTP era rollover (its 32-bit seconds wrap; it used to apply at
+    // once), and one a day ahead.
+    let year_2100 = OscTime { seconds: ((4_102_444_800u64 + 2_208_988_800) % (1 << 32)) as u32, fractional: 0 };
+    tx.send_to(&tagged(year_2100), rx.local_addr()).unwrap();
+    tx.send_to(&bundle(SystemTime::now() + Duration::from_secs(86_400)), rx.local_addr()).unwrap();
+    assert!(receive(&mut rx, 2).is_empty(), "neither applies now");
+    assert_eq!(rx.counters().snapshot()[6], 2, "both dropped: more than an hour ahead");
+    // More future bundles than the schedule holds: the rest are dropped, memory stays bounded.
+    let soon = bundle(SystemTime::now() + Duration::from_secs(60));
+    let extra = 500;
+    for _ in 0..indra::control::osc::MAX_SCHEDULED + extra {
+        tx.send_to(&soon, rx.local_addr()).unwrap();
+    }
+    let sent = 2 + (indra::control::osc::MAX_SCHEDULED + extra) as u64;
+    assert!(receive(&mut rx, sent).is_empty());
+    let dropped = rx.counters().snapshot()[6];
+    assert!(dropped >= 2 + extra as u64, "dropped {dropped}");
 }
 
 #[test]

@@ -259,9 +259,9 @@ impl ControlHub {
     pub fn status(&self) -> String {
         let mut parts = Vec::new();
         if let Some(o) = &self.osc {
-            let [packets, _, malformed, unknown, bad, applied] = o.counters().snapshot();
+            let [packets, _, malformed, unknown, bad, applied, dropped] = o.counters().snapshot();
             parts.push(format!(
-                "OSC {}: {packets} packets, {applied} applied, {malformed} malformed, {unknown} unknown address, {bad} bad args",
+                "OSC {}: {packets} packets, {applied} applied, {malformed} malformed, {unknown} unknown address, {bad} bad args, {dropped} dropped",
                 o.local_addr()
             ));
         }

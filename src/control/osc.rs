@@ -6,7 +6,7 @@
 use std::collections::HashSet;
 use std::net::{SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, SystemTime};
@@ -32,15 +32,34 @@ pub struct OscCounters {
     pub bad_arguments: AtomicU64,
     /// Messages applied to parameters or commands.
     pub applied: AtomicU64,
+    /// Batches dropped: the queue to the render loop was full (a flood), or a time tag lay more
+    /// than [`MAX_AHEAD`] in the future.
+    pub dropped: AtomicU64,
 }
 
 impl OscCounters {
-    /// (packets, messages, malformed, unknown address, bad arguments, applied).
-    pub fn snapshot(&self) -> [u64; 6] {
-        [&self.packets, &self.messages, &self.malformed, &self.unknown_address, &self.bad_arguments, &self.applied]
-            .map(|c| c.load(Ordering::Relaxed))
+    /// (packets, messages, malformed, unknown address, bad arguments, applied, dropped).
+    pub fn snapshot(&self) -> [u64; 7] {
+        [
+            &self.packets,
+            &self.messages,
+            &self.malformed,
+            &self.unknown_address,
+            &self.bad_arguments,
+            &self.applied,
+            &self.dropped,
+        ]
+        .map(|c| c.load(Ordering::Relaxed))
     }
 }
+
+/// Batches the receiver thread may queue for the render loop; a flood beyond it is dropped and
+/// counted, so memory stays flat however fast packets come and however slow frames are.
+pub const MAX_QUEUED: usize = 8192;
+/// Future-tagged batches held at once; more are dropped and counted.
+pub const MAX_SCHEDULED: usize = 4096;
+/// The furthest ahead a time tag may schedule a bundle; later ones are dropped and counted.
+pub const MAX_AHEAD: Duration = Duration::from_secs(3600);
 
 /// Messages that apply together, at `due` (None: at once).
 #[derive(Clone, Debug, PartialEq)]
@@ -81,11 +100,23 @@ fn flatten(packet: OscPacket, batch: &mut Batch) {
     }
 }
 
-/// An OSC (NTP) time tag as a system time; `None` (apply at once) for times before 1970, which
-/// rosc's own conversion would panic on.
+/// An OSC (NTP) time tag as a system time. NTP seconds wrap every 2³² s (the next era starts in
+/// 2036): a tag that would fall before 1970, or more than half an era before now, is read in the
+/// next era, so tags after 2036 stay in the future instead of wrapping to 1900 (and applying at
+/// once).
 fn ntp_to_system(t: rosc::OscTime) -> Option<SystemTime> {
-    const NTP_TO_UNIX_SECONDS: u64 = 2_208_988_800;
-    let seconds = u64::from(t.seconds).checked_sub(NTP_TO_UNIX_SECONDS)?;
+    ntp_to_system_near(t, SystemTime::now())
+}
+
+fn ntp_to_system_near(t: rosc::OscTime, now: SystemTime) -> Option<SystemTime> {
+    const NTP_TO_UNIX_SECONDS: i64 = 2_208_988_800;
+    const ERA: i64 = 1 << 32;
+    let now_unix = now.duration_since(SystemTime::UNIX_EPOCH).map_or(0, |d| d.as_secs() as i64);
+    let mut unix = i64::from(t.seconds) - NTP_TO_UNIX_SECONDS;
+    while unix < 0 || unix < now_unix - ERA / 2 {
+        unix += ERA;
+    }
+    let seconds = u64::try_from(unix).ok()?;
     let nanos = (u64::from(t.fractional) * 1_000_000_000) >> 32;
     SystemTime::UNIX_EPOCH.checked_add(Duration::new(seconds, nanos as u32))
 }
@@ -113,7 +144,7 @@ impl OscReceiver {
         let _ = socket2::SockRef::from(&socket).set_recv_buffer_size(RECEIVE_BUFFER_BYTES);
         socket.set_read_timeout(Some(Duration::from_millis(50))).map_err(|e| e.to_string())?;
         let local = socket.local_addr().map_err(|e| e.to_string())?;
-        let (tx, queue) = channel();
+        let (tx, queue) = sync_channel(MAX_QUEUED);
         let counters = Arc::new(OscCounters::default());
         let stop = Arc::new(AtomicBool::new(false));
         let logged = Arc::new(Mutex::new(HashSet::new()));
@@ -138,9 +169,21 @@ impl OscReceiver {
         &self.counters
     }
 
-    /// Every batch that is due at `now`, in arrival order; later ones wait.
+    /// Every batch that is due at `now`, in arrival order; later ones wait (at most
+    /// [`MAX_SCHEDULED`], none more than [`MAX_AHEAD`] ahead: the rest are dropped and counted).
     pub fn drain(&mut self, now: SystemTime) -> Vec<Batch> {
-        self.scheduled.extend(self.queue.try_iter());
+        let horizon = now + MAX_AHEAD;
+        for batch in self.queue.try_iter() {
+            let too_late = batch.due.is_some_and(|t| t > horizon);
+            let full = batch.due.is_some_and(|t| t > now) && self.scheduled.len() >= MAX_SCHEDULED;
+            if too_late || full {
+                self.counters.dropped.fetch_add(1, Ordering::Relaxed);
+                let why = if too_late { "a time tag more than an hour ahead" } else { "too many future bundles" };
+                log_once(&self.logged, why, &format!("bundle dropped: {why}"));
+                continue;
+            }
+            self.scheduled.push(batch);
+        }
         let (due, later): (Vec<Batch>, Vec<Batch>) =
             self.scheduled.drain(..).partition(|b| b.due.is_none_or(|t| t <= now));
         self.scheduled = later;
@@ -205,7 +248,7 @@ fn describe_args(args: &[OscType]) -> String {
 
 fn receive_loop(
     socket: &UdpSocket,
-    tx: &Sender<Batch>,
+    tx: &SyncSender<Batch>,
     counters: &OscCounters,
     stop: &AtomicBool,
     logged: &Mutex<HashSet<String>>,
@@ -222,8 +265,17 @@ fn receive_loop(
                     if batch.messages.iter().any(|m| m.addr == "/indra/stats") {
                         reply_stats(socket, from, counters);
                     }
-                    if tx.send(batch).is_err() {
-                        return;
+                    match tx.try_send(batch) {
+                        Ok(()) => {}
+                        Err(TrySendError::Full(_)) => {
+                            counters.dropped.fetch_add(1, Ordering::Relaxed);
+                            log_once(
+                                logged,
+                                "queue full",
+                                "the render loop is behind; packets are dropped and counted",
+                            );
+                        }
+                        Err(TrySendError::Disconnected(_)) => return,
                     }
                 }
             }
@@ -357,5 +409,26 @@ pub fn coerce_args(args: &[OscType], decl: &ParamDecl) -> Option<ParamValue> {
         ParamType::Bool => numbers(args).filter(|n| n.len() == 1).map(|n| ParamValue::Bool(n[0] != 0.0)),
         ParamType::Int => numbers(args).filter(|n| n.len() == 1).map(|n| ParamValue::Int(n[0].round() as i32)),
         ty => numbers(args).and_then(|n| ty.value_from(&n)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn time_tags_after_2036_stay_in_the_future() {
+        let now = SystemTime::UNIX_EPOCH + Duration::from_secs(1_796_000_000); // 2026-12
+        let at = |unix: u64| {
+            let ntp = unix + 2_208_988_800;
+            ntp_to_system_near(rosc::OscTime { seconds: (ntp % (1 << 32)) as u32, fractional: 0 }, now)
+        };
+        let year_2100 = 4_102_444_800; // 2100-01-01
+        assert_eq!(at(year_2100), Some(SystemTime::UNIX_EPOCH + Duration::from_secs(year_2100)));
+        let soon = 1_796_000_010;
+        assert_eq!(at(soon), Some(SystemTime::UNIX_EPOCH + Duration::from_secs(soon)));
+        // A raw value that would be 1900 is the next era's (2036), never "at once".
+        let wrapped = ntp_to_system_near(rosc::OscTime { seconds: 1_000, fractional: 0 }, now).unwrap();
+        assert!(wrapped > now, "{wrapped:?}");
     }
 }
