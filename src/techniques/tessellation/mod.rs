@@ -16,7 +16,9 @@
 mod params;
 pub mod reference;
 
-pub use params::{CHANNELS, PLANE_SIZE, TessUniforms, VIEWS, camera, edge_count, frustum_planes, model, params};
+pub use params::{
+    CHANNELS, MSAA_MODES, PLANE_SIZE, TessUniforms, VIEWS, camera, edge_count, frustum_planes, model, params,
+};
 
 use std::cell::RefCell;
 
@@ -41,7 +43,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 /// The colour format.
 pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Samples per pixel of the surface (resolved before anything downstream sees it).
+/// Samples per pixel of the surface with `msaa` on (resolved before anything downstream sees it).
 pub const MSAA: u32 = 4;
 
 /// The per-frame buffers for one grid size.
@@ -55,10 +57,11 @@ struct Buffers {
     compute_group: wgpu::BindGroup,
 }
 
-/// Multisampled colour and depth targets for one output size.
+/// Colour (multisampled only) and depth targets for one output size and sample count.
 struct Targets {
     size: (u32, u32),
-    color: wgpu::TextureView,
+    samples: u32,
+    color: Option<wgpu::TextureView>,
     depth: wgpu::TextureView,
 }
 
@@ -76,7 +79,8 @@ pub struct Tessellation {
     patches: ComputeKernel,
     scan: ComputeKernel,
     boundaries: ComputeKernel,
-    draw: wgpu::RenderPipeline,
+    /// The draw pipeline for 1 and for [`MSAA`] samples.
+    draw: [wgpu::RenderPipeline; 2],
     sampler: wgpu::Sampler,
     buffers: Option<Buffers>,
     targets: Option<Targets>,
@@ -163,40 +167,43 @@ impl Tessellation {
         let scan = kernel("scan", &[&compute_layout])?;
         let boundaries = kernel("evaluate_boundaries", &[&uniform_layout, &draw_layout, &boundary_layout])?;
         let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
-        let draw = crate::gpu::validated(device, &origin, || {
-            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("tessellation_draw_pipeline_layout"),
-                bind_group_layouts: &[Some(&uniform_layout), Some(&draw_layout)],
-                immediate_size: 0,
-            });
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("tessellation/draw"),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(FORMAT.into())],
-                }),
-                primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: wgpu::MultisampleState { count: MSAA, ..Default::default() },
-                multiview_mask: None,
-                cache: None,
+        let pipeline = |samples: u32| {
+            crate::gpu::validated(device, &origin, || {
+                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("tessellation_draw_pipeline_layout"),
+                    bind_group_layouts: &[Some(&uniform_layout), Some(&draw_layout)],
+                    immediate_size: 0,
+                });
+                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some("tessellation/draw"),
+                    layout: Some(&layout),
+                    vertex: wgpu::VertexState {
+                        module: &module,
+                        entry_point: Some("vs_main"),
+                        compilation_options: Default::default(),
+                        buffers: &[],
+                    },
+                    fragment: Some(wgpu::FragmentState {
+                        module: &module,
+                        entry_point: Some("fs_main"),
+                        compilation_options: Default::default(),
+                        targets: &[Some(FORMAT.into())],
+                    }),
+                    primitive: wgpu::PrimitiveState::default(),
+                    depth_stencil: Some(wgpu::DepthStencilState {
+                        format: DEPTH,
+                        depth_write_enabled: Some(true),
+                        depth_compare: Some(wgpu::CompareFunction::Less),
+                        stencil: Default::default(),
+                        bias: Default::default(),
+                    }),
+                    multisample: wgpu::MultisampleState { count: samples, ..Default::default() },
+                    multiview_mask: None,
+                    cache: None,
+                })
             })
-        })?;
+        };
+        let draw = [pipeline(1)?, pipeline(MSAA)?];
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("tessellation_height_sampler"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -324,9 +331,9 @@ impl Tessellation {
         *self.draw_groups.get_mut() = BindGroupCache::default();
     }
 
-    /// (Re)creates the multisampled targets for `size`.
-    fn ensure_targets(&mut self, size: (u32, u32)) {
-        if self.targets.as_ref().is_some_and(|t| t.size == size) {
+    /// (Re)creates the targets for `size` and `samples`.
+    fn ensure_targets(&mut self, size: (u32, u32), samples: u32) {
+        if self.targets.as_ref().is_some_and(|t| t.size == size && t.samples == samples) {
             return;
         }
         let target = |label, format| {
@@ -335,7 +342,7 @@ impl Tessellation {
                     label: Some(label),
                     size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
                     mip_level_count: 1,
-                    sample_count: MSAA,
+                    sample_count: samples,
                     dimension: wgpu::TextureDimension::D2,
                     format,
                     usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -345,8 +352,9 @@ impl Tessellation {
         };
         self.targets = Some(Targets {
             size,
-            color: target("tessellation_msaa_color", FORMAT),
-            depth: target("tessellation_msaa_depth", DEPTH),
+            samples,
+            color: (samples > 1).then(|| target("tessellation_msaa_color", FORMAT)),
+            depth: target("tessellation_depth", DEPTH),
         });
     }
 
@@ -364,7 +372,7 @@ impl Tessellation {
         })
     }
 
-    /// Records the draw: multisampled, resolved into `color`.
+    /// Records the draw into `color`: multisampled and resolved, or directly.
     fn record_draw(&self, ctx: &mut PassContext<'_>, height: TextureHandle, color: TextureHandle, clear: [f32; 4]) {
         let (Some(b), Some(t)) = (&self.buffers, &self.targets) else { return };
         let group = self
@@ -372,13 +380,17 @@ impl Tessellation {
             .borrow_mut()
             .get_or_create(ctx.texture_id(height), || self.make_draw_group(ctx.view(height), b))
             .clone();
-        let resolve = ctx.view(color).clone();
+        let output = ctx.view(color).clone();
+        let (view, resolve_target) = match &t.color {
+            Some(samples) => (samples, Some(&output)),
+            None => (&output, None),
+        };
         let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("tessellation/draw"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &t.color,
+                view,
                 depth_slice: None,
-                resolve_target: Some(&resolve),
+                resolve_target,
                 ops: wgpu::Operations {
                     load: wgpu::LoadOp::Clear(wgpu::Color {
                         r: f64::from(clear[0]),
@@ -386,7 +398,7 @@ impl Tessellation {
                         b: f64::from(clear[2]),
                         a: 1.0,
                     }),
-                    store: wgpu::StoreOp::Discard,
+                    store: if resolve_target.is_some() { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
                 },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
@@ -396,7 +408,7 @@ impl Tessellation {
             }),
             ..Default::default()
         });
-        pass.set_pipeline(&self.draw);
+        pass.set_pipeline(&self.draw[usize::from(t.samples > 1)]);
         pass.set_bind_group(0, &self.uniform_group, &[]);
         pass.set_bind_group(1, &group, &[]);
         pass.draw_indirect(&b.args.0, 0);
@@ -419,7 +431,7 @@ impl Technique for Tessellation {
         let size = graph.output_size();
         let u = TessUniforms::from_params(params, size);
         self.ensure_buffers(u.grid);
-        self.ensure_targets(size);
+        self.ensure_targets(size, if params.choice("msaa") == 1 { MSAA } else { 1 });
         self.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
         self.last = Some(u);
         self.draw_groups.get_mut().begin_frame();

@@ -11,6 +11,8 @@ pub const PLANE_SIZE: f32 = 10.0;
 
 /// View modes.
 pub const VIEWS: &[&str] = &["shaded", "wireframe", "level"];
+/// Multisampling choices (index 1 = 4×).
+pub const MSAA_MODES: &[&str] = &["off", "4x"];
 /// Which channel of the input is the height.
 pub const CHANNELS: &[&str] = &["red", "luminance"];
 
@@ -24,6 +26,12 @@ pub fn params() -> Vec<ParamDecl> {
         ParamDecl::new("inward", Bool(false), None, "displace against the normal (the sample's V/F shader)"),
         ParamDecl::choice("height_channel", CHANNELS, 0, "which channel of the input texture is the height"),
         ParamDecl::choice("view", VIEWS, 0, "shaded, wireframe over shading, or tessellation level as colour"),
+        ParamDecl::choice(
+            "msaa",
+            MSAA_MODES,
+            1,
+            "samples per pixel: 4× smooths edges; off is faster where fill is slow",
+        ),
         ParamDecl::new("camera_distance", Float(10.0), Some((1.0, 100.0)), "camera distance from the origin"),
         ParamDecl::new("camera_yaw", Float(0.0), Some((-180.0, 180.0)), "camera orbit about y").with_unit("°"),
         ParamDecl::new("camera_pitch", Float(0.0), Some((-89.0, 89.0)), "camera orbit elevation").with_unit("°"),
