@@ -162,6 +162,24 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
     }
 }
 
+/// Most steps a render or bench may seek through (≈ 190 days at 60 fps): beyond it a seek
+/// would run for hours, so it is refused with a sentence instead.
+const MAX_START: u64 = 1_000_000_000;
+
+/// Checks `--start`, `--frames` and `--dt`: one sentence for each bad value.
+fn check_timing(start: u64, frames: u64, dt: Option<f32>) -> Result<(), String> {
+    if start > MAX_START {
+        return Err(format!("--start {start} is past {MAX_START} steps; split the render or lower it"));
+    }
+    if frames > MAX_START {
+        return Err(format!("--frames {frames} is more than {MAX_START}; render in parts"));
+    }
+    if let Some(dt) = dt.filter(|dt| !(dt.is_finite() && *dt > 0.0 && *dt <= 1.0)) {
+        return Err(format!("--dt {dt} must be a number of seconds in (0, 1], e.g. 0.0166667"));
+    }
+    Ok(())
+}
+
 /// Loads a scene and applies `--set` assignments.
 fn scene_with_sets(assets: &Assets, name: &str, sets: &[String]) -> Result<Scene, String> {
     let mut scene = load_scene(assets, name).map_err(|e| e.to_string())?;
@@ -202,6 +220,7 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
 
 /// Renders a PNG sequence.
 pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<(), String> {
+    check_timing(args.start, args.frames, args.dt)?;
     let scene = scene_with_sets(assets, &args.scene, &args.sets)?;
     let script = match &args.replay {
         Some(path) => indra::control::record::read_replay(path, &scene)?,
@@ -311,6 +330,7 @@ pub fn list(assets: &Assets) -> Result<(), String> {
 
 /// Renders `frames` frames and prints per-pass GPU medians and frame time.
 pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), String> {
+    check_timing(args.start, args.frames.saturating_add(args.warmup), None)?;
     let scene = scene_with_sets(assets, &args.scene, &args.sets)?;
     let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
     let adapter = device.adapter_label();

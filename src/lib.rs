@@ -2,13 +2,14 @@
 //! techniques of *Unity Graphics Programming vol.4* with wgpu.
 //!
 //! Layers, from the bottom (a layer never imports one above it; see `DESIGN.md`):
-//! [`time`] and [`assets`] → [`gpu`] → [`graph`] → [`params`] → [`techniques`] → [`scene`] →
+//! [`time`], [`assets`] and [`atomic_file`] → [`gpu`] → [`graph`] → [`params`] → [`techniques`] → [`scene`] →
 //! [`offscreen`] / [`app`]; `main.rs` is the command line only.
 
 #![warn(missing_docs)]
 
 pub mod app;
 pub mod assets;
+pub mod atomic_file;
 pub mod control;
 pub mod geometry;
 

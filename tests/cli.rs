@@ -163,6 +163,25 @@ fn bench_prints_pass_medians_and_frame_time() {
 }
 
 #[test]
+fn bad_numbers_get_one_sentence_and_a_non_zero_exit() {
+    let out = temp_dir("bad-numbers");
+    let dir = out.to_str().unwrap();
+    for (args, expect) in [
+        (vec!["render", "kleinian", "--dt", "nan", "--out", dir], "--dt"),
+        (vec!["render", "kleinian", "--dt", "0", "--out", dir], "--dt"),
+        (vec!["render", "kleinian", "--start", "18446744073709551615", "--frames", "2", "--out", dir], "--start"),
+        (vec!["bench", "kleinian", "--frames", "18446744073709551615"], "--frames"),
+        (vec!["render", "kleinian", "--set", "limit_set.scale=NaN", "--out", dir], "finite"),
+        (vec!["render", "kleinian", "--set", "limit_set.hit_color=(1.0, inf, 0.0)", "--out", dir], "finite"),
+    ] {
+        let o = indra(&args);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {}", text(&o));
+        let t = text(&o);
+        assert!(t.contains(expect) && !t.contains("panicked"), "{args:?}: {t}");
+    }
+}
+
+#[test]
 fn bad_input_gets_one_clear_sentence() {
     let missing = indra(&["render", "no_such_scene"]);
     assert_eq!(missing.status.code(), Some(1));

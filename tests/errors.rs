@@ -71,3 +71,20 @@ fn set_takes_a_vector_as_a_scene_file_writes_it() {
     let e = scene.set_from_str("limit_set.t=(1.9, x)").unwrap_err();
     assert!(e.contains("'x'") && e.contains("(1.0, 0.5)"), "{e}");
 }
+
+#[test]
+fn nan_from_a_live_source_is_refused_once_with_a_message() {
+    use indra::params::{ParamWrite, Source};
+    let scene = load_scene(&common::assets(), "kleinian").unwrap();
+    let mut instance = indra::scene::SceneInstance::new(&common::gpu(), &common::assets(), scene, (32, 32)).unwrap();
+    let colour = instance.params(0).index("hit_color").unwrap();
+    let before = instance.params(0).target_at(colour);
+    let nan = ParamValue::Color([1.0, f32::NAN, 0.0, 1.0]);
+    let write =
+        ControlEvent::Write(ParamWrite { node: 0, param: colour, component: None, value: nan, source: Source::Osc });
+    instance.apply(&[write.clone(), write]);
+    assert_eq!(instance.params(0).target_at(colour), before, "an unbounded colour keeps its value");
+    let messages = instance.take_messages();
+    assert_eq!(messages.len(), 1, "{messages:?}");
+    assert!(messages[0].contains("limit_set.hit_color") && messages[0].contains("finite"), "{}", messages[0]);
+}

@@ -362,7 +362,8 @@ impl LearnStore {
         let learned: Vec<&MidiMapping> =
             mapper.bindings().iter().map(|b| &b.mapping).filter(|m| !scene.midi.iter().any(|(s, _)| s == *m)).collect();
         let text = ron::ser::to_string_pretty(&learned, Default::default()).map_err(|e| e.to_string())?;
-        std::fs::write(&self.path, text).map_err(|e| format!("cannot write {}: {e}", self.path.display()))
+        crate::atomic_file::write(&self.path, text.as_bytes())
+            .map_err(|e| format!("cannot write {}: {e}", self.path.display()))
     }
 }
 

@@ -51,7 +51,8 @@ impl PresetStore {
         let text = ron::ser::to_string_pretty(&file, Default::default()).map_err(|e| e.to_string())?;
         std::fs::create_dir_all(&self.dir).map_err(|e| format!("cannot create {}: {e}", self.dir.display()))?;
         let path = self.dir.join(format!("{name}.ron"));
-        std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        crate::atomic_file::write(&path, text.as_bytes())
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         Ok(path)
     }
 

@@ -39,8 +39,13 @@ impl ParamSet {
     }
 
     /// Sets parameter `i`'s target, converting to its type and clamping to its range. Without
-    /// smoothing (or for discrete types) the value follows at once.
-    pub fn set_at(&mut self, i: usize, value: ParamValue) {
+    /// smoothing (or for discrete types) the value follows at once. A value with a NaN or
+    /// infinite component is refused (the parameter keeps its value; returns false): every
+    /// source — OSC, MIDI, `--set`, presets, replays, tracks — writes through here.
+    pub fn set_at(&mut self, i: usize, value: ParamValue) -> bool {
+        if value.components().iter().any(|c| !c.is_finite()) {
+            return false;
+        }
         let decl = &self.decls[i];
         let typed =
             if value.ty() == decl.ty() { value } else { ParamValue::from_components(decl.ty(), &value.components()) };
@@ -48,15 +53,17 @@ impl ParamSet {
         if decl.smoothing <= 0.0 || !decl.is_smoothable() {
             self.values[i] = self.targets[i];
         }
+        true
     }
 
-    /// Sets one float component of parameter `i`'s target (tracks on `t.x`, OSC on `/t/x`).
-    pub fn set_component(&mut self, i: usize, component: usize, x: f32) {
+    /// Sets one float component of parameter `i`'s target (tracks on `t.x`, OSC on `/t/x`);
+    /// false if refused (not finite).
+    pub fn set_component(&mut self, i: usize, component: usize, x: f32) -> bool {
         let mut c = self.targets[i].components();
         if let Some(slot) = c.get_mut(component) {
             *slot = x;
         }
-        self.set_at(i, ParamValue::from_components(self.decls[i].ty(), &c));
+        self.set_at(i, ParamValue::from_components(self.decls[i].ty(), &c))
     }
 
     /// Moves smoothed values towards their targets over `dt` seconds: an exponential approach
@@ -179,6 +186,16 @@ mod tests {
         let mut q = set(0.0);
         q.set_at(0, ParamValue::Float(4.0));
         assert_eq!(q.float("x"), 4.0);
+    }
+
+    #[test]
+    fn nan_and_infinity_never_get_in() {
+        let mut p = set(0.0);
+        p.set_at(0, ParamValue::Float(4.0));
+        assert!(!p.set_at(0, ParamValue::Float(f32::NAN)));
+        assert!(!p.set_at(0, ParamValue::Float(f32::INFINITY)));
+        p.set_component(0, 0, f32::NEG_INFINITY);
+        assert_eq!(p.float("x"), 4.0, "the last finite value stays");
     }
 
     #[test]

@@ -27,6 +27,9 @@ pub struct SceneInstance {
     overridden: BTreeSet<(usize, usize)>,
     morph: Option<Morph>,
     pending_morph: Option<(NodeValues, f64)>,
+    /// Parameters a non-finite value was refused for (each told once), and the messages.
+    refused: BTreeSet<(usize, usize)>,
+    messages: Vec<String>,
 }
 
 impl SceneInstance {
@@ -38,7 +41,17 @@ impl SceneInstance {
             .map(|n| (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size }))
             .collect::<Result<Vec<_>, _>>()?;
         let params = scene.nodes.iter().map(|n| n.params.clone()).collect();
-        Ok(Self { scene, params, nodes, animate: true, overridden: BTreeSet::new(), morph: None, pending_morph: None })
+        Ok(Self {
+            scene,
+            params,
+            nodes,
+            animate: true,
+            overridden: BTreeSet::new(),
+            morph: None,
+            pending_morph: None,
+            refused: BTreeSet::new(),
+            messages: Vec::new(),
+        })
     }
 
     /// The validated scene.
@@ -86,9 +99,17 @@ impl SceneInstance {
         if w.param >= params.decls().len() {
             return;
         }
-        match w.component {
-            Some(c) => params.set_component(w.param, c, w.value.components()[0]),
+        let accepted = match w.component {
+            Some(c) => params.set_component(w.param, c, w.value.components().first().copied().unwrap_or(f32::NAN)),
             None => params.set_at(w.param, w.value),
+        };
+        if !accepted {
+            if self.refused.insert((w.node, w.param)) {
+                let (node, decl) = (&self.scene.nodes[w.node].id, &params.decls()[w.param].name);
+                self.messages
+                    .push(format!("{node}.{decl}: a value that is not a finite number was refused ({:?})", w.source));
+            }
+            return;
         }
         let live = matches!(w.source, Source::Ui | Source::Osc | Source::Midi | Source::Replay);
         if live && self.has_track(w.node, w.param) {
@@ -105,10 +126,11 @@ impl SceneInstance {
                 }
                 let value = bound.track.sample(time.seconds);
                 let params = &mut self.params[bound.node];
-                match bound.component {
+                // Track values come from validated keys: always finite.
+                let _ = match bound.component {
                     Some(c) => params.set_component(bound.param, c, value.components()[0]),
                     None => params.set_at(bound.param, value),
-                }
+                };
             }
         }
         if let Some((values, seconds)) = self.pending_morph.take() {
@@ -235,11 +257,14 @@ impl SceneInstance {
     /// What the techniques want the performer to know since the last call, prefixed by node id.
     pub fn take_messages(&mut self) -> Vec<String> {
         let ids = self.scene.nodes.iter().map(|n| n.id.as_str());
-        self.nodes
-            .iter_mut()
-            .zip(ids)
-            .flat_map(|(n, id)| n.take_messages().into_iter().map(move |m| format!("{id}: {m}")))
-            .collect()
+        let mut messages = std::mem::take(&mut self.messages);
+        messages.extend(
+            self.nodes
+                .iter_mut()
+                .zip(ids)
+                .flat_map(|(n, id)| n.take_messages().into_iter().map(move |m| format!("{id}: {m}"))),
+        );
+        messages
     }
 
     /// Writes for a key press: every trigger declared with [`InputRole::Key`] for this letter

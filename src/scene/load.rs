@@ -109,18 +109,21 @@ impl Scene {
             assignment.split_once('=').ok_or_else(|| format!("'{assignment}' is not of the form node.param=value"))?;
         let t = resolve_target(&self.nodes, target).map_err(|e| format!("scene '{}': {e}", self.name))?;
         let params = &mut self.nodes[t.node].params;
-        match t.component {
+        let accepted = match t.component {
             Some(c) => {
                 let x = value
                     .trim()
                     .parse::<f32>()
                     .map_err(|_| format!("'{value}' is not a number (a component takes one)"))?;
-                params.set_component(t.param, c, x);
+                params.set_component(t.param, c, x)
             }
             None => {
                 let typed = parse_value_override(value, &params.decls()[t.param])?;
-                params.set_at(t.param, typed);
+                params.set_at(t.param, typed)
             }
+        };
+        if !accepted {
+            return Err(format!("'{value}' is not a finite number ({target})"));
         }
         params.snap();
         Ok(())
