@@ -272,15 +272,18 @@ impl Technique for Poisson {
 }
 
 /// 2-D: orthographic, top-down, the rectangle fitted with a 5% margin. 3-D: perspective (60°),
-/// orbiting the box at 0.8 × its diagonal, slightly from above.
+/// orbiting the box slightly from above, far enough that the box's bounding sphere (and the
+/// spheres drawn at its corners) fits the narrower field of view at every angle.
 fn camera(key: &RunKey, params: &ParamSet, time: &FrameTime, aspect: f32, count: usize) -> PoissonUniforms {
     use glam::Vec3;
     let draw_radius = key.radius * params.float("draw_scale") / 2.0;
     let (view_proj, right, up) = if key.three_d {
         let diagonal = Vec3::from(key.extent).length();
         let angle = (params.float("orbit_speed") * time.seconds as f32).to_radians();
-        // Close enough that the box fills about two thirds of the 60° view (corners may leave it).
-        let eye = Vec3::new(angle.sin(), 0.35, -angle.cos()).normalize() * 0.8 * diagonal;
+        let half_fov = 30f32.to_radians();
+        let narrowest = half_fov.min((half_fov.tan() * aspect).atan());
+        let distance = (diagonal / 2.0 + draw_radius) / narrowest.sin() * 1.02;
+        let eye = Vec3::new(angle.sin(), 0.35, -angle.cos()).normalize() * distance;
         let view = glam::camera::lh::view::look_at_mat4(eye, Vec3::ZERO, Vec3::Y);
         let proj =
             glam::camera::lh::proj::directx::perspective(60f32.to_radians(), aspect, diagonal * 0.05, diagonal * 5.0);
@@ -307,6 +310,31 @@ fn camera(key: &RunKey, params: &ParamSet, time: &FrameTime, aspect: f32, count:
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_whole_box_stays_in_view_at_every_orbit_angle() {
+        let mut p = ParamSet::new(params());
+        p.set_at(p.index("dimensions").unwrap(), crate::params::ParamValue::Enum(1));
+        p.set_at(p.index("extent").unwrap(), crate::params::ParamValue::Vec3([200.0, 200.0, 200.0]));
+        let key = RunKey::of(&p);
+        for aspect in [16.0 / 9.0, 1.0, 9.0 / 16.0] {
+            for frame in (0..7200).step_by(50) {
+                let time = FrameTime { frame, seconds: frame as f64 / 60.0, dt: 1.0 / 60.0, seed: 1 };
+                let u = camera(&key, &p, &time, aspect, 0);
+                let view_proj = glam::Mat4::from_cols_array_2d(&u.view_proj);
+                for corner in 0..8 {
+                    let c = glam::Vec3::new(
+                        if corner & 1 == 0 { -100.0 } else { 100.0 },
+                        if corner & 2 == 0 { -100.0 } else { 100.0 },
+                        if corner & 4 == 0 { -100.0 } else { 100.0 },
+                    );
+                    let clip = view_proj * c.extend(1.0);
+                    let (x, y) = (clip.x / clip.w, clip.y / clip.w);
+                    assert!(x.abs() <= 1.0 && y.abs() <= 1.0, "aspect {aspect}, frame {frame}: corner {c} at ({x}, {y})");
+                }
+            }
+        }
+    }
 
     #[test]
     fn uniform_layout_matches_the_wgsl_struct() {
