@@ -386,6 +386,47 @@ fn oscquery_serves_every_parameter_with_type_range_and_value() {
     assert_eq!(status, 404);
 }
 
+/// Sends raw bytes, returns the status of the reply (0 if the connection was just closed).
+fn http_raw(addr: std::net::SocketAddr, request: &[u8]) -> u16 {
+    use std::io::{Read, Write};
+    let mut s = std::net::TcpStream::connect(addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+    let _ = s.write_all(request);
+    let mut response = Vec::new();
+    let _ = s.read_to_end(&mut response);
+    String::from_utf8_lossy(&response).get(9..12).and_then(|c| c.parse().ok()).unwrap_or(0)
+}
+
+#[test]
+fn oscquery_survives_hostile_http() {
+    use std::io::{Read, Write};
+    let server = OscQueryServer::start("127.0.0.1:0", 9000).unwrap();
+    let addr = server.local_addr();
+    // The request that aborted the show: a body of 99,999,999,999 bytes declared (never sent).
+    assert_eq!(http_raw(addr, b"GET / HTTP/1.1\r\nContent-Length: 99999999999\r\n\r\n"), 413);
+    assert_eq!(http_raw(addr, b"POST / HTTP/1.1\r\nContent-Length: 3\r\n\r\nabc"), 405);
+    // 100 KB of headers: refused without reading on.
+    let mut huge = b"GET / HTTP/1.1\r\n".to_vec();
+    huge.extend(std::iter::repeat_n(b"X-Pad: aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa\r\n".as_slice(), 2000).flatten());
+    assert_eq!(http_raw(addr, &huge), 431);
+    // A client that stalls half-way through its headers does not hold up anyone else.
+    let mut stalled = std::net::TcpStream::connect(addr).unwrap();
+    stalled.write_all(b"GET / HTTP/1.1\r\nHost: x\r\n").unwrap();
+    let started = Instant::now();
+    assert_eq!(http_get(addr, "/?HOST_INFO").0, 200);
+    assert!(started.elapsed() < Duration::from_secs(1), "a stalled client delayed another one");
+    // It is dropped after the timeout instead of holding a thread forever.
+    stalled.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+    let mut rest = Vec::new();
+    let closed = stalled.read_to_end(&mut rest).is_ok();
+    assert!(closed && String::from_utf8_lossy(&rest).contains("400"), "{}", String::from_utf8_lossy(&rest));
+    // A hundred idle connections: the server stays up and answers once they time out.
+    let idle: Vec<_> = (0..100).map(|_| std::net::TcpStream::connect(addr).unwrap()).collect();
+    std::thread::sleep(Duration::from_millis(2500));
+    assert_eq!(http_get(addr, "/?HOST_INFO").0, 200);
+    drop(idle);
+}
+
 #[test]
 fn stats_are_answered_over_osc() {
     let mut rx = OscReceiver::bind("127.0.0.1:0").unwrap();

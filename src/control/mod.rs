@@ -6,6 +6,7 @@
 
 pub mod address;
 pub mod feedback;
+pub mod http;
 pub mod hub;
 pub mod midi;
 pub mod osc;

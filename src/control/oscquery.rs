@@ -3,14 +3,12 @@
 //! TouchOSC-style clients discover every parameter. The render loop publishes snapshots; the
 //! server thread only reads them.
 
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, RwLock};
-use std::thread::JoinHandle;
-use std::time::Duration;
 
 use serde_json::{Map, Value, json};
 
 use super::address::param_address;
+use super::http::HttpServer;
 use crate::params::{ParamDecl, ParamType, ParamValue};
 use crate::scene::SceneInstance;
 
@@ -92,35 +90,38 @@ pub fn subtree<'a>(tree: &'a Value, path: &str) -> Option<&'a Value> {
     path.split('/').filter(|s| !s.is_empty()).try_fold(tree, |node, part| node.get("CONTENTS")?.get(part))
 }
 
-/// The HTTP server thread.
+/// The OSCQuery endpoint: the published tree, served over HTTP.
 pub struct OscQueryServer {
     snapshot: Arc<RwLock<Value>>,
-    local: std::net::SocketAddr,
-    stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<()>>,
+    server: HttpServer,
 }
 
 impl OscQueryServer {
-    /// Serves on `addr` (port 0 picks one), advertising `osc_port` in HOST_INFO.
+    /// Serves on `addr` (port 0 picks one), advertising `osc_port` in HOST_INFO. The server has
+    /// hard limits (see [`super::http`]): no request can exhaust memory or hold up the others.
     pub fn start(addr: &str, osc_port: u16) -> Result<Self, String> {
-        let server = tiny_http::Server::http(addr).map_err(|e| format!("cannot serve OSCQuery on {addr}: {e}"))?;
-        let local = server.server_addr().to_ip().ok_or("OSCQuery server has no IP address")?;
         let snapshot = Arc::new(RwLock::new(json!({ "FULL_PATH": "/", "CONTENTS": {} })));
-        let stop = Arc::new(AtomicBool::new(false));
-        let thread = {
-            let (snapshot, stop) = (snapshot.clone(), stop.clone());
-            std::thread::Builder::new()
-                .name("indra-oscquery".into())
-                .spawn(move || serve(&server, &snapshot, &stop, osc_port))
-                .map_err(|e| e.to_string())?
-        };
-        log::info!("OSCQuery on http://{local}/");
-        Ok(Self { snapshot, local, stop, thread: Some(thread) })
+        let tree = snapshot.clone();
+        let handler = Arc::new(move |target: &str| {
+            let (path, query) = target.split_once('?').unwrap_or((target, ""));
+            let body = if query.contains("HOST_INFO") {
+                Some(host_info(osc_port))
+            } else {
+                tree.read().ok().and_then(|t| subtree(&t, path).cloned())
+            };
+            match body {
+                Some(v) => (200, v.to_string()),
+                None => (404, "{}".to_string()),
+            }
+        });
+        let server = HttpServer::start(addr, "oscquery", handler)?;
+        log::info!("OSCQuery on http://{}/", server.local_addr());
+        Ok(Self { snapshot, server })
     }
 
     /// The bound address.
     pub fn local_addr(&self) -> std::net::SocketAddr {
-        self.local
+        self.server.local_addr()
     }
 
     /// Publishes the current tree.
@@ -129,33 +130,5 @@ impl OscQueryServer {
         if let Ok(mut s) = self.snapshot.write() {
             *s = t;
         }
-    }
-}
-
-impl Drop for OscQueryServer {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(t) = self.thread.take() {
-            let _ = t.join();
-        }
-    }
-}
-
-fn serve(server: &tiny_http::Server, snapshot: &RwLock<Value>, stop: &AtomicBool, osc_port: u16) {
-    while !stop.load(Ordering::Relaxed) {
-        let Ok(Some(request)) = server.recv_timeout(Duration::from_millis(100)) else { continue };
-        let url = request.url().to_string();
-        let (path, query) = url.split_once('?').unwrap_or((&url, ""));
-        let body = if query.contains("HOST_INFO") {
-            Some(host_info(osc_port))
-        } else {
-            snapshot.read().ok().and_then(|t| subtree(&t, path).cloned())
-        };
-        let header = tiny_http::Header::from_bytes("Content-Type", "application/json").expect("valid header");
-        let response = match body {
-            Some(v) => tiny_http::Response::from_string(v.to_string()).with_header(header),
-            None => tiny_http::Response::from_string("{}").with_status_code(404).with_header(header),
-        };
-        let _ = request.respond(response);
     }
 }

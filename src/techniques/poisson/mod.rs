@@ -330,7 +330,10 @@ mod tests {
                     );
                     let clip = view_proj * c.extend(1.0);
                     let (x, y) = (clip.x / clip.w, clip.y / clip.w);
-                    assert!(x.abs() <= 1.0 && y.abs() <= 1.0, "aspect {aspect}, frame {frame}: corner {c} at ({x}, {y})");
+                    assert!(
+                        x.abs() <= 1.0 && y.abs() <= 1.0,
+                        "aspect {aspect}, frame {frame}: corner {c} at ({x}, {y})"
+                    );
                 }
             }
         }
