@@ -96,7 +96,9 @@ fn vs_debug(@builtin(vertex_index) particle: u32, @builtin(instance_index) kind:
     );
     var out: Flat;
     out.clip = view.view_proj * vec4<f32>(positions[particle].xyz, 1.0);
-    out.color = colors[min(kind, 3u)];
+    // Lines and points add up (one + one): each at a fraction of full intensity, so that where
+    // hundreds overlap the kinds still read as colours instead of saturating to white.
+    out.color = colors[min(kind, 3u)] * 0.3;
     return out;
 }
 

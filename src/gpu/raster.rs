@@ -52,6 +52,9 @@ pub struct RasterDesc<'a> {
     pub color: wgpu::TextureFormat,
     /// Depth format and test, with depth writes; `None` for no depth.
     pub depth: Option<(wgpu::TextureFormat, wgpu::CompareFunction)>,
+    /// Add to the target (one + one) without writing depth, so overlapping lines all show
+    /// (debug views, the book's additive line looks); false: opaque with depth writes.
+    pub additive: bool,
 }
 
 /// A render pipeline from `module` with `layout`. Call inside [`super::validated`] so that a
@@ -75,12 +78,23 @@ pub fn raster_pipeline(
             module,
             entry_point: Some(desc.fragment),
             compilation_options: Default::default(),
-            targets: &[Some(desc.color.into())],
+            targets: &[Some(wgpu::ColorTargetState {
+                format: desc.color,
+                blend: desc.additive.then(|| wgpu::BlendState {
+                    color: wgpu::BlendComponent {
+                        src_factor: wgpu::BlendFactor::One,
+                        dst_factor: wgpu::BlendFactor::One,
+                        operation: wgpu::BlendOperation::Add,
+                    },
+                    alpha: wgpu::BlendComponent::REPLACE,
+                }),
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
         }),
         primitive: wgpu::PrimitiveState { topology: desc.topology, ..Default::default() },
         depth_stencil: desc.depth.map(|(format, compare)| wgpu::DepthStencilState {
             format,
-            depth_write_enabled: Some(true),
+            depth_write_enabled: Some(!desc.additive),
             depth_compare: Some(compare),
             stencil: Default::default(),
             bias: Default::default(),

@@ -121,7 +121,7 @@ impl Renderer {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = |vertex, fragment, topology| {
+        let pipeline = |vertex, fragment, topology, additive| {
             crate::gpu::raster_pipeline(
                 device,
                 &module,
@@ -133,17 +133,19 @@ impl Renderer {
                     topology,
                     color: super::FORMAT,
                     depth: Some((DEPTH, wgpu::CompareFunction::LessEqual)),
+                    additive,
                 },
             )
         };
         use wgpu::PrimitiveTopology as T;
         let (surface, sphere, lines, points, insets) = crate::gpu::validated(device, &origin, || {
             (
-                pipeline("vs_surface", "fs_surface", T::TriangleList),
-                pipeline("vs_sphere", "fs_sphere", T::TriangleList),
-                pipeline("vs_debug", "fs_debug", T::LineList),
-                pipeline("vs_debug", "fs_debug", T::PointList),
-                pipeline("vs_inset", "fs_inset", T::TriangleList),
+                pipeline("vs_surface", "fs_surface", T::TriangleList, false),
+                pipeline("vs_sphere", "fs_sphere", T::TriangleList, false),
+                // Springs and particles add up, as the book draws them: no kind hides another.
+                pipeline("vs_debug", "fs_debug", T::LineList, true),
+                pipeline("vs_debug", "fs_debug", T::PointList, true),
+                pipeline("vs_inset", "fs_inset", T::TriangleList, false),
             )
         })?;
         let uniform = crate::gpu::uniform_buffer::<ClothViewUniforms>(device, "cloth_view");

@@ -138,6 +138,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
                 topology: wgpu::PrimitiveTopology::TriangleList,
                 color: FORMAT,
                 depth: Some((DEPTH, wgpu::CompareFunction::Less)),
+                additive: false,
             },
         )
     })?;

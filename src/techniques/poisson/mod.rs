@@ -181,6 +181,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
                 topology: wgpu::PrimitiveTopology::TriangleList,
                 color: FORMAT,
                 depth: Some((DEPTH, wgpu::CompareFunction::Less)),
+                additive: false,
             },
         )
     })?;

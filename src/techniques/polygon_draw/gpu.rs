@@ -91,6 +91,7 @@ impl Renderer {
                     topology,
                     color: FORMAT,
                     depth: None,
+                    additive: false,
                 },
             )
         };
