@@ -80,7 +80,7 @@ pub fn raster_pipeline(
             compilation_options: Default::default(),
             targets: &[Some(wgpu::ColorTargetState {
                 format: desc.color,
-                blend: desc.additive.then(|| wgpu::BlendState {
+                blend: desc.additive.then_some(wgpu::BlendState {
                     color: wgpu::BlendComponent {
                         src_factor: wgpu::BlendFactor::One,
                         dst_factor: wgpu::BlendFactor::One,
