@@ -16,8 +16,12 @@ pub struct Overlay {
     pub stats: Option<FrameStats>,
     /// Rolling per-pass GPU medians.
     pub timings: Vec<PassTiming>,
-    /// Distinct errors with how often each happened; each is logged once.
+    /// Distinct errors with how often each happened; each is logged once. At most
+    /// [`MAX_SHOWN_ERRORS`], newest kept: a flood of distinct failures cannot grow memory.
     errors: Vec<(String, u32)>,
+    /// Errors pushed out of the list, and distinct errors logged so far.
+    errors_dropped: u64,
+    errors_logged: u64,
     /// Name typed for saving a preset.
     pub preset_name: String,
     /// Seconds a preset recall morphs over (0: instant).
@@ -31,6 +35,8 @@ impl Default for Overlay {
             stats: None,
             timings: Vec::new(),
             errors: Vec::new(),
+            errors_dropped: 0,
+            errors_logged: 0,
             preset_name: "preset-1".into(),
             morph_seconds: 0.0,
         }
@@ -41,19 +47,41 @@ impl Overlay {
     /// Forgets shown errors (after a fix was picked up).
     pub fn clear_errors(&mut self) {
         self.errors.clear();
+        self.errors_dropped = 0;
     }
 
     /// Records an error: logged the first time, counted after that, shown until dismissed.
+    /// Long messages are cut; past [`MAX_SHOWN_ERRORS`] the oldest make room (and are counted),
+    /// and past [`MAX_LOGGED_ERRORS`] distinct ones are no longer logged.
     pub fn report(&mut self, message: String) {
-        match self.errors.iter_mut().find(|(m, _)| *m == message) {
-            Some((_, count)) => *count += 1,
-            None => {
-                log::error!("{message}");
-                self.errors.push((message, 1));
-            }
+        let message = match message.char_indices().nth(MAX_ERROR_CHARS) {
+            Some((cut, _)) => format!("{}…", &message[..cut]),
+            None => message,
+        };
+        if let Some((_, count)) = self.errors.iter_mut().find(|(m, _)| *m == message) {
+            *count = count.saturating_add(1);
+            return;
         }
+        self.errors_logged += 1;
+        if self.errors_logged <= MAX_LOGGED_ERRORS {
+            log::error!("{message}");
+        } else if self.errors_logged == MAX_LOGGED_ERRORS + 1 {
+            log::error!("{MAX_LOGGED_ERRORS} distinct errors logged; further ones are only shown");
+        }
+        if self.errors.len() == MAX_SHOWN_ERRORS {
+            self.errors.remove(0);
+            self.errors_dropped += 1;
+        }
+        self.errors.push((message, 1));
     }
 }
+
+/// Distinct errors the overlay lists at once.
+pub const MAX_SHOWN_ERRORS: usize = 20;
+/// Distinct errors logged before the log only gets a count.
+pub const MAX_LOGGED_ERRORS: u64 = 200;
+/// Longest error shown, in characters.
+pub const MAX_ERROR_CHARS: usize = 400;
 
 /// Draws the whole overlay for one frame; returns the control events the performer made.
 pub fn draw_ui(
@@ -92,6 +120,9 @@ pub fn draw_ui(
     if !overlay.errors.is_empty() {
         let mut dismiss = false;
         egui::Window::new("errors").anchor(egui::Align2::RIGHT_BOTTOM, [-8.0, -8.0]).show(ui.ctx(), |ui| {
+            if overlay.errors_dropped > 0 {
+                ui.label(format!("({} older errors not shown)", overlay.errors_dropped));
+            }
             for (message, count) in &overlay.errors {
                 let suffix = if *count > 1 { format!("  (×{count})") } else { String::new() };
                 ui.colored_label(egui::Color32::from_rgb(255, 110, 110), format!("{message}{suffix}"));
@@ -99,7 +130,7 @@ pub fn draw_ui(
             dismiss = ui.button("dismiss").clicked();
         });
         if dismiss {
-            overlay.errors.clear();
+            overlay.clear_errors();
         }
     }
     events
@@ -277,5 +308,23 @@ fn timing_panel(ui: &mut egui::Ui, overlay: &Overlay) {
             s.transient_bytes_requested / 1024,
             s.compile_time.as_secs_f64() * 1e6
         ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_flood_of_distinct_errors_keeps_the_overlay_bounded() {
+        let mut overlay = Overlay::default();
+        for i in 0..10_000 {
+            overlay.report(format!("preset '{i}' not found {}", "x".repeat(1000)));
+            overlay.report(format!("preset '{i}' not found {}", "x".repeat(1000)));
+        }
+        assert_eq!(overlay.errors.len(), MAX_SHOWN_ERRORS);
+        assert_eq!(overlay.errors_dropped, 10_000 - MAX_SHOWN_ERRORS as u64);
+        assert!(overlay.errors.iter().all(|(m, n)| m.chars().count() <= MAX_ERROR_CHARS + 1 && *n == 2));
+        assert!(overlay.errors.last().unwrap().0.starts_with("preset '9999'"), "the newest are kept");
     }
 }
