@@ -11,7 +11,7 @@ mod raster;
 mod readback;
 mod shader;
 
-pub use binding::{check_bindings, uniform_buffer, uniform_entry, wgsl_struct_size};
+pub use binding::{check_bindings, storage_entry, uniform_buffer, uniform_entry, wgsl_struct_size};
 pub use blit::{Blit, BlitTarget, DISPLAY_FORMAT};
 pub use cache::{BindGroupCache, DEFAULT_MAX_AGE};
 pub use compute::ComputeKernel;

@@ -98,16 +98,7 @@ impl Renderer {
         let (origin, source) =
             setup.shader_source("cloth_render.wgsl", &[("view", 0), ("positions", 1), ("normals", 2)])?;
         let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
-        let storage = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
+        let storage = |binding| crate::gpu::storage_entry(binding, wgpu::ShaderStages::VERTEX_FRAGMENT, true);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cloth_draw_layout"),
             entries: &[

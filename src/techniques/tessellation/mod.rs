@@ -22,7 +22,7 @@ pub use params::{
 
 use std::cell::RefCell;
 
-use crate::gpu::{BindGroupCache, ComputeKernel, ShaderError};
+use crate::gpu::{BindGroupCache, ComputeKernel, ShaderError, storage_entry as storage};
 use crate::graph::{BufferHandle, FrameGraph, PassContext, TextureDesc, TextureHandle};
 use crate::params::ParamSet;
 use crate::time::FrameTime;
@@ -92,19 +92,6 @@ pub struct Tessellation {
 
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     Ok(Box::new(Tessellation::new(setup)?))
-}
-
-fn storage(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
 }
 
 impl Tessellation {
