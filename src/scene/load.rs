@@ -149,6 +149,9 @@ pub fn parse_value_override(text: &str, decl: &ParamDecl) -> Result<ParamValue, 
         "true" => RawValue::Bool(true),
         "false" => RawValue::Bool(false),
         name if ty == ParamType::Enum && decl.option_index(name).is_some() => RawValue::Text(name.into()),
+        name if ty == ParamType::Enum && name.parse::<f64>().is_err() => {
+            return Err(format!("'{name}' is not one of {}", decl.options.join(", ")));
+        }
         list => RawValue::List(
             list.trim_end_matches(',')
                 .split(',')
@@ -199,20 +202,42 @@ pub fn parse_scene(origin: &str, source: &str) -> Result<Scene, SceneErrors> {
             message: e.code.to_string(),
         }])
     })?;
-    Validator { origin, source, errors: Vec::new() }.validate(file)
+    Validator { origin, source, errors: Vec::new(), more: 0 }.validate(file)
 }
+
+/// Errors located and reported per file; the rest are counted. Locating scans the source, so a
+/// file with tens of thousands of mistakes would otherwise take quadratic time to check.
+const MAX_REPORTED_ERRORS: usize = 50;
+/// Most nodes a scene may have (each builds pipelines and textures): a bound that `check` reports,
+/// rather than a render that runs out of memory.
+pub const MAX_NODES: usize = 256;
 
 /// Collects every semantic error of one file, each located by anchors.
 struct Validator<'a> {
     origin: &'a str,
     source: &'a str,
     errors: Vec<SceneError>,
+    /// Errors past [`MAX_REPORTED_ERRORS`], counted only.
+    more: usize,
 }
 
 impl Validator<'_> {
     fn error(&mut self, anchors: &[&str], message: String) {
+        if self.errors.len() >= MAX_REPORTED_ERRORS {
+            self.more += 1;
+            return;
+        }
         let (line, column) = locate(self.source, anchors);
         self.errors.push(SceneError { origin: self.origin.into(), line, column, message });
+    }
+
+    /// The errors found, with a last line counting those not reported.
+    fn failure(mut self) -> SceneErrors {
+        if self.more > 0 {
+            let message = format!("… and {} more errors (fix these first)", self.more);
+            self.errors.push(SceneError { origin: self.origin.into(), line: 1, column: 1, message });
+        }
+        SceneErrors(self.errors)
     }
 
     fn validate(mut self, file: SceneFile) -> Result<Scene, SceneErrors> {
@@ -221,6 +246,11 @@ impl Validator<'_> {
         }
         if !(file.dt > 0.0 && file.dt <= 1.0) {
             self.error(&["dt"], format!("dt {} must be in (0, 1] seconds", file.dt));
+        }
+        if file.nodes.len() > MAX_NODES {
+            let message = format!("{} nodes; a scene may have at most {MAX_NODES}", file.nodes.len());
+            self.error(&["nodes"], message);
+            return Err(self.failure());
         }
         let mut nodes = Vec::new();
         let mut seen = BTreeSet::new();
@@ -240,7 +270,7 @@ impl Validator<'_> {
             self.error(&["output", &anchor], format!("output '{}' is not a node of this scene", file.output));
         }
         if !self.errors.is_empty() || nodes.len() != file.nodes.len() {
-            return Err(SceneErrors(self.errors));
+            return Err(self.failure());
         }
         // Reorder so that inputs come first; remap input and output indices.
         let position: BTreeMap<usize, usize> = order.iter().enumerate().map(|(new, &old)| (old, new)).collect();
@@ -252,7 +282,7 @@ impl Validator<'_> {
         let tracks = self.tracks(&file, &ordered);
         let (osc_aliases, midi) = self.controls(&file, &ordered);
         if !self.errors.is_empty() {
-            return Err(SceneErrors(self.errors));
+            return Err(self.failure());
         }
         Ok(Scene {
             origin: self.origin.into(),
@@ -541,6 +571,31 @@ mod tests {
             let e = first_error(&src);
             assert!(e.message.contains("two finite numbers") && e.line > 1, "{bad}: {e}");
         }
+    }
+
+    #[test]
+    fn thousands_of_mistakes_report_fifty_and_count_the_rest() {
+        let params: Vec<String> = (0..5000).map(|i| format!("\"nope_{i}\": 1.0")).collect();
+        let src =
+            GOOD.replace("params: { \"scale\": 2.0,", &format!("params: {{ {}, \"scale\": 2.0,", params.join(", ")));
+        let errors = parse_scene("test.ron", &src).map(|_| ()).unwrap_err().0;
+        assert_eq!(errors.len(), MAX_REPORTED_ERRORS + 1);
+        assert!(errors.last().unwrap().message.contains("4950 more"), "{}", errors.last().unwrap());
+    }
+
+    #[test]
+    fn a_scene_with_too_many_nodes_is_refused_at_check_time() {
+        let nodes: Vec<String> = (0..=MAX_NODES).map(|i| format!("(id: \"k{i}\", technique: \"kleinian\")")).collect();
+        let src = format!("(name: \"many\", size: (64, 64), nodes: [{}], output: \"k0\")", nodes.join(", "));
+        let e = first_error(&src);
+        assert!(e.message.contains("at most 256"), "{e}");
+    }
+
+    #[test]
+    fn an_unknown_option_lists_the_options() {
+        let decl = ParamDecl::choice("solver", &["verlet", "xpbd"], 0, "");
+        assert_eq!(parse_value_override("Bogus", &decl).unwrap_err(), "'Bogus' is not one of verlet, xpbd");
+        assert_eq!(parse_value_override("xpbd", &decl), Ok(ParamValue::Enum(1)));
     }
 
     #[test]
