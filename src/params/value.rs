@@ -62,7 +62,11 @@ impl ParamType {
         let exact = numbers.len() == self.components();
         Some(match self {
             ParamType::Float if exact => ParamValue::Float(f(0)),
-            ParamType::Int if exact && numbers[0].fract() == 0.0 && numbers[0].abs() < 2e9 => {
+            ParamType::Int
+                if exact
+                    && numbers[0].fract() == 0.0
+                    && (f64::from(i32::MIN)..=f64::from(i32::MAX)).contains(&numbers[0]) =>
+            {
                 ParamValue::Int(numbers[0] as i32)
             }
             ParamType::Bool if exact && (numbers[0] == 0.0 || numbers[0] == 1.0) => ParamValue::Bool(numbers[0] == 1.0),
@@ -202,6 +206,19 @@ impl ParamValue {
         let Some((lo, hi)) = range else { return *self };
         if matches!(self, ParamValue::Bool(_) | ParamValue::Trigger(_) | ParamValue::Text(_)) {
             return *self;
+        }
+        // Integers clamp as integers (through f32 they would lose digits past 2²⁴).
+        let whole = |x: f32, round: fn(f32) -> f32| round(x) as i64;
+        match *self {
+            ParamValue::Int(i) => {
+                return ParamValue::Int(i64::from(i).max(whole(lo, f32::ceil)).min(whole(hi, f32::floor)) as i32);
+            }
+            ParamValue::Enum(i) => {
+                return ParamValue::Enum(
+                    i64::from(i).max(whole(lo, f32::ceil)).min(whole(hi, f32::floor)).max(0) as u32
+                );
+            }
+            _ => {}
         }
         // max/min, not clamp: a range that is somehow not finite must never panic the show.
         let c: Vec<f32> = self.components().iter().map(|x| x.max(lo).min(hi)).collect();
@@ -418,6 +435,17 @@ mod tests {
         assert_eq!((&*c, c.into_iter().count()), (&[1.0, 2.0, 3.0][..], 3));
         assert!(ParamValue::Text(Text::new("x")).components().is_empty());
         assert_eq!(&*ParamValue::Trigger(true).components(), &[1.0]);
+    }
+
+    #[test]
+    fn integers_stay_integers_to_the_ends_of_i32() {
+        assert_eq!(ParamType::Int.value_from(&[2_000_000_000.0]), Some(ParamValue::Int(2_000_000_000)));
+        assert_eq!(ParamType::Int.value_from(&[f64::from(i32::MAX)]), Some(ParamValue::Int(i32::MAX)));
+        assert_eq!(ParamType::Int.value_from(&[f64::from(i32::MAX) + 1.0]), None);
+        let odd = ParamValue::Int(16_777_217); // 2²⁴ + 1: not representable in f32
+        assert_eq!(odd.clamped(Some((1.0, 2.1e9))), odd, "in range, unchanged");
+        assert_eq!(ParamValue::Int(5).clamped(Some((1.5, 3.5))), ParamValue::Int(3));
+        assert_eq!(ParamValue::Enum(9).clamped(Some((0.0, 2.0))), ParamValue::Enum(2));
     }
 
     #[test]
