@@ -260,19 +260,8 @@ impl State {
 
     fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue, which: usize) -> Vec<[f32; 4]> {
         let size = u64::from(self.res * self.res) * 16;
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("cloth_positions_readback"),
-            size,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let mut encoder =
-            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("cloth_readback") });
-        encoder.copy_buffer_to_buffer(&self.particles[which], 0, &staging, 0, size);
-        queue.submit([encoder.finish()]);
-        staging.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping the readback"));
-        device.poll(wgpu::PollType::wait_indefinitely()).expect("device lost");
-        let data = staging.slice(..).get_mapped_range().expect("mapped").to_vec();
-        bytemuck::cast_slice(&data).to_vec()
+        crate::gpu::read_buffer(device, queue, &self.particles[which], 0, size)
+            .map(|bytes| bytemuck::cast_slice(&bytes).to_vec())
+            .unwrap_or_default()
     }
 }
