@@ -221,14 +221,13 @@ fn a_reload_that_drops_a_node_while_its_events_are_queued_learned_and_recorded()
 
     std::fs::write(&path, EDITED).unwrap();
     let mut live = LiveReload::new(&Assets::new(Some(root.clone()))).unwrap();
-    let report = live.apply(std::slice::from_ref(&path), player.instance_mut(), &gpu, (64, 64));
+    let report = live.apply(std::slice::from_ref(&path), &mut player, &gpu, (64, 64));
     assert!(report.errors.is_empty() && report.scene_changed, "{report:?}");
     let remap = report.remap.expect("a replaced scene comes with its remap");
 
     // Queued: glow's write is dropped, k's follows k to index 1.
     assert_eq!(remap.events(&mut queued), 1);
     assert_eq!(queued, [write(1, scale, ParamValue::Float(3.0))]);
-    player.remap(&remap);
     hub.set_scene(player.instance().scene(), Some(&remap));
     assert_eq!(hub.mapper.learning, None, "learn waits for a parameter that is gone: it stops");
     // Recording goes on with the new positions; a stale position is left out, never a panic.

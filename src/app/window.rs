@@ -344,7 +344,7 @@ impl Running {
     fn reload(&mut self) {
         let Some(live) = self.live.as_mut() else { return };
         let size = (self.config.width, self.config.height);
-        let report = live.poll(self.player.instance_mut(), &self.gpu, size);
+        let report = live.poll(&mut self.player, &self.gpu, size);
         for e in report.errors {
             self.overlay.report(e);
         }
@@ -360,7 +360,6 @@ impl Running {
             if dropped > 0 {
                 log::warn!("{dropped} queued control event(s) dropped: their parameters left the scene");
             }
-            self.player.remap(remap);
         }
         if report.scene_changed {
             self.hub.set_scene(self.player.instance().scene(), report.remap.as_ref());

@@ -7,7 +7,7 @@ use super::watcher::{Watcher, read_stable};
 use crate::assets::{AssetKind, Assets};
 use crate::gpu::{Gpu, validate_wgsl};
 use crate::params::Remap;
-use crate::scene::{SceneInstance, parse_scene};
+use crate::scene::{Player, SceneInstance, parse_scene};
 
 /// What one poll did.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -51,21 +51,18 @@ impl LiveReload {
         self.broken.iter()
     }
 
-    /// Applies whatever changed on disk since the last poll.
-    pub fn poll(&mut self, instance: &mut SceneInstance, gpu: &Gpu, size: (u32, u32)) -> ReloadReport {
+    /// Applies whatever changed on disk since the last poll to `player`'s scene.
+    pub fn poll(&mut self, player: &mut Player, gpu: &Gpu, size: (u32, u32)) -> ReloadReport {
         let changed = self.watcher.as_ref().map(Watcher::changed).unwrap_or_default();
-        self.apply(&changed, instance, gpu, size)
+        self.apply(&changed, player, gpu, size)
     }
 
-    /// Applies the given changed files.
-    pub fn apply(
-        &mut self,
-        files: &[PathBuf],
-        instance: &mut SceneInstance,
-        gpu: &Gpu,
-        size: (u32, u32),
-    ) -> ReloadReport {
+    /// Applies the given changed files. When the scene is replaced, the player's scheduled
+    /// events follow the [`ReloadReport::remap`]; the caller applies it to whatever else holds
+    /// parameter positions (queued UI events, MIDI learn).
+    pub fn apply(&mut self, files: &[PathBuf], player: &mut Player, gpu: &Gpu, size: (u32, u32)) -> ReloadReport {
         let mut report = ReloadReport::default();
+        let instance = player.instance_mut();
         for path in files {
             let shown = path.display().to_string();
             let result = match path.extension().and_then(|e| e.to_str()) {
@@ -90,6 +87,9 @@ impl LiveReload {
                     self.broken.insert(path.clone(), e);
                 }
             }
+        }
+        if let Some(remap) = &report.remap {
+            player.remap(remap);
         }
         report
     }

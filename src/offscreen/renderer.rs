@@ -122,11 +122,7 @@ impl OffscreenRenderer {
 
     /// Applies edited shader and scene files picked up by `live` (hot reload, off-screen).
     pub fn poll_reload(&mut self, live: &mut LiveReload) -> ReloadReport {
-        let report = live.poll(self.player.instance_mut(), &self.gpu, self.size);
-        if let Some(remap) = &report.remap {
-            self.player.remap(remap);
-        }
-        report
+        live.poll(&mut self.player, &self.gpu, self.size)
     }
 
     /// Waits for the GPU and folds outstanding pass timings into the medians.
