@@ -10,6 +10,7 @@ use std::time::{Duration, Instant, SystemTime};
 
 use indra::assets::Assets;
 use indra::control::osc::{OscReceiver, OscRouter};
+use indra::geometry::SplitMix64;
 use indra::scene::load_scene;
 use rosc::{OscBundle, OscMessage, OscPacket, OscTime, OscType};
 
@@ -22,22 +23,15 @@ fn resident_kib() -> u64 {
         .unwrap_or(0)
 }
 
-fn xorshift(state: &mut u64) -> u64 {
-    *state ^= *state << 13;
-    *state ^= *state >> 7;
-    *state ^= *state << 17;
-    *state
-}
-
 fn encode(packet: OscPacket) -> Vec<u8> {
     rosc::encoder::encode(&packet).expect("encodable")
 }
 
 /// Packet `i` of the flood.
-fn hostile(i: u64, state: &mut u64) -> Vec<u8> {
+fn hostile(i: u64, rng: &mut SplitMix64) -> Vec<u8> {
     let message = |addr: String, args| OscPacket::Message(OscMessage { addr, args });
     match i % 6 {
-        0 => (0..xorshift(state) % 200).map(|_| xorshift(state) as u8).collect(),
+        0 => (0..rng.below(200)).map(|_| rng.next_u64() as u8).collect(),
         1 => encode(message(format!("/indra/nowhere/{}/{}", i, "x".repeat(200)), vec![OscType::Int(1)])),
         2 => encode(message("/indra/limit_set/scale".into(), vec![OscType::String("y".repeat(300))])),
         3 => {
@@ -69,9 +63,9 @@ fn main() {
     let before = resident_kib();
     let sender = std::thread::spawn(move || {
         let socket = UdpSocket::bind("127.0.0.1:0").expect("socket");
-        let mut state = 0x2545_F491_4F6C_DD1D_u64;
+        let mut rng = SplitMix64::new(0x2545_F491_4F6C_DD1D);
         for i in 0..count {
-            let _ = socket.send_to(&hostile(i, &mut state), target);
+            let _ = socket.send_to(&hostile(i, &mut rng), target);
         }
     });
     let started = Instant::now();

@@ -7,6 +7,7 @@ mod common;
 
 use std::collections::{BTreeMap, BTreeSet};
 
+use indra::geometry::SplitMix64;
 use indra::graph::{FrameGraph, GraphRuntime, PersistentTexture};
 use indra::offscreen::OffscreenRenderer;
 use indra::params::{ParamSet, ParamValue};
@@ -15,19 +16,11 @@ use indra::techniques::tessellation::{self, Tessellation, reference};
 use indra::techniques::{NodeSetup, Technique};
 use indra::time::FixedClock;
 
-/// A deterministic generator for cameras and heights.
-fn xorshift(state: &mut u64) -> f32 {
-    *state ^= *state << 13;
-    *state ^= *state >> 7;
-    *state ^= *state << 17;
-    (*state >> 40) as f32 / (1u64 << 24) as f32
-}
-
 /// A random height field (RGBA8, height in red), smooth enough to matter, rough enough to crack.
 fn height_texture(gpu: &indra::gpu::Gpu, seed: u64) -> PersistentTexture {
     let (w, h) = (61, 47);
-    let mut state = seed;
-    let data: Vec<u8> = (0..w * h).flat_map(|_| [(xorshift(&mut state) * 255.0) as u8, 0, 0, 255]).collect();
+    let mut rng = SplitMix64::new(seed);
+    let data: Vec<u8> = (0..w * h).flat_map(|_| [(rng.unit() * 255.0) as u8, 0, 0, 255]).collect();
     let t = PersistentTexture::new(&gpu.device, "test_heights", (w, h), wgpu::TextureFormat::Rgba8Unorm);
     gpu.queue.write_texture(
         t.texture.as_image_copy(),
@@ -57,16 +50,16 @@ fn frame(
     gpu.queue.submit([encoder.finish()]);
 }
 
-fn random_params(state: &mut u64, grid: i32) -> ParamSet {
+fn random_params(rng: &mut SplitMix64, grid: i32) -> ParamSet {
     let mut p = ParamSet::new(tessellation::params());
     let mut set = |name: &str, value: ParamValue| p.set_at(p.index(name).unwrap(), value);
     set("grid", ParamValue::Int(grid));
-    set("camera_yaw", ParamValue::Float(xorshift(state) * 120.0 - 60.0));
-    set("camera_pitch", ParamValue::Float(xorshift(state) * 100.0 - 30.0));
-    set("camera_distance", ParamValue::Float(4.0 + xorshift(state) * 20.0));
-    set("fov", ParamValue::Float(30.0 + xorshift(state) * 60.0));
-    set("edge_length", ParamValue::Float(2.0 + xorshift(state) * 30.0));
-    set("displacement", ParamValue::Float(xorshift(state) * 2.0));
+    set("camera_yaw", ParamValue::Float(rng.unit() as f32 * 120.0 - 60.0));
+    set("camera_pitch", ParamValue::Float(rng.unit() as f32 * 100.0 - 30.0));
+    set("camera_distance", ParamValue::Float(4.0 + rng.unit() as f32 * 20.0));
+    set("fov", ParamValue::Float(30.0 + rng.unit() as f32 * 60.0));
+    set("edge_length", ParamValue::Float(2.0 + rng.unit() as f32 * 30.0));
+    set("displacement", ParamValue::Float(rng.unit() as f32 * 2.0));
     p.snap();
     p
 }
@@ -81,10 +74,10 @@ fn edge_factors_culling_and_levels_match_the_books_formulas_for_random_cameras()
     let gpu = common::gpu();
     let mut tess = node(&gpu);
     let height = height_texture(&gpu, 7);
-    let mut state = 0x5eed_1234_u64;
+    let mut rng = SplitMix64::new(0x5eed_1234);
     let (mut culled, mut compared) = (0, 0);
     for round in 0..12 {
-        let params = random_params(&mut state, 6 + round % 5);
+        let params = random_params(&mut rng, 6 + round % 5);
         frame(&gpu, &mut tess, &height, &params, (320, 200));
         let u = tess.uniforms().unwrap();
         let (gpu_factors, gpu_levels) = (tess.read_factors(), tess.read_levels());
@@ -117,11 +110,11 @@ type Side = (u32, BTreeSet<[u32; 3]>);
 fn displaced_neighbours_never_open_a_crack() {
     let gpu = common::gpu();
     let mut tess = node(&gpu);
-    let mut state = 0xc0ffee_u64;
+    let mut rng = SplitMix64::new(0xc0ffee);
     let (mut edges_checked, mut mixed_levels) = (0, 0);
     for round in 0..10 {
         let height = height_texture(&gpu, 100 + round);
-        let params = random_params(&mut state, 8);
+        let params = random_params(&mut rng, 8);
         frame(&gpu, &mut tess, &height, &params, (320, 200));
         let u = tess.uniforms().unwrap();
         let levels = tess.read_levels();
