@@ -55,6 +55,8 @@ pub struct RasterDesc<'a> {
     /// Add to the target (one + one) without writing depth, so overlapping lines all show
     /// (debug views, the book's additive line looks); false: opaque with depth writes.
     pub additive: bool,
+    /// Samples per pixel of the targets it draws into (1: no multisampling).
+    pub samples: u32,
 }
 
 /// A render pipeline from `module` with `layout`. Call inside [`super::validated`] so that a
@@ -99,7 +101,7 @@ pub fn raster_pipeline(
             stencil: Default::default(),
             bias: Default::default(),
         }),
-        multisample: wgpu::MultisampleState::default(),
+        multisample: wgpu::MultisampleState { count: desc.samples, ..Default::default() },
         multiview_mask: None,
         cache: None,
     })

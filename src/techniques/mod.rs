@@ -13,6 +13,7 @@ pub mod kleinian;
 pub mod poisson;
 pub mod polygon_draw;
 pub mod runner;
+pub mod space_colonization;
 pub mod star_glow;
 pub mod tessellation;
 pub mod text_mesh;
@@ -35,6 +36,7 @@ pub const REGISTRY: &[TechniqueInfo] = &[
     grid_fluid::INFO,
     tessellation::INFO,
     height_image::INFO,
+    space_colonization::INFO,
 ];
 
 /// Finds a technique by the name scenes use.

@@ -125,6 +125,7 @@ impl Renderer {
                     color: super::FORMAT,
                     depth: Some((DEPTH, wgpu::CompareFunction::LessEqual)),
                     additive,
+                    samples: 1,
                 },
             )
         };

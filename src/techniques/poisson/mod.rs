@@ -182,6 +182,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
                 color: FORMAT,
                 depth: Some((DEPTH, wgpu::CompareFunction::Less)),
                 additive: false,
+                samples: 1,
             },
         )
     })?;

@@ -92,6 +92,7 @@ impl Renderer {
                     color: FORMAT,
                     depth: None,
                     additive: false,
+                    samples: 1,
                 },
             )
         };

@@ -57,14 +57,6 @@ struct Buffers {
     compute_group: wgpu::BindGroup,
 }
 
-/// Colour (multisampled only) and depth targets for one output size and sample count.
-struct Targets {
-    size: (u32, u32),
-    samples: u32,
-    color: Option<wgpu::TextureView>,
-    depth: wgpu::TextureView,
-}
-
 /// A tessellation node.
 pub struct Tessellation {
     device: wgpu::Device,
@@ -83,7 +75,7 @@ pub struct Tessellation {
     draw: [wgpu::RenderPipeline; 2],
     sampler: wgpu::Sampler,
     buffers: Option<Buffers>,
-    targets: Option<Targets>,
+    targets: crate::gpu::DrawTargets,
     /// Draw bind groups by height texture id.
     draw_groups: RefCell<BindGroupCache<u64>>,
     /// The last frame's uniforms (tests compare against the CPU reference with them).
@@ -218,7 +210,7 @@ impl Tessellation {
             draw,
             sampler,
             buffers: None,
-            targets: None,
+            targets: crate::gpu::DrawTargets::new("tessellation/draw", FORMAT, Some(DEPTH)),
             draw_groups: RefCell::default(),
             last: None,
         })
@@ -318,33 +310,6 @@ impl Tessellation {
         *self.draw_groups.get_mut() = BindGroupCache::default();
     }
 
-    /// (Re)creates the targets for `size` and `samples`.
-    fn ensure_targets(&mut self, size: (u32, u32), samples: u32) {
-        if self.targets.as_ref().is_some_and(|t| t.size == size && t.samples == samples) {
-            return;
-        }
-        let target = |label, format| {
-            self.device
-                .create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
-                    mip_level_count: 1,
-                    sample_count: samples,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                    view_formats: &[],
-                })
-                .create_view(&Default::default())
-        };
-        self.targets = Some(Targets {
-            size,
-            samples,
-            color: (samples > 1).then(|| target("tessellation_msaa_color", FORMAT)),
-            depth: target("tessellation_depth", DEPTH),
-        });
-    }
-
     fn make_draw_group(&self, height: &wgpu::TextureView, b: &Buffers) -> wgpu::BindGroup {
         self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("tessellation_draw_group"),
@@ -361,41 +326,16 @@ impl Tessellation {
 
     /// Records the draw into `color`: multisampled and resolved, or directly.
     fn record_draw(&self, ctx: &mut PassContext<'_>, height: TextureHandle, color: TextureHandle, clear: [f32; 4]) {
-        let (Some(b), Some(t)) = (&self.buffers, &self.targets) else { return };
+        let Some(b) = &self.buffers else { return };
         let group = self
             .draw_groups
             .borrow_mut()
             .get_or_create(ctx.texture_id(height), || self.make_draw_group(ctx.view(height), b))
             .clone();
         let output = ctx.view(color).clone();
-        let (view, resolve_target) = match &t.color {
-            Some(samples) => (samples, Some(&output)),
-            None => (&output, None),
-        };
-        let mut pass = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("tessellation/draw"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: f64::from(clear[0]),
-                        g: f64::from(clear[1]),
-                        b: f64::from(clear[2]),
-                        a: 1.0,
-                    }),
-                    store: if resolve_target.is_some() { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &t.depth,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
-                stencil_ops: None,
-            }),
-            ..Default::default()
-        });
-        pass.set_pipeline(&self.draw[usize::from(t.samples > 1)]);
+        let clear = wgpu::Color { r: f64::from(clear[0]), g: f64::from(clear[1]), b: f64::from(clear[2]), a: 1.0 };
+        let mut pass = self.targets.begin_pass(ctx.encoder, &output, clear);
+        pass.set_pipeline(&self.draw[usize::from(self.targets.samples() > 1)]);
         pass.set_bind_group(0, &self.uniform_group, &[]);
         pass.set_bind_group(1, &group, &[]);
         pass.draw_indirect(&b.args.0, 0);
@@ -418,7 +358,7 @@ impl Technique for Tessellation {
         let size = graph.output_size();
         let u = TessUniforms::from_params(params, size);
         self.ensure_buffers(u.grid);
-        self.ensure_targets(size, if params.choice("msaa") == 1 { MSAA } else { 1 });
+        self.targets.ensure(&self.device, size, if params.choice("msaa") == 1 { MSAA } else { 1 });
         self.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
         self.last = Some(u);
         self.draw_groups.get_mut().begin_frame();
@@ -474,7 +414,7 @@ impl Technique for Tessellation {
             u.patch_count,
             u.grid,
             u.edge_px,
-            self.targets.as_ref().map_or(0, |t| t.size.0),
+            self.targets.size().0,
             u.screen_height
         )]
     }

@@ -1,0 +1,126 @@
+// Chapter 1 drawing: each edge (parent → child) is one instance; the child end is drawn at
+// mix(parent, child, t) so branches visibly grow out. Lines: two vertices, added up (the book's
+// look). Tubes: an instanced capsule — a round ring of SIDES vertices at each end and a
+// hemispherical cap on the growing tip — in world space, coloured by the normal as in the book,
+// or lit (Blinn-Phong) with tips that glow while they grow. Positions come from `posed` (world
+// space, w = t), written by the growth shader's `pose` kernel.
+
+struct View {
+    view_proj: mat4x4<f32>,
+    camera: vec4<f32>,
+    color: vec4<f32>,
+    // xyz: towards the light; w: emission of a tip at t = 0.
+    light: vec4<f32>,
+    thickness: f32,
+    seed_count: u32,
+    lit: u32,
+    _pad: u32,
+}
+
+struct Node {
+    pos: vec3<f32>,
+    t: f32,
+    depth: u32,
+    mass: f32,
+    parent: u32,
+    skin: u32,
+}
+
+@group(0) @binding(0) var<uniform> view: View;
+@group(0) @binding(1) var<storage, read> posed: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> nodes: array<Node>;
+
+const PI: f32 = 3.14159265;
+// Must match `TUBE_SIDES` and `TUBE_CAP_ROWS` in render.rs (the index buffer).
+const SIDES: u32 = 10u;
+const CAP_ROWS: u32 = 4u;
+
+struct Edge {
+    from_pos: vec3<f32>,
+    to_pos: vec3<f32>,
+    // Unit direction of the full edge (also while it is still short).
+    axis: vec3<f32>,
+    t: f32,
+}
+
+fn edge(instance: u32) -> Edge {
+    let child = view.seed_count + instance;
+    let a = posed[nodes[child].parent];
+    let b = posed[child];
+    let full = b.xyz - a.xyz;
+    let len = length(full);
+    var axis = vec3<f32>(0.0, 1.0, 0.0);
+    if len > 0.0 {
+        axis = full / len;
+    }
+    return Edge(a.xyz, mix(a.xyz, b.xyz, b.w), axis, b.w);
+}
+
+@vertex
+fn vs_line(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32) -> @builtin(position) vec4<f32> {
+    let e = edge(instance);
+    return view.view_proj * vec4<f32>(select(e.from_pos, e.to_pos, v == 1u), 1.0);
+}
+
+@fragment
+fn fs_line() -> @location(0) vec4<f32> {
+    return vec4<f32>(view.color.rgb, 1.0);
+}
+
+struct TubeOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) normal: vec3<f32>,
+    @location(1) world: vec3<f32>,
+    @location(2) t: f32,
+}
+
+// A right-handed orthonormal pair perpendicular to unit n (Duff et al. 2017, branch-free).
+fn perpendiculars(n: vec3<f32>) -> mat2x3<f32> {
+    let s = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    return mat2x3<f32>(vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x), vec3<f32>(b, s + n.y * n.y * a, -n.y));
+}
+
+@vertex
+fn vs_tube(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32) -> TubeOut {
+    let e = edge(instance);
+    let frame = perpendiculars(e.axis);
+    let row = v / SIDES;
+    let angle = f32(v % SIDES) / f32(SIDES) * 2.0 * PI;
+    let radial = frame[0] * cos(angle) + frame[1] * sin(angle);
+    // Row 0: the ring at the parent; row 1: at the tip; rows 2…: the cap, closing at the pole.
+    var centre = e.from_pos;
+    var normal = radial;
+    if row >= 1u {
+        centre = e.to_pos;
+    }
+    if row >= 2u {
+        let polar = f32(row - 1u) / f32(CAP_ROWS) * 0.5 * PI;
+        normal = radial * cos(polar) + e.axis * sin(polar);
+    }
+    let world = centre + normal * view.thickness;
+    var out: TubeOut;
+    out.clip = view.view_proj * vec4<f32>(world, 1.0);
+    out.normal = normal;
+    out.world = world;
+    out.t = e.t;
+    return out;
+}
+
+@fragment
+fn fs_tube(in: TubeOut) -> @location(0) vec4<f32> {
+    let n = normalize(in.normal);
+    if view.lit == 0u {
+        return vec4<f32>(view.color.rgb * (n * 0.5 + 0.5), 1.0);
+    }
+    let l = normalize(view.light.xyz);
+    let to_eye = normalize(view.camera.xyz - in.world);
+    let h = normalize(l + to_eye);
+    let diffuse = max(dot(n, l), 0.0);
+    let specular = pow(max(dot(n, h), 0.0), 48.0) * 0.35;
+    // The book's emissive tips: 1 at t = 0 fading to 0 at t = 1.
+    let glow = (1.0 - smoothstep(0.0, 1.0, in.t)) * view.light.w;
+    let rgb = view.color.rgb * (0.18 + 0.82 * diffuse) + vec3<f32>(specular) + view.color.rgb * glow;
+    return vec4<f32>(rgb, 1.0);
+}

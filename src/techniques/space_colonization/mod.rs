@@ -1,0 +1,313 @@
+//! Chapter 1: space colonization (Runions, Lane & Prusinkiewicz 2007) grown on the GPU. Branches
+//! grow from seeds towards a cloud of attractions; each growth step is Search → Attract → Connect
+//! → Remove → Grow (see `shaders/space_colonization.wgsl`), entirely on the GPU with indirect
+//! dispatches and draws — no count is read back.
+//!
+//! Changes from the book's sample (seed-reference §1, §9 items 1–7), and why:
+//! 1. Frames between growth updates (`update_every` > 1) still draw and still grow t (the sample
+//!    returned before drawing: flicker).
+//! 2. The growth direction is the normalised mean of the unit vectors (the sample's unnormalised
+//!    mean gave short or zero steps and stacked nodes when attractions surround a node); a mean
+//!    shorter than 1e-3 gives no candidate.
+//! 3. Tubes are an instanced capsule mesh with a round cross-section and a whole hemispherical
+//!    cap (the sample's geometry stage made pentagons and cut the cap short).
+//! 4. Tubes are built in world space from posed end points, so the radius is the thickness in
+//!    world units whatever the object's scale or skinning.
+//! 5. Search and Remove visit a uniform grid over the nodes (a counting sort by cell, rebuilt on
+//!    the GPU after every Connect) instead of every node; `search: BruteForce` keeps the
+//!    sample's way for comparison. Counts and sizes stay on the GPU (indirect dispatch and
+//!    draw; free slots cost nothing).
+//! 6. Skinned nodes are posed with the full 4-weight linear blend of the vertex they took their
+//!    skin from, every frame on the GPU (the sample used one rigid bone: tearing at joints).
+//! 7. Growth and kill distances default to 0.25, inside their own range (the sample's 0.2 was not).
+//!
+//! Determinism: an attraction's nearest node is the lowest index among the closest; direction
+//! sums are 16.16 fixed-point integers (atomic adds commute); a candidate's slot is its rank
+//! among the flagged nodes in node order (a prefix sum), never the order atomics returned; the
+//! mass hash is integer-only. The same scene, seed and frame give the same bytes.
+//!
+//! Slots: nodes occupy slots `0..count` and never die, so the free pool is `count..capacity`
+//! (the sample's append/consume buffer, without the order a consume buffer would randomise).
+//!
+//! Book: [UGP4 ch.1] "GPU-Based Space Colonization Algorithm" (nakamura). Shaders:
+//! `shaders/space_colonization.wgsl`, `shaders/space_colonization_draw.wgsl`,
+//! `shaders/prefix_sum.wgsl`.
+
+mod cloud;
+mod growth;
+mod params;
+pub mod reference;
+mod render;
+
+pub use cloud::{Attraction, Cloud, NONE, Node};
+pub use growth::VertexSkin;
+pub use params::{
+    GridLayout, GrowthUniforms, MAX_CELLS, MSAA_MODES, PoseUniforms, SEARCHES, SOURCES, VIEWS, ViewUniforms, params,
+};
+pub use render::{TUBE_CAP_ROWS, TUBE_SIDES, tube_indices};
+
+use growth::{BLOCK, GrowthState, Kernels};
+use render::{Renderer, Style};
+
+use crate::gpu::ShaderError;
+use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
+use crate::params::ParamSet;
+use crate::time::FrameTime;
+
+use super::{NodeSetup, Technique, TechniqueInfo, srgb_to_linear};
+
+/// The registry entry.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "space_colonization",
+    chapter: "1: GPU-Based Space Colonization",
+    summary: "branches grow towards a cloud of attractions, grid-accelerated on the GPU, drawn as lines or tubes",
+    params,
+    inputs: &[],
+    shaders: &["space_colonization.wgsl", "space_colonization_draw.wgsl", "prefix_sum.wgsl"],
+    create,
+};
+
+/// The colour format.
+pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// What the cloud was built from: a change restarts the growth.
+#[derive(Clone, Debug, PartialEq)]
+struct CloudKey {
+    source: u32,
+    side: i32,
+    seed_count: i32,
+    variation: i32,
+    seed: u64,
+}
+
+impl CloudKey {
+    fn of(p: &ParamSet, seed: u64) -> Self {
+        Self {
+            source: p.choice("source"),
+            side: p.int("side"),
+            seed_count: p.int("seed_count"),
+            variation: p.int("variation"),
+            seed,
+        }
+    }
+
+    /// The random seed of the jitter, the seeds and the masses.
+    fn rng_seed(&self) -> u64 {
+        self.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ self.variation as u64
+    }
+}
+
+/// A space colonization node.
+pub struct SpaceColonization {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    kernels: Kernels,
+    renderer: Renderer,
+    /// One 256-byte growth uniform block per queued frame, bound at a dynamic offset.
+    uniforms: wgpu::Buffer,
+    state: Option<GrowthState>,
+    key: Option<CloudKey>,
+    /// Frames queued by `step` (uniforms, grid, growth steps), recorded by `add_passes`.
+    pending: Vec<(GrowthUniforms, GridLayout, u32)>,
+    frames_since_reset: u64,
+    last: Option<GrowthUniforms>,
+    messages: Vec<String>,
+}
+
+fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
+    Ok(Box::new(SpaceColonization::new(setup)?))
+}
+
+fn uniform_blocks(device: &wgpu::Device, blocks: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("sc_growth_uniforms"),
+        size: blocks.max(1) * BLOCK,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+impl SpaceColonization {
+    /// Builds the pipelines; the cloud is made on the first step.
+    pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
+        let device = &setup.gpu.device;
+        Ok(Self {
+            device: device.clone(),
+            queue: setup.gpu.queue.clone(),
+            kernels: Kernels::new(setup)?,
+            renderer: Renderer::new(setup, FORMAT)?,
+            uniforms: uniform_blocks(device, 8),
+            state: None,
+            key: None,
+            pending: Vec::new(),
+            frames_since_reset: 0,
+            last: None,
+            messages: Vec::new(),
+        })
+    }
+
+    /// The attractions and the nodes in use, as the GPU holds them after the last submitted
+    /// frame (blocking; for tests and tools).
+    pub fn read(&self) -> (Vec<Attraction>, Vec<Node>) {
+        self.state.as_ref().map(|s| s.read(&self.device, &self.queue)).unwrap_or_default()
+    }
+
+    /// Node slots (the attraction count, as in the book).
+    pub fn capacity(&self) -> u32 {
+        self.state.as_ref().map_or(0, |s| s.capacity)
+    }
+
+    /// The uniforms of the last queued frame (its growth settings in local units).
+    pub fn last_uniforms(&self) -> Option<GrowthUniforms> {
+        self.last
+    }
+
+    /// Builds the cloud and seeds if the source changed or a reset was asked for.
+    fn ensure_state(&mut self, p: &ParamSet, seed: u64) {
+        let key = CloudKey::of(p, seed);
+        if self.state.is_some() && self.key.as_ref() == Some(&key) && !p.fired("reset") {
+            return;
+        }
+        let cloud = Cloud::lattice_sphere(key.side.clamp(2, 128) as u32, key.rng_seed());
+        if key.source == 1 {
+            self.messages.push("space_colonization: no model loaded; growing in the sphere".into());
+        }
+        let seeds = cloud.seeds(key.seed_count.clamp(1, 64) as usize, key.rng_seed());
+        let index_count = self.renderer.index_count;
+        self.state = Some(GrowthState::new(&self.device, &self.queue, &self.kernels, &cloud, &seeds, &[], index_count));
+        self.key = Some(key);
+        self.pending.clear();
+        self.frames_since_reset = 0;
+    }
+}
+
+impl Technique for SpaceColonization {
+    fn simulates_on_gpu(&self) -> bool {
+        true
+    }
+
+    fn step(&mut self, params: &ParamSet, time: &FrameTime) {
+        self.ensure_state(params, time.seed);
+        let state = self.state.as_ref().expect("ensured");
+        let every = params.int("update_every").clamp(1, 5) as u64;
+        let steps =
+            if self.frames_since_reset.is_multiple_of(every) { params.int("steps").clamp(1, 16) as u32 } else { 0 };
+        let key = self.key.as_ref().expect("ensured");
+        let hash_seed = (key.rng_seed() ^ (key.rng_seed() >> 32)) as u32;
+        let u = params::growth_uniforms(params, state.unit, time.dt);
+        let (u, layout) = state.complete(u, hash_seed, self.renderer.index_count);
+        self.pending.push((u, layout, steps));
+        self.last = Some(u);
+        self.frames_since_reset += 1;
+    }
+
+    fn take_messages(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.messages)
+    }
+
+    fn bench_report(&mut self) -> Vec<String> {
+        let (attractions, nodes) = self.read();
+        let alive = attractions.iter().filter(|a| a.alive != 0).count();
+        vec![format!(
+            "{} nodes of {} slots, {} of {} attractions alive",
+            nodes.len(),
+            self.capacity(),
+            alive,
+            attractions.len()
+        )]
+    }
+
+    fn add_passes<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        params: &ParamSet,
+        time: &FrameTime,
+        _inputs: &[TextureHandle],
+    ) -> TextureHandle {
+        self.ensure_state(params, time.seed);
+        let frames = std::mem::take(&mut self.pending);
+        let blocks = frames.len().max(1) as u64;
+        if self.uniforms.size() < blocks * BLOCK {
+            self.uniforms = uniform_blocks(&self.device, blocks.next_power_of_two());
+        }
+        let mut bytes = vec![0u8; (blocks * BLOCK) as usize];
+        for (i, (u, _, _)) in frames.iter().enumerate() {
+            let at = i * BLOCK as usize;
+            bytes[at..at + size_of::<GrowthUniforms>()].copy_from_slice(bytemuck::bytes_of(u));
+        }
+        self.queue.write_buffer(&self.uniforms, 0, &bytes);
+        let cells = frames.iter().map(|f| f.1.cells()).max().unwrap_or(1);
+        let state = self.state.as_mut().expect("ensured");
+        state.prepare(&self.device, &self.kernels, &self.uniforms, cells);
+        let ops = state.plan(&frames);
+
+        let (w, h) = graph.output_size();
+        let model = params::model(params, time.seconds);
+        state.set_pose(&self.queue, &PoseUniforms { model: model.to_cols_array_2d(), skinned: 0, _pad: [0; 3] }, &[]);
+        let (eye, view_proj) = params::view_proj(params, w as f32 / h.max(1) as f32);
+        let linear = |c: [f32; 4]| [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3]];
+        let light = params.get("light_dir").components();
+        let light = glam::Vec3::new(light[0], light[1], light[2]).normalize_or(glam::Vec3::Y);
+        let view_mode = params.choice("view");
+        let view = ViewUniforms {
+            view_proj: view_proj.to_cols_array_2d(),
+            camera: [eye.x, eye.y, eye.z, 1.0],
+            color: linear(params.color("color")),
+            light: [light.x, light.y, light.z, params.float("emission")],
+            thickness: params.float("thickness"),
+            seed_count: state.seed_count,
+            lit: u32::from(view_mode == 2),
+            _pad: 0,
+        };
+        let samples = if params.choice("msaa") == 1 { render::MSAA } else { 1 };
+        self.renderer.targets.ensure(&self.device, (w, h), samples);
+        self.renderer.prepare(&self.device, &self.queue, self.state.as_ref().expect("ensured"), &view);
+        let b = linear(params.color("background"));
+        let clear = wgpu::Color { r: f64::from(b[0]), g: f64::from(b[1]), b: f64::from(b[2]), a: 1.0 };
+        let style = if view_mode == 0 { Style::Lines } else { Style::Tubes };
+
+        let this: &'r SpaceColonization = self;
+        let state = this.state.as_ref().expect("ensured");
+        let nodes = graph.import_buffer("space_colonization/nodes", &state.nodes.buffer, state.nodes.id);
+        let attractions =
+            graph.import_buffer("space_colonization/attractions", &state.attractions.buffer, state.attractions.id);
+        let args = graph.import_buffer("space_colonization/args", &state.args.buffer, state.args.id);
+        let posed = graph.import_buffer("space_colonization/posed", &state.posed.buffer, state.posed.id);
+        graph
+            .add_pass("space_colonization/grow")
+            .write_buffer(nodes)
+            .write_buffer(attractions)
+            .write_buffer(args)
+            .record(move |ctx| {
+                let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("space_colonization/grow"),
+                    timestamp_writes: None,
+                });
+                state.record(&mut pass, &this.kernels, &ops);
+            });
+        let color = graph.create_texture("space_colonization/image", TextureDesc::full(FORMAT));
+        if graph.is_simulation_only() {
+            return color;
+        }
+        graph.add_pass("space_colonization/pose").read_buffer(nodes).read_buffer(args).write_buffer(posed).record(
+            move |ctx| {
+                let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("space_colonization/pose"),
+                    timestamp_writes: None,
+                });
+                state.record_pose(&mut pass, &this.kernels);
+            },
+        );
+        graph
+            .add_pass("space_colonization/draw")
+            .read_buffer(posed)
+            .read_buffer(nodes)
+            .read_buffer(args)
+            .render_target(color)
+            .record(move |ctx| this.renderer.draw(ctx, state, color, style, clear));
+        color
+    }
+}
+
+#[cfg(test)]
+mod tests;

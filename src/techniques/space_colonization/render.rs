@@ -1,0 +1,165 @@
+//! Drawing the forest: instanced lines or capsules, one instance per edge, sized by the indirect
+//! arguments the growth step wrote (free slots cost nothing), multisampled and resolved.
+
+use super::growth::{GrowthState, LINE_ARGS, TUBE_ARGS};
+use super::params::ViewUniforms;
+use crate::gpu::{BindGroupCache, DrawTargets, RasterDesc, ShaderError, raster_pipeline};
+use crate::graph::PassContext;
+use crate::techniques::NodeSetup;
+
+/// Vertices around a tube (the draw shader's `SIDES`).
+pub const TUBE_SIDES: u32 = 10;
+/// Rings of the tip's hemispherical cap (the draw shader's `CAP_ROWS`).
+pub const TUBE_CAP_ROWS: u32 = 4;
+/// Depth format of the tube pass.
+const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Samples per pixel with `msaa` on.
+pub const MSAA: u32 = 4;
+
+/// Indices of one capsule: quads between consecutive rings (two rings and the cap's).
+pub fn tube_indices() -> Vec<u32> {
+    let rows = 2 + TUBE_CAP_ROWS;
+    let mut indices = Vec::new();
+    for row in 0..rows - 1 {
+        for side in 0..TUBE_SIDES {
+            let next = (side + 1) % TUBE_SIDES;
+            let (a, b) = (row * TUBE_SIDES + side, row * TUBE_SIDES + next);
+            let (c, d) = (a + TUBE_SIDES, b + TUBE_SIDES);
+            indices.extend_from_slice(&[a, b, c, b, d, c]);
+        }
+    }
+    indices
+}
+
+/// What is drawn.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Style {
+    /// Additive lines.
+    Lines,
+    /// Opaque capsules.
+    Tubes,
+}
+
+/// The draw pipelines (lines and tubes, at 1 and [`MSAA`] samples) and targets.
+pub struct Renderer {
+    /// [lines, tubes] × [1 sample, MSAA].
+    pipelines: [[wgpu::RenderPipeline; 2]; 2],
+    layout: wgpu::BindGroupLayout,
+    uniform: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    /// Indices per tube.
+    pub index_count: u32,
+    /// Colour (multisampled) and depth attachments.
+    pub targets: DrawTargets,
+    groups: BindGroupCache<(u64, u64)>,
+}
+
+impl Renderer {
+    /// Builds the pipelines from `shaders/space_colonization_draw.wgsl` for `format`.
+    pub fn new(setup: &NodeSetup<'_>, format: wgpu::TextureFormat) -> Result<Self, ShaderError> {
+        let device = &setup.gpu.device;
+        let (origin, source) =
+            setup.shader_source("space_colonization_draw.wgsl", &[("view", 0), ("posed", 1), ("nodes", 2)])?;
+        let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
+        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("sc_draw_layout"),
+            entries: &[
+                crate::gpu::uniform_entry::<ViewUniforms>(0, stages),
+                crate::gpu::storage_entry(1, wgpu::ShaderStages::VERTEX, true),
+                crate::gpu::storage_entry(2, wgpu::ShaderStages::VERTEX, true),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("sc_draw_pipeline_layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |style: Style, samples| {
+            let (vertex, fragment, topology, depth, additive) = match style {
+                // Lines add up regardless of depth, as the book draws them.
+                Style::Lines => {
+                    ("vs_line", "fs_line", wgpu::PrimitiveTopology::LineList, wgpu::CompareFunction::Always, true)
+                }
+                Style::Tubes => {
+                    ("vs_tube", "fs_tube", wgpu::PrimitiveTopology::TriangleList, wgpu::CompareFunction::Less, false)
+                }
+            };
+            let desc = RasterDesc {
+                vertex,
+                fragment,
+                buffers: &[],
+                topology,
+                color: format,
+                depth: Some((DEPTH, depth)),
+                additive,
+                samples,
+            };
+            raster_pipeline(device, &module, &pipeline_layout, &desc)
+        };
+        let pipelines = crate::gpu::validated(device, &origin, || {
+            [Style::Lines, Style::Tubes].map(|s| [pipeline(s, 1), pipeline(s, MSAA)])
+        })?;
+        let index_data = tube_indices();
+        use wgpu::util::DeviceExt;
+        let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("sc_tube_indices"),
+            contents: bytemuck::cast_slice(&index_data),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+        Ok(Self {
+            pipelines,
+            layout,
+            uniform: crate::gpu::uniform_buffer::<ViewUniforms>(device, "sc_view"),
+            indices,
+            index_count: index_data.len() as u32,
+            targets: DrawTargets::new("space_colonization/draw", format, Some(DEPTH)),
+            groups: BindGroupCache::default(),
+        })
+    }
+
+    /// Writes the view uniforms and makes the bind group for `state`'s buffers.
+    pub fn prepare(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, state: &GrowthState, view: &ViewUniforms) {
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(view));
+        self.groups.begin_frame();
+        let (layout, uniform) = (&self.layout, &self.uniform);
+        self.groups.get_or_create((state.posed.id, state.nodes.id), || {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("sc_draw_group"),
+                layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: state.posed.buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 2, resource: state.nodes.buffer.as_entire_binding() },
+                ],
+            })
+        });
+    }
+
+    /// Records the draw of every grown edge into `color` (resolved if multisampled).
+    pub fn draw(
+        &self,
+        ctx: &mut PassContext<'_>,
+        state: &GrowthState,
+        color: crate::graph::TextureHandle,
+        style: Style,
+        clear: wgpu::Color,
+    ) {
+        let Some(group) = self.groups.get(&(state.posed.id, state.nodes.id)) else { return };
+        let output = ctx.view(color).clone();
+        let mut pass = self.targets.begin_pass(ctx.encoder, &output, clear);
+        let samples = usize::from(self.targets.samples() > 1);
+        pass.set_bind_group(0, group, &[]);
+        match style {
+            Style::Lines => {
+                pass.set_pipeline(&self.pipelines[0][samples]);
+                pass.draw_indirect(&state.args.buffer, LINE_ARGS);
+            }
+            Style::Tubes => {
+                pass.set_pipeline(&self.pipelines[1][samples]);
+                pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed_indirect(&state.args.buffer, TUBE_ARGS);
+            }
+        }
+    }
+}
