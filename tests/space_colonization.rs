@@ -1,0 +1,212 @@
+//! Chapter 1 on lavapipe: a GPU growth step equals the CPU reference (nodes, edges, removed
+//! attractions) from states along a whole growth; the grid search gives exactly the brute-force
+//! result; after a full growth the edges form a forest with no edge longer than the growth
+//! distance and no live attraction within the kill distance; the pool never overflows; two
+//! renders are the same bytes; golden renders of the scenes at two times.
+
+mod common;
+
+use indra::offscreen::OffscreenRenderer;
+use indra::params::{ParamSet, ParamValue};
+use indra::scene::load_scene;
+use indra::techniques::runner::NodeRunner;
+use indra::techniques::space_colonization::{self, Attraction, NONE, Node, SpaceColonization, reference};
+
+type Runner = NodeRunner<SpaceColonization>;
+
+fn rig(settings: &[(&str, ParamValue)]) -> Runner {
+    let mut params = ParamSet::new(space_colonization::params());
+    let defaults = [
+        ("side", ParamValue::Int(10)),
+        ("influence", ParamValue::Float(1.14)),
+        ("growth_distance", ParamValue::Float(0.597)),
+        ("kill_distance", ParamValue::Float(0.484)),
+        ("msaa", ParamValue::Enum(0)),
+    ];
+    for (name, value) in defaults.iter().chain(settings) {
+        let i = params.index(name).unwrap_or_else(|| panic!("{name}"));
+        assert!(params.set_at(i, *value), "{name}");
+    }
+    params.snap();
+    NodeRunner::new(common::gpu(), &common::assets(), params, 1.0 / 60.0, SpaceColonization::new).unwrap()
+}
+
+fn search(brute: bool) -> (&'static str, ParamValue) {
+    ("search", ParamValue::Enum(if brute { 0 } else { 1 }))
+}
+
+fn close(a: [f32; 3], b: [f32; 3], tolerance: f32) -> bool {
+    a.iter().zip(&b).all(|(x, y)| (x - y).abs() <= tolerance)
+}
+
+/// Asserts that two states match: structure exactly, positions and floats to `tolerance`.
+fn assert_same(
+    what: &str,
+    (a_att, a_nodes): &(Vec<Attraction>, Vec<Node>),
+    (b_att, b_nodes): &(Vec<Attraction>, Vec<Node>),
+) {
+    assert_eq!(a_nodes.len(), b_nodes.len(), "{what}: node counts");
+    for (i, (a, b)) in a_nodes.iter().zip(b_nodes).enumerate() {
+        assert_eq!((a.parent, a.depth), (b.parent, b.depth), "{what}: node {i}");
+        assert!(close(a.pos, b.pos, 1e-5), "{what}: node {i} at {:?} vs {:?}", a.pos, b.pos);
+        assert!((a.t - b.t).abs() <= 1e-5 && (a.mass - b.mass).abs() <= 1e-6, "{what}: node {i} {a:?} vs {b:?}");
+    }
+    assert_eq!(a_att.len(), b_att.len());
+    for (i, (a, b)) in a_att.iter().zip(b_att).enumerate() {
+        assert_eq!((a.alive, a.nearest), (b.alive, b.nearest), "{what}: attraction {i}");
+    }
+}
+
+#[test]
+fn one_gpu_growth_step_matches_the_cpu_reference_all_along_a_growth() {
+    for brute in [false, true] {
+        let mut r = rig(&[search(brute), ("variation", ParamValue::Int(3))]);
+        r.run(1);
+        let mut checked = 0;
+        for frame in 1..40 {
+            let (mut attractions, mut nodes) = r.node.read();
+            r.run(1);
+            let u = r.node.last_uniforms().unwrap();
+            reference::step(&mut attractions, &mut nodes, &u);
+            let gpu = r.node.read();
+            assert_same(&format!("frame {frame}, brute force {brute}"), &gpu, &(attractions, nodes));
+            checked += usize::from(gpu.1.len() > 6);
+        }
+        let (attractions, nodes) = r.node.read();
+        eprintln!(
+            "brute force {brute}: {} nodes, {} attractions left",
+            nodes.len(),
+            attractions.iter().filter(|a| a.alive != 0).count()
+        );
+        assert!(checked > 30 && nodes.len() > 100, "the growth must get going: {} nodes", nodes.len());
+    }
+}
+
+#[test]
+fn the_grid_search_gives_exactly_the_brute_force_result() {
+    for (variation, influence, steps) in [(1, 1.14, 1), (2, 3.0, 3), (5, 0.6, 2)] {
+        let settings = |brute| {
+            [
+                search(brute),
+                ("variation", ParamValue::Int(variation)),
+                ("influence", ParamValue::Float(influence)),
+                ("steps", ParamValue::Int(steps)),
+                ("side", ParamValue::Int(14)),
+                ("kill_distance", ParamValue::Float(0.25)),
+                ("growth_distance", ParamValue::Float(0.3)),
+            ]
+        };
+        let (mut grid, mut brute) = (rig(&settings(false)), rig(&settings(true)));
+        for frame in (0..60).step_by(10) {
+            grid.run(10);
+            brute.run(10);
+            let (g, b) = (grid.node.read(), brute.node.read());
+            assert_eq!(g, b, "variation {variation}, influence {influence}: frame {frame} differs");
+        }
+        let nodes = grid.node.read().1.len();
+        eprintln!("variation {variation}, influence {influence}: {nodes} nodes, identical");
+    }
+}
+
+#[test]
+fn a_full_growth_is_a_forest_of_short_edges_that_killed_what_it_reached() {
+    let mut r =
+        rig(&[("side", ParamValue::Int(16)), ("seed_count", ParamValue::Int(9)), ("steps", ParamValue::Int(4))]);
+    r.run(90);
+    let (attractions, nodes) = r.node.read();
+    let u = r.node.last_uniforms().unwrap();
+    let capacity = r.node.capacity() as usize;
+    assert!(nodes.len() <= capacity && capacity == attractions.len());
+    let seeds = u.seed_count as usize;
+    for (i, n) in nodes.iter().enumerate() {
+        if i < seeds {
+            assert_eq!((n.parent, n.depth), (NONE, 0), "seed {i}");
+            continue;
+        }
+        // Parents come first, so following parents always ends at a seed: no cycles.
+        let p = nodes[n.parent as usize];
+        assert!((n.parent as usize) < i, "node {i}'s parent {} is not older", n.parent);
+        assert_eq!(n.depth, p.depth + 1, "node {i}");
+        let length = (0..3).map(|k| (n.pos[k] - p.pos[k]).powi(2)).sum::<f32>().sqrt();
+        assert!((length - u.growth).abs() < 1e-4, "edge {i} is {length} long, growth distance {}", u.growth);
+        assert!((0.0..=1.0).contains(&n.t) && (u.mass_min..=u.mass_max).contains(&n.mass), "node {i}: {n:?}");
+    }
+    for (i, a) in attractions.iter().enumerate().filter(|(_, a)| a.alive != 0) {
+        let reach = reference::nearest_node(&nodes, a.pos, u.kill * u.kill);
+        assert_eq!(reach, NONE, "live attraction {i} lies within the kill distance of node {reach}");
+    }
+    let alive = attractions.iter().filter(|a| a.alive != 0).count();
+    eprintln!("{} nodes of {capacity}, {alive} attractions alive", nodes.len());
+    assert!(alive < attractions.len() / 4, "a full growth consumes most attractions: {alive} left");
+}
+
+#[test]
+fn the_pool_never_overflows_at_the_far_end_of_every_range() {
+    let mut r = rig(&[
+        ("side", ParamValue::Int(8)),
+        ("seed_count", ParamValue::Int(64)),
+        ("influence", ParamValue::Float(3.0)),
+        ("growth_distance", ParamValue::Float(0.25)),
+        ("kill_distance", ParamValue::Float(0.25)),
+        ("steps", ParamValue::Int(16)),
+        ("update_every", ParamValue::Int(5)),
+        ("growth_speed", ParamValue::Float(200.0)),
+        ("mass_min", ParamValue::Float(1.0)),
+        ("mass_max", ParamValue::Float(0.0)),
+    ]);
+    r.run(60);
+    let (attractions, nodes) = r.node.read();
+    eprintln!("{} nodes, capacity {}", nodes.len(), r.node.capacity());
+    assert!(nodes.len() as u32 <= r.node.capacity());
+    assert_eq!(r.node.capacity() as usize, attractions.len());
+    assert!(nodes.len() > 64, "it grew: {}", nodes.len());
+}
+
+#[test]
+fn reset_starts_the_same_growth_again() {
+    let mut r = rig(&[]);
+    r.run(8);
+    let first = r.node.read();
+    r.run(20);
+    r.params.set_at(r.params.index("reset").unwrap(), ParamValue::Trigger(true));
+    r.run(8);
+    assert_eq!(r.node.read(), first);
+}
+
+fn render(scene: &str, size: (u32, u32), frames: &[u64], sets: &[&str]) -> Vec<Vec<u8>> {
+    let mut s = load_scene(&common::assets(), scene).unwrap();
+    for set in sets {
+        s.set_from_str(set).unwrap();
+    }
+    let mut r = OffscreenRenderer::new(common::gpu(), &common::assets(), s, Some(size), None, None).unwrap();
+    let last = *frames.iter().max().unwrap();
+    (0..=last)
+        .map(|_| r.render_next().unwrap().rgba)
+        .enumerate()
+        .filter(|(f, _)| frames.contains(&(*f as u64)))
+        .map(|(_, b)| b)
+        .collect()
+}
+
+#[test]
+fn the_same_scene_gives_the_same_bytes() {
+    let a = render("space_colonization_tubes", (96, 64), &[45], &[]);
+    let b = render("space_colonization_tubes", (96, 64), &[45], &[]);
+    assert!(a == b);
+}
+
+fn golden(scene: &str, frames: &[u64], sets: &[&str]) {
+    for (image, f) in render(scene, (256, 256), frames, sets).iter().zip(frames) {
+        common::golden().check(&format!("{scene}_f{f:04}"), (256, 256), image).unwrap_or_else(|e| panic!("{e}"));
+    }
+}
+
+#[test]
+fn golden_space_colonization_lines() {
+    golden("space_colonization", &[20, 90], &[]);
+}
+
+#[test]
+fn golden_space_colonization_tubes() {
+    golden("space_colonization_tubes", &[30, 90], &[]);
+}
