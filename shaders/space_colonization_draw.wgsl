@@ -1,4 +1,4 @@
-// Chapter 1 drawing: each edge (parent → child) is one instance; the child end is drawn at
+// Chapter 1 drawing (plus the skinned scene's floor and the model's faint glow): each edge (parent → child) is one instance; the child end is drawn at
 // mix(parent, child, t) so branches visibly grow out. Lines: two vertices, added up (the book's
 // look). Tubes: an instanced capsule — a round ring of SIDES vertices at each end and a
 // hemispherical cap on the growing tip — in world space, coloured by the normal as in the book,
@@ -14,7 +14,17 @@ struct View {
     thickness: f32,
     seed_count: u32,
     lit: u32,
-    _pad: u32,
+    // Strength of the model's glow.
+    ghost: f32,
+    // Local → world of the model's mesh (after skinning).
+    model: mat4x4<f32>,
+    // Linear floor colour; w: half size (0: none).
+    floor: vec4<f32>,
+}
+
+struct VertexSkin {
+    joints: vec4<u32>,
+    weights: vec4<f32>,
 }
 
 struct Node {
@@ -29,6 +39,9 @@ struct Node {
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<storage, read> posed: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> nodes: array<Node>;
+@group(0) @binding(3) var<storage, read> mesh_positions: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> vertex_skins: array<VertexSkin>;
+@group(0) @binding(5) var<storage, read> joint_matrices: array<mat4x4<f32>>;
 
 const PI: f32 = 3.14159265;
 // Must match `TUBE_SIDES` and `TUBE_CAP_ROWS` in render.rs (the index buffer).
@@ -123,4 +136,57 @@ fn fs_tube(in: TubeOut) -> @location(0) vec4<f32> {
     let glow = (1.0 - smoothstep(0.0, 1.0, in.t)) * view.light.w;
     let rgb = view.color.rgb * (0.18 + 0.82 * diffuse) + vec3<f32>(specular) + view.color.rgb * glow;
     return vec4<f32>(rgb, 1.0);
+}
+
+// ---- the floor: a lit square at y = 0 ----
+
+struct FloorOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+}
+
+@vertex
+fn vs_floor(@builtin(vertex_index) v: u32) -> FloorOut {
+    let corners = array<vec2<f32>, 6>(vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(1.0, 1.0), vec2(-1.0, -1.0), vec2(1.0, 1.0), vec2(-1.0, 1.0));
+    let c = corners[v] * view.floor.w;
+    var out: FloorOut;
+    out.world = vec3<f32>(c.x, 0.0, c.y);
+    out.clip = view.view_proj * vec4<f32>(out.world, 1.0);
+    return out;
+}
+
+@fragment
+fn fs_floor(in: FloorOut) -> @location(0) vec4<f32> {
+    let l = normalize(view.light.xyz);
+    let diffuse = max(l.y, 0.0);
+    // Fades out towards the edge so the square does not end in a hard line.
+    let fade = 1.0 - smoothstep(0.6, 1.0, length(in.world.xz) / view.floor.w);
+    return vec4<f32>(view.floor.rgb * (0.25 + 0.75 * diffuse) * fade, 1.0);
+}
+
+// ---- the model's skin, drawn as a faint additive glow ----
+
+struct MeshOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+}
+
+@vertex
+fn vs_mesh(@builtin(vertex_index) v: u32) -> MeshOut {
+    let s = vertex_skins[v];
+    let p = mesh_positions[v];
+    let skinned = (joint_matrices[s.joints.x] * p) * s.weights.x + (joint_matrices[s.joints.y] * p) * s.weights.y
+        + (joint_matrices[s.joints.z] * p) * s.weights.z + (joint_matrices[s.joints.w] * p) * s.weights.w;
+    var out: MeshOut;
+    out.world = (view.model * skinned).xyz;
+    out.clip = view.view_proj * vec4<f32>(out.world, 1.0);
+    return out;
+}
+
+@fragment
+fn fs_mesh(in: MeshOut) -> @location(0) vec4<f32> {
+    // Flat normal from the screen derivatives; grazing faces glow most (a rim).
+    let n = normalize(cross(dpdx(in.world), dpdy(in.world)));
+    let facing = abs(dot(n, normalize(view.camera.xyz - in.world)));
+    return vec4<f32>(view.color.rgb * view.ghost * (1.0 - facing), 1.0);
 }

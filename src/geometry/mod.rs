@@ -1,8 +1,10 @@
-//! CPU geometry algorithms of the book (chapters 5 and 7). No wgpu, scenes or UI in here.
+//! CPU geometry algorithms of the book (chapters 1, 5 and 7). No wgpu, scenes or UI in here.
 
 pub mod outline;
 pub mod poisson;
 mod rng;
+pub mod skinned;
 pub mod triangulate;
+pub mod volume;
 
 pub use rng::SplitMix64;

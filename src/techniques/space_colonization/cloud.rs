@@ -118,4 +118,28 @@ impl Cloud {
         }
         chosen.iter().map(|&i| Node::seed(self.attractions[i].pos, self.attractions[i].skin)).collect()
     }
+
+    /// `count` seeds spread out: the first chosen by `seed`, each next the attraction farthest
+    /// from those chosen — so every limb of a model gets one before any part gets two (a limb
+    /// joined to the body by less than the influence distance is never reached from outside).
+    pub fn spread_seeds(&self, count: usize, seed: u64) -> Vec<Node> {
+        let n = self.attractions.len();
+        if n == 0 {
+            return Vec::new();
+        }
+        let mut rng = SplitMix64::new(seed ^ 0x5eed_5eed_5eed_5eed);
+        let mut chosen = vec![rng.below(n)];
+        let d2 = |a: [f32; 3], b: [f32; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f32>();
+        let mut nearest: Vec<f32> =
+            self.attractions.iter().map(|a| d2(a.pos, self.attractions[chosen[0]].pos)).collect();
+        while chosen.len() < count.min(n) {
+            let (far, _) =
+                nearest.iter().enumerate().fold((0, -1.0), |best, (i, &d)| if d > best.1 { (i, d) } else { best });
+            chosen.push(far);
+            for (i, a) in self.attractions.iter().enumerate() {
+                nearest[i] = nearest[i].min(d2(a.pos, self.attractions[far].pos));
+            }
+        }
+        chosen.iter().map(|&i| Node::seed(self.attractions[i].pos, self.attractions[i].skin)).collect()
+    }
 }

@@ -144,6 +144,27 @@ fn buffer(device: &wgpu::Device, label: &str, bytes: u64, usage: wgpu::BufferUsa
     })
 }
 
+/// What a skinned source adds: every vertex's skin and the bind-pose mesh (to draw it).
+#[derive(Clone, Debug, Default)]
+pub struct SkinData {
+    /// Joints and weights per mesh vertex (a node's `skin` indexes this).
+    pub skins: Vec<VertexSkin>,
+    /// Bind-pose positions.
+    pub positions: Vec<[f32; 3]>,
+    /// Triangles.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// The model's mesh on the GPU, for drawing it.
+pub struct MeshBuffers {
+    /// Positions as vec4s.
+    pub positions: wgpu::Buffer,
+    /// Triangle indices.
+    pub indices: wgpu::Buffer,
+    /// Index count (0: no mesh).
+    pub index_count: u32,
+}
+
 /// A buffer the frame graph imports, with its resource id.
 pub struct Imported {
     /// The buffer.
@@ -186,7 +207,12 @@ pub struct GrowthState {
     cells: Option<(u32, wgpu::Buffer, wgpu::Buffer, ScanTarget)>,
     flag_scan: ScanTarget,
     pose_uniform: wgpu::Buffer,
-    joints: wgpu::Buffer,
+    /// Skinning matrices of the current frame.
+    pub joints: wgpu::Buffer,
+    /// Joints and weights per mesh vertex.
+    pub skins: wgpu::Buffer,
+    /// The model's mesh (an empty one for the sphere).
+    pub mesh: MeshBuffers,
     growth_group: Option<(u64, wgpu::BindGroup)>,
     args_group: wgpu::BindGroup,
     pose_group: wgpu::BindGroup,
@@ -202,9 +228,11 @@ impl GrowthState {
         kernels: &Kernels,
         cloud: &Cloud,
         seeds: &[Node],
-        skins: &[VertexSkin],
+        skin: &SkinData,
         tube_indices: u32,
     ) -> Self {
+        use wgpu::util::DeviceExt;
+        let skins = &skin.skins;
         let capacity = cloud.attractions.len().max(seeds.len()).max(1) as u32;
         let cap = u64::from(capacity);
         let none = wgpu::BufferUsages::empty();
@@ -247,6 +275,16 @@ impl GrowthState {
             ],
         });
         let flag_scan = kernels.scan.target(device, &flags, capacity);
+        let positions: Vec<[f32; 4]> = skin.positions.iter().map(|p| [p[0], p[1], p[2], 1.0]).collect();
+        let mesh_positions = buffer(device, "sc_mesh_positions", (positions.len() * 16) as u64, none);
+        queue.write_buffer(&mesh_positions, 0, bytemuck::cast_slice(&positions));
+        let index_data: Vec<u32> = skin.triangles.iter().flatten().copied().collect();
+        let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("sc_mesh_indices"),
+            contents: bytemuck::cast_slice(if index_data.is_empty() { &[0u32; 3][..] } else { &index_data }),
+            usage: wgpu::BufferUsages::INDEX,
+        });
+        let mesh = MeshBuffers { positions: mesh_positions, indices, index_count: index_data.len() as u32 };
         Self {
             capacity,
             attraction_count: cloud.attractions.len() as u32,
@@ -266,6 +304,8 @@ impl GrowthState {
             flag_scan,
             pose_uniform,
             joints,
+            skins,
+            mesh,
             growth_group: None,
             args_group,
             pose_group,

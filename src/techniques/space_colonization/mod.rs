@@ -35,19 +35,25 @@
 
 mod cloud;
 mod growth;
+mod model;
 mod params;
 pub mod reference;
 mod render;
 
 pub use cloud::{Attraction, Cloud, NONE, Node};
-pub use growth::VertexSkin;
+pub use growth::{SkinData, VertexSkin};
+pub use model::{Sampling, load as load_model};
 pub use params::{
     GridLayout, GrowthUniforms, MAX_CELLS, MSAA_MODES, PoseUniforms, SEARCHES, SOURCES, VIEWS, ViewUniforms, params,
 };
 pub use render::{TUBE_CAP_ROWS, TUBE_SIDES, tube_indices};
 
 use growth::{BLOCK, GrowthState, Kernels};
-use render::{Renderer, Style};
+use render::{Extras, Renderer, Style};
+
+use std::sync::Arc;
+
+use crate::geometry::skinned::SkinnedMesh;
 
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
@@ -78,6 +84,8 @@ struct CloudKey {
     seed_count: i32,
     variation: i32,
     seed: u64,
+    /// The model's path, voxels and spacing (Model source only).
+    model: Option<(String, i32, u32)>,
 }
 
 impl CloudKey {
@@ -88,6 +96,13 @@ impl CloudKey {
             seed_count: p.int("seed_count"),
             variation: p.int("variation"),
             seed,
+            model: (p.choice("source") == 1).then(|| {
+                let path = match p.get("model") {
+                    crate::params::ParamValue::Text(t) => t.as_str().trim().to_string(),
+                    _ => String::new(),
+                };
+                (path, p.int("voxels"), p.float("spacing").to_bits())
+            }),
         }
     }
 
@@ -112,6 +127,12 @@ pub struct SpaceColonization {
     frames_since_reset: u64,
     last: Option<GrowthUniforms>,
     messages: Vec<String>,
+    /// Where relative model paths are looked up.
+    root: Option<std::path::PathBuf>,
+    /// The model the cloud was sampled from (it poses the nodes), if any.
+    mesh: Option<Arc<SkinnedMesh>>,
+    /// The last model loaded, by path (a restart does not read the file again).
+    loaded: Option<(String, Arc<SkinnedMesh>)>,
 }
 
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
@@ -143,6 +164,9 @@ impl SpaceColonization {
             frames_since_reset: 0,
             last: None,
             messages: Vec::new(),
+            root: setup.assets.root().map(std::path::Path::to_path_buf),
+            mesh: None,
+            loaded: None,
         })
     }
 
@@ -168,16 +192,78 @@ impl SpaceColonization {
         if self.state.is_some() && self.key.as_ref() == Some(&key) && !p.fired("reset") {
             return;
         }
-        let cloud = Cloud::lattice_sphere(key.side.clamp(2, 128) as u32, key.rng_seed());
-        if key.source == 1 {
-            self.messages.push("space_colonization: no model loaded; growing in the sphere".into());
-        }
-        let seeds = cloud.seeds(key.seed_count.clamp(1, 64) as usize, key.rng_seed());
+        let (cloud, skin, mesh) = match self.model_cloud(&key) {
+            Some(Ok((cloud, skin, mesh))) => (cloud, skin, Some(mesh)),
+            Some(Err(e)) => {
+                self.messages.push(format!("space_colonization: {e}; growing in the sphere instead"));
+                (Cloud::lattice_sphere(key.side.clamp(2, 128) as u32, key.rng_seed()), SkinData::default(), None)
+            }
+            None => (Cloud::lattice_sphere(key.side.clamp(2, 128) as u32, key.rng_seed()), SkinData::default(), None),
+        };
+        let count = key.seed_count.clamp(1, 64) as usize;
+        // The sphere keeps the book's random seeds; a model's limbs each need one.
+        let seeds =
+            if mesh.is_some() { cloud.spread_seeds(count, key.rng_seed()) } else { cloud.seeds(count, key.rng_seed()) };
         let index_count = self.renderer.index_count;
-        self.state = Some(GrowthState::new(&self.device, &self.queue, &self.kernels, &cloud, &seeds, &[], index_count));
+        self.state =
+            Some(GrowthState::new(&self.device, &self.queue, &self.kernels, &cloud, &seeds, &skin, index_count));
+        self.mesh = mesh;
         self.key = Some(key);
         self.pending.clear();
         self.frames_since_reset = 0;
+    }
+}
+
+/// A cloud sampled inside a model, its skins and the model.
+type ModelCloud = (Cloud, SkinData, Arc<SkinnedMesh>);
+
+impl SpaceColonization {
+    /// The cloud inside the key's model, if the source is a model: loaded (or reused) and sampled.
+    fn model_cloud(&mut self, key: &CloudKey) -> Option<Result<ModelCloud, String>> {
+        let (path, voxels, spacing) = key.model.as_ref()?;
+        let mesh = match &self.loaded {
+            Some((loaded, mesh)) if loaded == path => mesh.clone(),
+            _ => match model::load(self.root.as_deref(), path) {
+                Ok(mesh) => {
+                    let mesh = Arc::new(mesh);
+                    self.loaded = Some((path.clone(), mesh.clone()));
+                    mesh
+                }
+                Err(e) => return Some(Err(e)),
+            },
+        };
+        let sampling = Sampling {
+            voxels: (*voxels).clamp(8, 256) as u32,
+            spacing: f32::from_bits(*spacing),
+            seed: key.rng_seed(),
+        };
+        let (cloud, skins) = model::cloud(&mesh, sampling);
+        if cloud.attractions.is_empty() {
+            return Some(Err(format!("{path}: no volume inside the mesh (is it closed?)")));
+        }
+        let skin = SkinData { skins, positions: mesh.positions.clone(), triangles: mesh.triangles.clone() };
+        Some(Ok((cloud, skin, mesh)))
+    }
+
+    /// The distance unit of the growth parameters: the sphere's 2 / side, or the model's voxel
+    /// times `unit_scale`.
+    fn unit(&self, params: &ParamSet) -> f32 {
+        let base = self.state.as_ref().map_or(1.0, |s| s.unit);
+        if self.mesh.is_some() { base * params.float("unit_scale") } else { base }
+    }
+
+    /// The pose uniforms and joint matrices of this frame.
+    fn pose(&self, params: &ParamSet, seconds: f64) -> (PoseUniforms, Vec<[[f32; 4]; 4]>) {
+        let model = params::model(params, seconds);
+        let joints = match &self.mesh {
+            Some(mesh) => {
+                let time = mesh.ping_pong(seconds, params.float("animation_speed"));
+                mesh.joint_matrices(time).iter().map(|m| m.to_cols_array_2d()).collect()
+            }
+            None => Vec::new(),
+        };
+        let skinned = u32::from(self.mesh.is_some());
+        (PoseUniforms { model: model.to_cols_array_2d(), skinned, _pad: [0; 3] }, joints)
     }
 }
 
@@ -194,7 +280,7 @@ impl Technique for SpaceColonization {
             if self.frames_since_reset.is_multiple_of(every) { params.int("steps").clamp(1, 16) as u32 } else { 0 };
         let key = self.key.as_ref().expect("ensured");
         let hash_seed = (key.rng_seed() ^ (key.rng_seed() >> 32)) as u32;
-        let u = params::growth_uniforms(params, state.unit, time.dt);
+        let u = params::growth_uniforms(params, self.unit(params), time.dt);
         let (u, layout) = state.complete(u, hash_seed, self.renderer.index_count);
         self.pending.push((u, layout, steps));
         self.last = Some(u);
@@ -242,8 +328,9 @@ impl Technique for SpaceColonization {
         let ops = state.plan(&frames);
 
         let (w, h) = graph.output_size();
-        let model = params::model(params, time.seconds);
-        state.set_pose(&self.queue, &PoseUniforms { model: model.to_cols_array_2d(), skinned: 0, _pad: [0; 3] }, &[]);
+        let (pose, joints) = self.pose(params, time.seconds);
+        let state = self.state.as_ref().expect("ensured");
+        state.set_pose(&self.queue, &pose, &joints);
         let (eye, view_proj) = params::view_proj(params, w as f32 / h.max(1) as f32);
         let linear = |c: [f32; 4]| [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3]];
         let light = params.get("light_dir").components();
@@ -257,8 +344,14 @@ impl Technique for SpaceColonization {
             thickness: params.float("thickness"),
             seed_count: state.seed_count,
             lit: u32::from(view_mode == 2),
-            _pad: 0,
+            ghost: if params.bool("show_model") && self.mesh.is_some() { 0.6 } else { 0.0 },
+            model: pose.model,
+            floor: {
+                let c = linear(params.color("floor_color"));
+                [c[0], c[1], c[2], if params.bool("floor") { 12.0 } else { 0.0 }]
+            },
         };
+        let extras = Extras { floor: view.floor[3] > 0.0, mesh: view.ghost > 0.0 };
         let samples = if params.choice("msaa") == 1 { render::MSAA } else { 1 };
         self.renderer.targets.ensure(&self.device, (w, h), samples);
         self.renderer.prepare(&self.device, &self.queue, self.state.as_ref().expect("ensured"), &view);
@@ -304,7 +397,7 @@ impl Technique for SpaceColonization {
             .read_buffer(nodes)
             .read_buffer(args)
             .render_target(color)
-            .record(move |ctx| this.renderer.draw(ctx, state, color, style, clear));
+            .record(move |ctx| this.renderer.draw(ctx, state, color, style, extras, clear));
         color
     }
 }

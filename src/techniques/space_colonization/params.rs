@@ -34,6 +34,33 @@ pub fn params() -> Vec<ParamDecl> {
         ),
         ParamDecl::new("seed_count", Int(6), Some((1.0, 64.0)), "branches to start from (restarts)"),
         ParamDecl::new("variation", Int(0), Some((0.0, 1e6)), "another jitter and other seeds (restarts)"),
+        ParamDecl::text(
+            "model",
+            "assets/models/RiggedFigure.gltf",
+            "glTF 2.0 skinned model (.gltf or .glb) for the Model source",
+        ),
+        ParamDecl::new("voxels", Int(64), Some((16.0, 256.0)), "model voxels along its longest side (restarts)"),
+        ParamDecl::new(
+            "spacing",
+            Float(1.0),
+            Some((0.5, 4.0)),
+            "least distance between model attractions, in voxels (restarts)",
+        ),
+        ParamDecl::new(
+            "unit_scale",
+            Float(2.5),
+            Some((0.5, 10.0)),
+            "model distance unit, in voxels (the sample's unitScale)",
+        ),
+        ParamDecl::new(
+            "animation_speed",
+            Float(0.5),
+            Some((0.0, 4.0)),
+            "speed of the model's clip, played back and forth",
+        ),
+        ParamDecl::new("show_model", Bool(false), None, "draw the model's skin as a faint glow over the branches"),
+        ParamDecl::new("floor", Bool(false), None, "a lit floor under the model"),
+        ParamDecl::new("floor_color", Color([0.868, 0.868, 0.868, 1.0]), None, "floor colour"),
         ParamDecl::new("update_every", Int(1), Some((1.0, 5.0)), "frames between growth updates (the sample's frame)"),
         ParamDecl::new("steps", Int(1), Some((1.0, 16.0)), "growth steps per update (the sample's iterations)"),
         ParamDecl::new("mass_min", Float(0.25), Some((0.0, 1.0)), "lightest node: grows slowest"),
@@ -184,8 +211,12 @@ pub struct ViewUniforms {
     pub seed_count: u32,
     /// 1: lit tubes.
     pub lit: u32,
-    /// Padding.
-    pub _pad: u32,
+    /// Strength of the model's glow (0: not drawn).
+    pub ghost: f32,
+    /// Local → world of the model's mesh (after skinning).
+    pub model: [[f32; 4]; 4],
+    /// Linear floor colour; w: the floor's half size (0: no floor).
+    pub floor: [f32; 4],
 }
 
 /// The pose kernel's uniform block (`Pose` in the growth shader).

@@ -11,6 +11,9 @@ use crate::techniques::NodeSetup;
 pub const TUBE_SIDES: u32 = 10;
 /// Rings of the tip's hemispherical cap (the draw shader's `CAP_ROWS`).
 pub const TUBE_CAP_ROWS: u32 = 4;
+/// The draw shader's bindings, in the order of the draw group's entries.
+const DRAW_BINDINGS: [(&str, u32); 6] =
+    [("view", 0), ("posed", 1), ("nodes", 2), ("mesh_positions", 3), ("vertex_skins", 4), ("joint_matrices", 5)];
 /// Depth format of the tube pass.
 const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Samples per pixel with `msaa` on.
@@ -38,12 +41,25 @@ pub enum Style {
     Lines,
     /// Opaque capsules.
     Tubes,
+    /// The floor (opaque).
+    Floor,
+    /// The model's skin (additive, depth-tested).
+    Mesh,
+}
+
+/// What one frame draws besides the branches.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Extras {
+    /// Draw the floor first.
+    pub floor: bool,
+    /// Draw the model's glow last.
+    pub mesh: bool,
 }
 
 /// The draw pipelines (lines and tubes, at 1 and [`MSAA`] samples) and targets.
 pub struct Renderer {
-    /// [lines, tubes] × [1 sample, MSAA].
-    pipelines: [[wgpu::RenderPipeline; 2]; 2],
+    /// [lines, tubes, floor, mesh] × [1 sample, MSAA].
+    pipelines: [[wgpu::RenderPipeline; 2]; 4],
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
     indices: wgpu::Buffer,
@@ -58,8 +74,7 @@ impl Renderer {
     /// Builds the pipelines from `shaders/space_colonization_draw.wgsl` for `format`.
     pub fn new(setup: &NodeSetup<'_>, format: wgpu::TextureFormat) -> Result<Self, ShaderError> {
         let device = &setup.gpu.device;
-        let (origin, source) =
-            setup.shader_source("space_colonization_draw.wgsl", &[("view", 0), ("posed", 1), ("nodes", 2)])?;
+        let (origin, source) = setup.shader_source("space_colonization_draw.wgsl", &DRAW_BINDINGS)?;
         let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
         let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -68,6 +83,9 @@ impl Renderer {
                 crate::gpu::uniform_entry::<ViewUniforms>(0, stages),
                 crate::gpu::storage_entry(1, wgpu::ShaderStages::VERTEX, true),
                 crate::gpu::storage_entry(2, wgpu::ShaderStages::VERTEX, true),
+                crate::gpu::storage_entry(3, wgpu::ShaderStages::VERTEX, true),
+                crate::gpu::storage_entry(4, wgpu::ShaderStages::VERTEX, true),
+                crate::gpu::storage_entry(5, wgpu::ShaderStages::VERTEX, true),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -84,6 +102,13 @@ impl Renderer {
                 Style::Tubes => {
                     ("vs_tube", "fs_tube", wgpu::PrimitiveTopology::TriangleList, wgpu::CompareFunction::Less, false)
                 }
+                Style::Floor => {
+                    ("vs_floor", "fs_floor", wgpu::PrimitiveTopology::TriangleList, wgpu::CompareFunction::Less, false)
+                }
+                // The glow adds where nothing nearer hides it.
+                Style::Mesh => {
+                    ("vs_mesh", "fs_mesh", wgpu::PrimitiveTopology::TriangleList, wgpu::CompareFunction::Less, true)
+                }
             };
             let desc = RasterDesc {
                 vertex,
@@ -98,7 +123,7 @@ impl Renderer {
             raster_pipeline(device, &module, &pipeline_layout, &desc)
         };
         let pipelines = crate::gpu::validated(device, &origin, || {
-            [Style::Lines, Style::Tubes].map(|s| [pipeline(s, 1), pipeline(s, MSAA)])
+            [Style::Lines, Style::Tubes, Style::Floor, Style::Mesh].map(|s| [pipeline(s, 1), pipeline(s, MSAA)])
         })?;
         let index_data = tube_indices();
         use wgpu::util::DeviceExt;
@@ -131,6 +156,9 @@ impl Renderer {
                     wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 1, resource: state.posed.buffer.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 2, resource: state.nodes.buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: state.mesh.positions.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: state.skins.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 5, resource: state.joints.as_entire_binding() },
                 ],
             })
         });
@@ -143,6 +171,7 @@ impl Renderer {
         state: &GrowthState,
         color: crate::graph::TextureHandle,
         style: Style,
+        extras: Extras,
         clear: wgpu::Color,
     ) {
         let Some(group) = self.groups.get(&(state.posed.id, state.nodes.id)) else { return };
@@ -150,6 +179,10 @@ impl Renderer {
         let mut pass = self.targets.begin_pass(ctx.encoder, &output, clear);
         let samples = usize::from(self.targets.samples() > 1);
         pass.set_bind_group(0, group, &[]);
+        if extras.floor {
+            pass.set_pipeline(&self.pipelines[2][samples]);
+            pass.draw(0..6, 0..1);
+        }
         match style {
             Style::Lines => {
                 pass.set_pipeline(&self.pipelines[0][samples]);
@@ -160,6 +193,12 @@ impl Renderer {
                 pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed_indirect(&state.args.buffer, TUBE_ARGS);
             }
+            Style::Floor | Style::Mesh => {}
+        }
+        if extras.mesh && state.mesh.index_count > 0 {
+            pass.set_pipeline(&self.pipelines[3][samples]);
+            pass.set_index_buffer(state.mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..state.mesh.index_count, 0, 0..1);
         }
     }
 }
