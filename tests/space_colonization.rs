@@ -9,6 +9,7 @@ mod common;
 use indra::offscreen::OffscreenRenderer;
 use indra::params::{ParamSet, ParamValue};
 use indra::scene::load_scene;
+use indra::techniques::Technique;
 use indra::techniques::runner::NodeRunner;
 use indra::techniques::space_colonization::{self, Attraction, NONE, Node, SpaceColonization, reference};
 
@@ -209,4 +210,106 @@ fn golden_space_colonization_lines() {
 #[test]
 fn golden_space_colonization_tubes() {
     golden("space_colonization_tubes", &[30, 90], &[]);
+}
+
+fn model_rig(path: &str) -> Runner {
+    rig(&[
+        ("source", ParamValue::Enum(1)),
+        ("model", ParamValue::Text(indra::params::Text::new(path))),
+        ("voxels", ParamValue::Int(40)),
+        ("influence", ParamValue::Float(1.91)),
+        ("growth_distance", ParamValue::Float(0.573)),
+        ("kill_distance", ParamValue::Float(0.398)),
+        ("seed_count", ParamValue::Int(8)),
+        ("animation_speed", ParamValue::Float(1.0)),
+    ])
+}
+
+#[test]
+fn branches_inside_the_figure_follow_its_four_weight_skin() {
+    let mut r = model_rig("assets/models/RiggedFigure.gltf");
+    r.run(50);
+    assert!(r.node.take_messages().is_empty());
+    let mesh = r.node.model().expect("the bundled figure loads").clone();
+    let (_, nodes) = r.node.read();
+    let posed = r.node.read_posed();
+    assert_eq!(posed.len(), nodes.len());
+    assert!(nodes.len() > 100, "{} nodes", nodes.len());
+    // The last drawn frame is frame 49; the figure moves then (not the bind pose).
+    let seconds = 49.0 / 60.0;
+    let matrices = mesh.joint_matrices(mesh.ping_pong(seconds, 1.0));
+    let model = glam::Mat4::from_scale(glam::Vec3::splat(6.0));
+    let mut moved = 0.0f32;
+    for (n, p) in nodes.iter().zip(&posed) {
+        let skinned = model.transform_point3(glam::Vec3::from(mesh.skin_point(n.skin as usize, n.pos, &matrices)));
+        let bind = model.transform_point3(mesh.bind_transform().transform_point3(glam::Vec3::from(n.pos)));
+        assert!((skinned - glam::Vec3::new(p[0], p[1], p[2])).length() < 1e-3, "{skinned} vs {p:?}");
+        assert!((p[3] - n.t).abs() < 1e-6);
+        moved = moved.max((skinned - bind).length());
+    }
+    assert!(moved > 0.1, "the pose moves branches away from the bind pose: {moved}");
+}
+
+/// The bundled figure's JSON with `edit` applied, written to a temporary file.
+fn edited_figure(name: &str, edit: impl Fn(&str) -> String) -> std::path::PathBuf {
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/models/RiggedFigure.gltf")).unwrap();
+    let dir = std::env::temp_dir().join(format!("indra-gltf-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, edit(&text)).unwrap();
+    path
+}
+
+#[test]
+fn a_broken_model_is_one_clear_message_and_the_growth_goes_on_in_the_sphere() {
+    use indra::geometry::skinned::SkinnedMesh;
+    let truncated = edited_figure("truncated.gltf", |t| t[..t.len() / 2].to_string());
+    let missing = edited_figure("missing-buffer.gltf", |t| {
+        let value = t.find("\"data:").unwrap();
+        let end = value + 1 + t[value + 1..].find('"').unwrap() + 1;
+        format!("{}\"nowhere.bin\"{}", &t[..value], &t[end..])
+    });
+    let bad_accessor = edited_figure("bad-accessor.gltf", |t| t.replacen("\"POSITION\": 3", "\"POSITION\": 99", 1));
+    for (path, says) in
+        [(&truncated, "truncated.gltf"), (&missing, "nowhere.bin"), (&bad_accessor, "bad-accessor.gltf")]
+    {
+        let e = SkinnedMesh::load(path).expect_err("a broken file is an error");
+        assert!(e.contains(says), "'{e}' should name {says}");
+        let mut r = model_rig(path.to_str().unwrap());
+        r.run(10);
+        let messages = r.node.take_messages();
+        assert_eq!(messages.len(), 1, "{messages:?}");
+        assert!(messages[0].contains(path.file_name().unwrap().to_str().unwrap()), "{messages:?}");
+        assert!(r.node.model().is_none() && r.node.read().1.len() > 8, "the show goes on in the sphere");
+    }
+    let e = SkinnedMesh::load(std::path::Path::new("no/such/figure.glb")).unwrap_err();
+    assert!(e.contains("figure.glb"), "{e}");
+}
+
+#[test]
+fn a_binary_glb_loads_like_the_gltf() {
+    use indra::geometry::skinned::SkinnedMesh;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/models/RiggedFigure.gltf");
+    let (document, buffers, _) = gltf::import(path).unwrap();
+    let mut json = document.into_json();
+    json.buffers[0].uri = None;
+    let json = gltf::json::serialize::to_string(&json).unwrap();
+    let mut bin = buffers[0].0.clone();
+    bin.resize(bin.len().next_multiple_of(4), 0);
+    let glb = gltf::binary::Glb {
+        header: gltf::binary::Header { magic: *b"glTF", version: 2, length: 0 },
+        json: std::borrow::Cow::Owned(json.into_bytes()),
+        bin: Some(std::borrow::Cow::Owned(bin)),
+    };
+    let file = std::env::temp_dir().join(format!("indra-figure-{}.glb", std::process::id()));
+    std::fs::write(&file, glb.to_vec().unwrap()).unwrap();
+    let (a, b) = (SkinnedMesh::load(std::path::Path::new(path)).unwrap(), SkinnedMesh::load(&file).unwrap());
+    assert_eq!((a.positions, a.triangles, a.joints), (b.positions, b.triangles, b.joints));
+    assert_eq!(a.channels.len(), b.channels.len());
+}
+
+#[test]
+fn golden_space_colonization_skinned() {
+    golden("space_colonization_skinned", &[40, 160], &["growth.voxels=48"]);
 }

@@ -80,12 +80,16 @@ pub struct SkinnedMesh {
 impl SkinnedMesh {
     /// Reads a `.gltf` or `.glb` file; the error names the file and what is wrong.
     pub fn load(path: &std::path::Path) -> Result<Self, String> {
-        let (document, buffers, _) = gltf::import(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        precheck(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+        let (document, buffers, _) =
+            gltf::import(path).map_err(|e| format!("{}: {}", path.display(), explain(path, e)))?;
         Self::from_document(&document, &buffers).map_err(|e| format!("{}: {e}", path.display()))
     }
 
     /// Reads a self-contained `.gltf` (data URIs) or `.glb` from memory.
     pub fn from_slice(name: &str, bytes: &[u8]) -> Result<Self, String> {
+        precheck(bytes).map_err(|e| format!("{name}: {e}"))?;
         let (document, buffers, _) = gltf::import_slice(bytes).map_err(|e| format!("{name}: {e}"))?;
         Self::from_document(&document, &buffers).map_err(|e| format!("{name}: {e}"))
     }
@@ -218,6 +222,46 @@ impl SkinnedMesh {
         let period = 2.0 * f64::from(self.duration);
         let phase = (seconds * f64::from(speed)).rem_euclid(period);
         (if phase > f64::from(self.duration) { period - phase } else { phase }) as f32
+    }
+}
+
+/// Accessor references checked before the crate validates: gltf-json 1.4.1 indexes the accessor
+/// list with a primitive's POSITION index unchecked, so an out-of-range one panics.
+fn precheck(bytes: &[u8]) -> Result<(), String> {
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| e.to_string())?;
+    let accessors = gltf.document.as_json().accessors.len();
+    for (m, mesh) in gltf.document.as_json().meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let attributes = primitive.attributes.iter().map(|(semantic, a)| (format!("{semantic:?}"), a.value()));
+            let indices = primitive.indices.iter().map(|a| ("indices".to_string(), a.value()));
+            if let Some((what, a)) = attributes.chain(indices).find(|(_, a)| *a >= accessors) {
+                return Err(format!("mesh {m} primitive {p}: {what} names accessor {a}, but there are {accessors}"));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The import error in words; a missing external buffer is named (the crate's I/O error is not).
+fn explain(path: &std::path::Path, error: gltf::Error) -> String {
+    if !matches!(error, gltf::Error::Io(_)) || !path.is_file() {
+        return error.to_string();
+    }
+    let Ok(gltf) = gltf::Gltf::open(path) else { return error.to_string() };
+    let dir = path.parent().unwrap_or(std::path::Path::new("."));
+    let missing: Vec<String> = gltf
+        .buffers()
+        .filter_map(|b| match b.source() {
+            gltf::buffer::Source::Uri(uri) if !uri.starts_with("data:") && !dir.join(uri).is_file() => {
+                Some(uri.to_string())
+            }
+            _ => None,
+        })
+        .collect();
+    if missing.is_empty() {
+        error.to_string()
+    } else {
+        format!("buffer file {} not found beside it", missing.join(", "))
     }
 }
 

@@ -176,6 +176,21 @@ impl SpaceColonization {
         self.state.as_ref().map(|s| s.read(&self.device, &self.queue)).unwrap_or_default()
     }
 
+    /// Every node's drawn position (world, w = t) from the last drawn frame (blocking; tests).
+    pub fn read_posed(&self) -> Vec<[f32; 4]> {
+        let Some(state) = &self.state else { return Vec::new() };
+        let count = self.read().1.len() as u64;
+        crate::gpu::read_buffer(&self.device, &self.queue, &state.posed.buffer, 0, count.max(1) * 16)
+            .map(|b| bytemuck::pod_collect_to_vec(&b))
+            .map(|v: Vec<[f32; 4]>| v[..count as usize].to_vec())
+            .unwrap_or_default()
+    }
+
+    /// The model the attractions were sampled from (None for the sphere, or a model that failed).
+    pub fn model(&self) -> Option<&SkinnedMesh> {
+        self.mesh.as_deref()
+    }
+
     /// Node slots (the attraction count, as in the book).
     pub fn capacity(&self) -> u32 {
         self.state.as_ref().map_or(0, |s| s.capacity)
