@@ -45,8 +45,8 @@ struct Node {
 
 const PI: f32 = 3.14159265;
 // Must match `TUBE_SIDES` and `TUBE_CAP_ROWS` in render.rs (the index buffer).
-const SIDES: u32 = 10u;
-const CAP_ROWS: u32 = 4u;
+const SIDES: u32 = 8u;
+const CAP_ROWS: u32 = 3u;
 
 struct Edge {
     from_pos: vec3<f32>,

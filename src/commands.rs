@@ -343,7 +343,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     for _ in 0..args.warmup {
         renderer.render_only().map_err(|e| e.to_string())?;
     }
-    renderer.finish_timings();
+    renderer.restart_timings();
     let mut walls = Vec::with_capacity(args.frames.min(1 << 16) as usize);
     let mut last = Instant::now();
     let mut stats = None;

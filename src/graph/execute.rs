@@ -214,6 +214,13 @@ impl GraphRuntime {
         }
     }
 
+    /// Forgets the timings so far, so that later medians cover only what follows.
+    pub fn reset_timings(&mut self) {
+        if let Some(t) = self.timer.as_mut() {
+            t.reset();
+        }
+    }
+
     fn resolve_texture(
         &mut self,
         device: &wgpu::Device,

@@ -212,6 +212,12 @@ impl GpuTimer {
         self.frame_total.median()
     }
 
+    /// Forgets every sample so far (a benchmark starts measuring after its seek and warm-up).
+    pub fn reset(&mut self) {
+        self.medians.clear();
+        self.frame_total = RollingMedian::new(WINDOW);
+    }
+
     /// Blocks until every in-flight slot is read (for `indra bench` at the end of a run).
     pub fn drain(&mut self, device: &wgpu::Device) {
         let _ = device.poll(wgpu::PollType::wait_indefinitely());

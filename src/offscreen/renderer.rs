@@ -129,6 +129,13 @@ impl OffscreenRenderer {
     pub fn finish_timings(&mut self) {
         self.runtime.drain_timings(&self.gpu.device);
     }
+
+    /// Waits for outstanding timings, then forgets them all (seek and warm-up frames must not
+    /// enter a benchmark's medians).
+    pub fn restart_timings(&mut self) {
+        self.runtime.drain_timings(&self.gpu.device);
+        self.runtime.reset_timings();
+    }
 }
 
 /// Why an off-screen frame could not be produced; each is one sentence for the user.

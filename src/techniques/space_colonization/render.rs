@@ -8,9 +8,9 @@ use crate::graph::PassContext;
 use crate::techniques::NodeSetup;
 
 /// Vertices around a tube (the draw shader's `SIDES`).
-pub const TUBE_SIDES: u32 = 10;
+pub const TUBE_SIDES: u32 = 8;
 /// Rings of the tip's hemispherical cap (the draw shader's `CAP_ROWS`).
-pub const TUBE_CAP_ROWS: u32 = 4;
+pub const TUBE_CAP_ROWS: u32 = 3;
 /// The draw shader's bindings, in the order of the draw group's entries.
 const DRAW_BINDINGS: [(&str, u32); 6] =
     [("view", 0), ("posed", 1), ("nodes", 2), ("mesh_positions", 3), ("vertex_skins", 4), ("joint_matrices", 5)];
