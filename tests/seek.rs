@@ -29,6 +29,11 @@ const CI_SETTINGS: &[(&str, &[&str], &str)] = &[
         &["growth.side=40"],
         "a million attractions take seconds per step on lavapipe; the same grid path runs with 33,000",
     ),
+    (
+        "space_colonization_skinned.ron",
+        &["growth.voxels=48"],
+        "voxelising and sampling the figure at 80 voxels takes ~10 s in a debug build; the same path at 48",
+    ),
 ];
 
 fn renderer(scene: Scene) -> OffscreenRenderer {
