@@ -310,6 +310,13 @@ fn a_binary_glb_loads_like_the_gltf() {
 }
 
 #[test]
+fn golden_space_colonization_1m_at_ci_size() {
+    // The scene's lit tubes and growth settings with 17,000 attractions (a million take seconds a
+    // step on lavapipe; the H200 bench runs the million).
+    golden("space_colonization_1m", &[20, 50], &["growth.side=32"]);
+}
+
+#[test]
 fn golden_space_colonization_skinned() {
     golden("space_colonization_skinned", &[40, 160], &["growth.voxels=48"]);
 }

@@ -30,7 +30,7 @@ pub fn params() -> Vec<ParamDecl> {
             "side",
             Int(16),
             Some((8.0, 128.0)),
-            "lattice points per axis: side 28 gives 10,144 attractions, 124 about a million (restarts)",
+            "lattice points per axis: side 28 gives 10,144 attractions, 126 gives 1,022,208 (restarts)",
         ),
         ParamDecl::new("seed_count", Int(6), Some((1.0, 64.0)), "branches to start from (restarts)"),
         ParamDecl::new("variation", Int(0), Some((0.0, 1e6)), "another jitter and other seeds (restarts)"),
