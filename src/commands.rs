@@ -37,6 +37,10 @@ pub struct RunArgs {
     /// a vector as 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
     #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
     pub sets: Vec<String>,
+    /// Samples per pixel of rasterising nodes, 1, 2, 4 or 8 (default: the scene's, normally 4);
+    /// lowered to what the adapter supports.
+    #[arg(long, value_parser = parse_msaa)]
+    pub msaa: Option<u32>,
     /// OSC listen address; loopback by default, 0.0.0.0:9000 opens it to the network.
     #[arg(long, default_value = DEFAULT_OSC)]
     pub osc: String,
@@ -80,6 +84,7 @@ impl Default for RunArgs {
             fullscreen: false,
             monitor: None,
             sets: Vec::new(),
+            msaa: None,
             osc: DEFAULT_OSC.into(),
             no_osc: false,
             osc_out: None,
@@ -121,6 +126,10 @@ pub struct RenderArgs {
     /// 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
     #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
     pub sets: Vec<String>,
+    /// Samples per pixel of rasterising nodes, 1, 2, 4 or 8 (default: the scene's, normally 4);
+    /// lowered to what the adapter supports.
+    #[arg(long, value_parser = parse_msaa)]
+    pub msaa: Option<u32>,
     /// Replay a control stream recorded with `run --record-controls`, frame-exactly.
     #[arg(long)]
     pub replay: Option<PathBuf>,
@@ -148,9 +157,20 @@ pub struct BenchArgs {
     /// 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
     #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
     pub sets: Vec<String>,
+    /// Samples per pixel of rasterising nodes, 1, 2, 4 or 8 (default: the scene's, normally 4);
+    /// lowered to what the adapter supports.
+    #[arg(long, value_parser = parse_msaa)]
+    pub msaa: Option<u32>,
     /// Hold tracks still (measure one parameter set, not an animation).
     #[arg(long)]
     pub no_animation: bool,
+}
+
+fn parse_msaa(text: &str) -> Result<u32, String> {
+    match text.trim().parse::<u32>() {
+        Ok(n @ (1 | 2 | 4 | 8)) => Ok(n),
+        _ => Err(format!("'{text}' is not a sample count: use 1, 2, 4 or 8")),
+    }
 }
 
 fn parse_size(text: &str) -> Result<(u32, u32), String> {
@@ -181,10 +201,13 @@ fn check_timing(start: u64, frames: u64, dt: Option<f32>) -> Result<(), String> 
 }
 
 /// Loads a scene and applies `--set` assignments.
-fn scene_with_sets(assets: &Assets, name: &str, sets: &[String]) -> Result<Scene, String> {
+fn scene_with_sets(assets: &Assets, name: &str, sets: &[String], msaa: Option<u32>) -> Result<Scene, String> {
     let mut scene = load_scene(assets, name).map_err(|e| e.to_string())?;
     for assignment in sets {
         scene.set_from_str(assignment)?;
+    }
+    if let Some(samples) = msaa {
+        scene.msaa = samples;
     }
     Ok(scene)
 }
@@ -193,9 +216,9 @@ fn scene_with_sets(assets: &Assets, name: &str, sets: &[String]) -> Result<Scene
 /// copy (with the error shown) so the show starts; the fix is picked up on save.
 pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), String> {
     let mut notices = Vec::new();
-    let scene = match scene_with_sets(assets, &args.scene, &args.sets) {
+    let scene = match scene_with_sets(assets, &args.scene, &args.sets, args.msaa) {
         Ok(scene) => scene,
-        Err(e) => match scene_with_sets(&Assets::new(None), &args.scene, &args.sets) {
+        Err(e) => match scene_with_sets(&Assets::new(None), &args.scene, &args.sets, args.msaa) {
             Ok(builtin) => {
                 notices.push(format!("{e}\n(running the built-in copy until the file is fixed)"));
                 builtin
@@ -221,7 +244,7 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
 /// Renders a PNG sequence.
 pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<(), String> {
     check_timing(args.start, args.frames, args.dt)?;
-    let scene = scene_with_sets(assets, &args.scene, &args.sets)?;
+    let scene = scene_with_sets(assets, &args.scene, &args.sets, args.msaa)?;
     let script = match &args.replay {
         Some(path) => indra::control::record::read_replay(path, &scene)?,
         None => Default::default(),
@@ -331,7 +354,7 @@ pub fn list(assets: &Assets) -> Result<(), String> {
 /// Renders `frames` frames and prints per-pass GPU medians and frame time.
 pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), String> {
     check_timing(args.start, args.frames.saturating_add(args.warmup), None)?;
-    let scene = scene_with_sets(assets, &args.scene, &args.sets)?;
+    let scene = scene_with_sets(assets, &args.scene, &args.sets, args.msaa)?;
     let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
     let adapter = device.adapter_label();
     let timestamps = device.has_timestamps();

@@ -66,7 +66,7 @@ fn random_params(rng: &mut SplitMix64, grid: i32) -> ParamSet {
 
 fn node(gpu: &indra::gpu::Gpu) -> Tessellation {
     let assets = common::assets();
-    Tessellation::new(&NodeSetup { gpu, assets: &assets, id: "surface", output_size: (320, 200) }).unwrap()
+    Tessellation::new(&NodeSetup { gpu, assets: &assets, id: "surface", output_size: (320, 200), msaa: 4 }).unwrap()
 }
 
 #[test]

@@ -98,6 +98,24 @@ impl<'r> FrameGraph<'r> {
         TextureHandle(self.textures.len() as u32 - 1)
     }
 
+    /// The attachments of a rasterising pass named `name`: the single-sample `format` image that
+    /// downstream nodes read, a multisampled colour target resolved into it when `samples` > 1,
+    /// and a depth buffer of `depth` format (same sample count) if asked for.
+    pub fn create_raster_targets(
+        &mut self,
+        name: &str,
+        format: wgpu::TextureFormat,
+        depth: Option<wgpu::TextureFormat>,
+        samples: u32,
+    ) -> RasterTargets {
+        let color = self.create_texture(format!("{name}/image"), TextureDesc::full(format));
+        let msaa = (samples > 1)
+            .then(|| self.create_texture(format!("{name}/msaa"), TextureDesc::full(format).multisampled(samples)));
+        let depth =
+            depth.map(|d| self.create_texture(format!("{name}/depth"), TextureDesc::full(d).multisampled(samples)));
+        RasterTargets { color, msaa, depth }
+    }
+
     /// Brings a node-owned texture into the graph. Passes that write it are never culled.
     pub fn import_texture(&mut self, name: impl Into<String>, texture: &PersistentTexture) -> TextureHandle {
         let origin = TextureOrigin::Imported(texture.texture.clone(), texture.view.clone(), texture.id);
@@ -180,6 +198,14 @@ impl<'r> PassBuilder<'_, 'r> {
         self
     }
 
+    /// The pass draws into `targets` (each of them a render target).
+    pub fn draws_into(mut self, targets: &RasterTargets) -> Self {
+        for t in [Some(targets.color), targets.msaa, targets.depth].into_iter().flatten() {
+            self = self.render_target(t);
+        }
+        self
+    }
+
     /// The pass reads `buffer` (storage or uniform).
     pub fn read_buffer(mut self, buffer: BufferHandle) -> Self {
         self.decl.accesses.push((Resource::Buffer(buffer.0), Access::Read));
@@ -203,6 +229,17 @@ impl<'r> PassBuilder<'_, 'r> {
         self.decl.record = Some(Box::new(record));
         self.graph.passes.push(self.decl);
     }
+}
+
+/// The attachments of a rasterising pass (see [`FrameGraph::create_raster_targets`]).
+#[derive(Clone, Copy, Debug)]
+pub struct RasterTargets {
+    /// The single-sample image downstream nodes read.
+    pub color: TextureHandle,
+    /// The multisampled colour target resolved into `color` (none at one sample).
+    pub msaa: Option<TextureHandle>,
+    /// The depth buffer, if any.
+    pub depth: Option<TextureHandle>,
 }
 
 /// A resolved texture as a pass sees it.
@@ -261,6 +298,11 @@ impl PassContext<'_> {
         self.buffers[buffer.0 as usize].as_ref().map(|b| b.1).unwrap_or(0)
     }
 
+    /// Begins a render pass into `targets` that clears to `clear` and ends resolved into the image.
+    pub fn begin_draw(&mut self, targets: &RasterTargets, clear: wgpu::Color) -> wgpu::RenderPass<'_> {
+        self.begin_resolved_pass(targets.color, targets.msaa, targets.depth, clear)
+    }
+
     /// Begins a render pass that clears `color` (and a depth buffer to 1.0, discarded after the
     /// pass): the usual start of a rasterising technique.
     pub fn begin_color_depth_pass(
@@ -269,29 +311,41 @@ impl PassContext<'_> {
         depth: TextureHandle,
         clear: wgpu::Color,
     ) -> wgpu::RenderPass<'_> {
-        self.begin_pass(color, Some(depth), clear)
+        self.begin_resolved_pass(color, None, Some(depth), clear)
     }
 
     /// Begins a render pass that clears `color`, without depth.
     pub fn begin_color_pass(&mut self, color: TextureHandle, clear: wgpu::Color) -> wgpu::RenderPass<'_> {
-        self.begin_pass(color, None, clear)
+        self.begin_resolved_pass(color, None, None, clear)
     }
 
-    fn begin_pass(
+    /// Begins a render pass that clears `msaa` (a multisampled target, if given) and resolves it
+    /// into `color` at the end — or clears and draws `color` directly — with an optional depth
+    /// buffer (of the same sample count) cleared to 1.0 and discarded after the pass.
+    pub fn begin_resolved_pass(
         &mut self,
         color: TextureHandle,
+        msaa: Option<TextureHandle>,
         depth: Option<TextureHandle>,
         clear: wgpu::Color,
     ) -> wgpu::RenderPass<'_> {
         let color_view = self.view(color).clone();
+        let msaa_view = msaa.map(|m| self.view(m).clone());
         let depth_view = depth.map(|d| self.view(d).clone());
+        let (view, resolve_target) = match &msaa_view {
+            Some(samples) => (samples, Some(&color_view)),
+            None => (&color_view, None),
+        };
         self.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(self.pass_name),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &color_view,
+                view,
                 depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+                resolve_target,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store: if resolve_target.is_some() { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
+                },
             })],
             depth_stencil_attachment: depth_view.as_ref().map(|view| wgpu::RenderPassDepthStencilAttachment {
                 view,

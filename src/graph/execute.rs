@@ -125,7 +125,8 @@ impl GraphRuntime {
                     let (resolved, pooled) = self.resolve_texture(device, &graph, t, usages[t]);
                     if let Some(i) = pooled {
                         let bytes = texture_bytes(size_of(&resolved), resolved.texture.format())
-                            * u64::from(resolved.texture.depth_or_array_layers());
+                            * u64::from(resolved.texture.depth_or_array_layers())
+                            * u64::from(resolved.texture.sample_count());
                         stats.transient_bytes_requested += bytes;
                         if used_pool_entries.insert(i) {
                             stats.transient_bytes_allocated += bytes;
@@ -238,6 +239,7 @@ impl GraphRuntime {
                     format: desc.format,
                     usage,
                     layers: desc.layers,
+                    samples: desc.samples,
                 };
                 let (index, resolved) = self.pool.acquire(device, key);
                 (resolved, Some(index))

@@ -13,7 +13,7 @@ mod pool;
 mod resource;
 mod timing;
 
-pub use builder::{FrameGraph, PassBuilder, PassContext};
+pub use builder::{FrameGraph, PassBuilder, PassContext, RasterTargets};
 pub use compile::{CompiledGraph, GraphError, compile};
 pub use execute::{FrameOutput, FrameStats, GraphRuntime};
 pub use pool::TexturePool;

@@ -16,6 +16,8 @@ pub struct PoolKey {
     pub usage: wgpu::TextureUsages,
     /// Array layers (`None`: plain 2-D).
     pub layers: Option<u32>,
+    /// Samples per texel.
+    pub samples: u32,
 }
 
 struct Entry {
@@ -49,6 +51,7 @@ impl TexturePool {
                 && e.key.size == key.size
                 && e.key.format == key.format
                 && e.key.layers == key.layers
+                && e.key.samples == key.samples
                 && e.key.usage.contains(key.usage)
         });
         let index = found.unwrap_or_else(|| {
@@ -61,7 +64,7 @@ impl TexturePool {
                     depth_or_array_layers: key.layers.unwrap_or(1),
                 },
                 mip_level_count: 1,
-                sample_count: 1,
+                sample_count: key.samples,
                 dimension: wgpu::TextureDimension::D2,
                 format: key.format,
                 usage: key.usage,

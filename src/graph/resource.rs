@@ -34,17 +34,26 @@ pub struct TextureDesc {
     /// `None`: a plain 2-D texture. `Some(n)`: a 2-D array of `n` layers, viewed as `D2Array`
     /// even when `n` is 1 (so shaders declaring arrays bind it whatever `n` is).
     pub layers: Option<u32>,
+    /// Samples per texel: more than 1 for a multisampled render target, which a pass resolves
+    /// into a single-sample texture (see `PassContext::begin_resolved_pass`).
+    pub samples: u32,
 }
 
 impl TextureDesc {
     /// A texture the size of the output.
     pub fn full(format: wgpu::TextureFormat) -> Self {
-        Self { extent: Extent::Relative(1, 1), format, layers: None }
+        Self { extent: Extent::Relative(1, 1), format, layers: None, samples: 1 }
     }
 
     /// A texture `num/den` of the output size.
     pub fn scaled(format: wgpu::TextureFormat, num: u32, den: u32) -> Self {
-        Self { extent: Extent::Relative(num, den), format, layers: None }
+        Self { extent: Extent::Relative(num, den), format, layers: None, samples: 1 }
+    }
+
+    /// The same size and format with `samples` samples per texel (a render target only).
+    #[must_use]
+    pub fn multisampled(self, samples: u32) -> Self {
+        Self { samples: samples.max(1), ..self }
     }
 
     /// The same size and format as a 2-D array of `layers` layers.

@@ -38,7 +38,7 @@ impl SceneInstance {
         let nodes = scene
             .nodes
             .iter()
-            .map(|n| (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size }))
+            .map(|n| (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa: scene.msaa }))
             .collect::<Result<Vec<_>, _>>()?;
         let params = scene.nodes.iter().map(|n| n.params.clone()).collect();
         Ok(Self {
@@ -182,7 +182,7 @@ impl SceneInstance {
             .iter()
             .map(|&i| {
                 let n = &self.scene.nodes[i];
-                (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size })
+                (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa: self.scene.msaa })
             })
             .collect::<Result<Vec<_>, _>>()?;
         for (i, node) in using.iter().zip(rebuilt) {
@@ -203,14 +203,18 @@ impl SceneInstance {
         assets: &Assets,
         output_size: (u32, u32),
     ) -> Result<Remap, ShaderError> {
+        // A changed sample count rebuilds every node (pipelines are made for one count).
+        let same_msaa = self.scene.msaa == scene.msaa;
         let kept = |n: &super::SceneNode| {
-            self.scene.nodes.iter().position(|o| o.id == n.id && o.technique.name == n.technique.name)
+            self.scene.nodes.iter().position(|o| same_msaa && o.id == n.id && o.technique.name == n.technique.name)
         };
         let mut fresh: Vec<Option<Box<dyn Technique>>> = Vec::with_capacity(scene.nodes.len());
         for n in &scene.nodes {
             fresh.push(match kept(n) {
                 Some(_) => None,
-                None => Some((n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size })?),
+                None => {
+                    Some((n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa: scene.msaa })?)
+                }
             });
         }
         let mut old_nodes: Vec<Option<Box<dyn Technique>>> = self.nodes.drain(..).map(Some).collect();

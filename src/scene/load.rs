@@ -23,6 +23,8 @@ pub struct Scene {
     pub seed: u64,
     /// Fixed step, seconds.
     pub dt: f32,
+    /// Samples per pixel wanted for rasterising nodes (1, 2, 4 or 8; the adapter may allow fewer).
+    pub msaa: u32,
     /// Nodes in dependency order (inputs before their consumers).
     pub nodes: Vec<SceneNode>,
     /// Index of the output node in `nodes`.
@@ -244,6 +246,9 @@ impl Validator<'_> {
         if file.size.0 == 0 || file.size.1 == 0 || file.size.0 > 16384 || file.size.1 > 16384 {
             self.error(&["size"], format!("size {:?} must be between 1 and 16384 on each axis", file.size));
         }
+        if ![1, 2, 4, 8].contains(&file.msaa) {
+            self.error(&["msaa"], format!("msaa {} must be 1, 2, 4 or 8 samples per pixel", file.msaa));
+        }
         if !(file.dt > 0.0 && file.dt <= 1.0) {
             self.error(&["dt"], format!("dt {} must be in (0, 1] seconds", file.dt));
         }
@@ -291,6 +296,7 @@ impl Validator<'_> {
             size: file.size,
             seed: file.seed,
             dt: file.dt,
+            msaa: file.msaa,
             nodes: ordered,
             output,
             tracks,

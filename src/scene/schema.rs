@@ -43,6 +43,10 @@ pub struct SceneFile {
     /// Fixed simulation step in seconds (default 1/60).
     #[serde(default = "default_dt")]
     pub dt: f32,
+    /// Samples per pixel of the rasterising nodes (1, 2, 4 or 8; default 4), resolved before
+    /// any post effect sees the image. `run`, `render` and `bench` override it with `--msaa`.
+    #[serde(default = "default_msaa")]
+    pub msaa: u32,
     /// Technique instances and their wiring.
     pub nodes: Vec<NodeFile>,
     /// The node whose texture is shown.
@@ -129,6 +133,10 @@ pub enum MidiCurve {
     Linear,
     /// Fine control at the low end (for zoom, speed, frequency).
     Exponential,
+}
+
+fn default_msaa() -> u32 {
+    4
 }
 
 fn default_dt() -> f32 {

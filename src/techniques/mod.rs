@@ -72,9 +72,25 @@ pub struct NodeSetup<'a> {
     pub id: &'a str,
     /// The scene's output size.
     pub output_size: (u32, u32),
+    /// Samples per pixel the scene asks rasterising nodes for (see [`NodeSetup::samples_for`]).
+    pub msaa: u32,
 }
 
 impl NodeSetup<'_> {
+    /// The scene's sample count, lowered to the largest this adapter can render and resolve for
+    /// every format in `formats` (colour targets and depth), at least 1.
+    pub fn samples_for(&self, formats: &[wgpu::TextureFormat]) -> u32 {
+        let supported = |n: u32| {
+            formats.iter().all(|f| {
+                let features = self.gpu.adapter.get_texture_format_features(*f);
+                let resolvable = f.is_depth_stencil_format()
+                    || features.flags.contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE);
+                features.flags.sample_count_supported(n) && resolvable
+            })
+        };
+        [8, 4, 2].into_iter().find(|&n| n <= self.msaa && supported(n)).unwrap_or(1)
+    }
+
     /// Loads a shader file's text and origin, turning a missing file into a located error, and
     /// checks that each `(name, binding)` the technique binds in group 0 is where the WGSL
     /// declares it (naga reflection): layouts and shaders cannot drift apart, also when a shader

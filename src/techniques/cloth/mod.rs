@@ -18,7 +18,7 @@ use render::{ClothView, Renderer};
 use state::State;
 
 use crate::gpu::{ComputeKernel, ShaderError};
-use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
+use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::ParamSet;
 use crate::time::{FrameTime, MAX_CATCH_UP_STEPS};
 
@@ -212,8 +212,7 @@ impl Technique for Cloth {
             });
             this.kernels.normals.dispatch(&mut pass, &[&state.bind_groups[&state.normals_key()]], [count, 1, 1]);
         });
-        let color = graph.create_texture("cloth/image", TextureDesc::full(FORMAT));
-        let depth = graph.create_texture("cloth/depth", TextureDesc::full(render::DEPTH));
+        let targets = graph.create_raster_targets("cloth", FORMAT, Some(render::DEPTH), this.renderer.samples);
         let mode = render::DrawMode {
             clear: view.background,
             debug: params.choice("view") == 1,
@@ -223,10 +222,9 @@ impl Technique for Cloth {
             .add_pass("cloth/draw")
             .read_buffer(cur)
             .read_buffer(normals)
-            .render_target(color)
-            .render_target(depth)
-            .record(move |ctx| this.renderer.draw(ctx, state, color, depth, mode));
-        color
+            .draws_into(&targets)
+            .record(move |ctx| this.renderer.draw(ctx, state, &targets, mode));
+        targets.color
     }
 }
 

@@ -2,7 +2,7 @@
 
 use super::state::State;
 use crate::gpu::ShaderError;
-use crate::graph::{PassContext, TextureHandle};
+use crate::graph::{PassContext, RasterTargets};
 use crate::params::ParamSet;
 use crate::techniques::{NodeSetup, srgb_to_linear};
 use crate::time::FrameTime;
@@ -89,6 +89,8 @@ pub struct Renderer {
     insets: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
+    /// Samples per pixel of the draw (the scene's `msaa`, as the adapter allows).
+    pub samples: u32,
 }
 
 impl Renderer {
@@ -112,6 +114,7 @@ impl Renderer {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
+        let samples = setup.samples_for(&[super::FORMAT, DEPTH]);
         let pipeline = |vertex, fragment, topology, additive| {
             crate::gpu::raster_pipeline(
                 device,
@@ -125,7 +128,7 @@ impl Renderer {
                     color: super::FORMAT,
                     depth: Some((DEPTH, wgpu::CompareFunction::LessEqual)),
                     additive,
-                    samples: 1,
+                    samples,
                 },
             )
         };
@@ -141,7 +144,7 @@ impl Renderer {
             )
         })?;
         let uniform = crate::gpu::uniform_buffer::<ClothViewUniforms>(device, "cloth_view");
-        Ok(Self { surface, sphere, lines, points, insets, layout, uniform })
+        Ok(Self { surface, sphere, lines, points, insets, layout, uniform, samples })
     }
 
     /// Two triangles per grid cell, shared vertices: indices are particle numbers.
@@ -185,15 +188,8 @@ impl Renderer {
     }
 
     /// Records the draw into `color` and `depth`.
-    pub fn draw(
-        &self,
-        ctx: &mut PassContext<'_>,
-        state: &State,
-        color: TextureHandle,
-        depth: TextureHandle,
-        mode: DrawMode,
-    ) {
-        let mut pass = ctx.begin_color_depth_pass(color, depth, mode.clear);
+    pub fn draw(&self, ctx: &mut PassContext<'_>, state: &State, targets: &RasterTargets, mode: DrawMode) {
+        let mut pass = ctx.begin_draw(targets, mode.clear);
         pass.set_bind_group(0, &state.draw_groups[&state.cur], &[]);
         match (&state.lines, mode.debug) {
             (Some((lines, ranges)), true) => {

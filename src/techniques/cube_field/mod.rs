@@ -9,7 +9,7 @@
 mod particles;
 
 use crate::gpu::ShaderError;
-use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
+use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 
@@ -112,6 +112,8 @@ impl CubeFieldUniforms {
 /// A cube field node.
 pub struct CubeField {
     pipeline: wgpu::RenderPipeline,
+    /// Samples per pixel of the draw (the scene's `msaa`, as the adapter allows).
+    samples: u32,
     block: crate::gpu::UniformBlock,
     instances: wgpu::Buffer,
     scratch: Vec<CubeInstance>,
@@ -122,6 +124,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let (origin, source) = setup.shader_source("cube_field.wgsl", &[("u", 0)])?;
     let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
     let block = crate::gpu::UniformBlock::new::<CubeFieldUniforms>(device, "cube_field_uniforms");
+    let samples = setup.samples_for(&[FORMAT, DEPTH]);
     let pipeline = crate::gpu::validated(device, &origin, || {
         crate::gpu::raster_pipeline(
             device,
@@ -139,7 +142,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
                 color: FORMAT,
                 depth: Some((DEPTH, wgpu::CompareFunction::Less)),
                 additive: false,
-                samples: 1,
+                samples,
             },
         )
     })?;
@@ -149,7 +152,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    Ok(Box::new(CubeField { pipeline, block, instances, scratch: Vec::with_capacity(MAX_CUBES) }))
+    Ok(Box::new(CubeField { pipeline, samples, block, instances, scratch: Vec::with_capacity(MAX_CUBES) }))
 }
 
 impl Technique for CubeField {
@@ -160,23 +163,22 @@ impl Technique for CubeField {
         time: &FrameTime,
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
-        let color = graph.create_texture("cube_field/image", TextureDesc::full(FORMAT));
-        let depth = graph.create_texture("cube_field/depth", TextureDesc::full(DEPTH));
-        let (w, h) = graph.texture_size(color);
+        let targets = graph.create_raster_targets("cube_field", FORMAT, Some(DEPTH), self.samples);
+        let (w, h) = graph.texture_size(targets.color);
         let uniforms = CubeFieldUniforms::from_params(params, w as f32 / h as f32);
         cubes_at(params, time, &mut self.scratch);
         let count = self.scratch.len() as u32;
         let this: &'r CubeField = self;
-        graph.add_pass("cube_field/draw").render_target(color).render_target(depth).record(move |ctx| {
+        graph.add_pass("cube_field/draw").draws_into(&targets).record(move |ctx| {
             ctx.queue.write_buffer(&this.block.buffer, 0, bytemuck::bytes_of(&uniforms));
             ctx.queue.write_buffer(&this.instances, 0, bytemuck::cast_slice(&this.scratch));
-            let mut pass = ctx.begin_color_depth_pass(color, depth, wgpu::Color::BLACK);
+            let mut pass = ctx.begin_draw(&targets, wgpu::Color::BLACK);
             pass.set_pipeline(&this.pipeline);
             pass.set_bind_group(0, &this.block.bind_group, &[]);
             pass.set_vertex_buffer(0, this.instances.slice(..));
             pass.draw(0..36, 0..count);
         });
-        color
+        targets.color
     }
 }
 

@@ -248,7 +248,7 @@ impl Technique for GridFluid {
         let fields = graph.import_buffer("grid_fluid/fields", buffer, *buffer_id);
         let output = graph.create_texture(
             "grid_fluid/density",
-            TextureDesc { extent: Extent::Absolute(n, n), format: FORMAT, layers: None },
+            TextureDesc { extent: Extent::Absolute(n, n), format: FORMAT, layers: None, samples: 1 },
         );
         let (simulate, last) = dispatches.split_at(dispatches.len() - 1);
         let (simulate, last) = (simulate.to_vec(), last[0]);

@@ -7,7 +7,7 @@
 
 use crate::geometry::poisson::{PoissonDisk, PoissonSettings, Step};
 use crate::gpu::ShaderError;
-use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
+use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 
@@ -144,6 +144,8 @@ impl Sampler {
 /// A Poisson disk node.
 pub struct Poisson {
     pipeline: wgpu::RenderPipeline,
+    /// Samples per pixel of the draw (the scene's `msaa`, as the adapter allows).
+    samples: u32,
     block: crate::gpu::UniformBlock,
     instances: crate::gpu::GrowableBuffer,
     /// Samples already in `instances`.
@@ -165,6 +167,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let (origin, source) = setup.shader_source("poisson.wgsl", &[("u", 0)])?;
     let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
     let block = crate::gpu::UniformBlock::new::<PoissonUniforms>(device, "poisson_uniforms");
+    let samples = setup.samples_for(&[FORMAT, DEPTH]);
     let pipeline = crate::gpu::validated(device, &origin, || {
         crate::gpu::raster_pipeline(
             device,
@@ -182,7 +185,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
                 color: FORMAT,
                 depth: Some((DEPTH, wgpu::CompareFunction::Less)),
                 additive: false,
-                samples: 1,
+                samples,
             },
         )
     })?;
@@ -190,6 +193,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         crate::gpu::GrowableBuffer::new(device, "poisson_instances", wgpu::BufferUsages::VERTEX, 4096 * INSTANCE);
     Ok(Box::new(Poisson {
         pipeline,
+        samples,
         block,
         instances,
         uploaded: 0,
@@ -252,24 +256,23 @@ impl Technique for Poisson {
         sampler.instances_from(first_new, &key, &mut self.pending);
         self.uploaded = count;
 
-        let color = graph.create_texture("poisson/image", TextureDesc::full(FORMAT));
-        let depth = graph.create_texture("poisson/depth", TextureDesc::full(DEPTH));
-        let (w, h) = graph.texture_size(color);
+        let targets = graph.create_raster_targets("poisson", FORMAT, Some(DEPTH), self.samples);
+        let (w, h) = graph.texture_size(targets.color);
         let uniforms = camera(&key, params, time, w as f32 / h as f32, count);
         let this: &'r Poisson = self;
-        graph.add_pass("poisson/draw").render_target(color).render_target(depth).record(move |ctx| {
+        graph.add_pass("poisson/draw").draws_into(&targets).record(move |ctx| {
             ctx.queue.write_buffer(&this.block.buffer, 0, bytemuck::bytes_of(&uniforms));
             if !this.pending.is_empty() {
                 let offset = first_new as u64 * INSTANCE;
                 ctx.queue.write_buffer(this.instances.buffer(), offset, bytemuck::cast_slice(&this.pending));
             }
-            let mut pass = ctx.begin_color_depth_pass(color, depth, wgpu::Color::BLACK);
+            let mut pass = ctx.begin_draw(&targets, wgpu::Color::BLACK);
             pass.set_pipeline(&this.pipeline);
             pass.set_bind_group(0, &this.block.bind_group, &[]);
             pass.set_vertex_buffer(0, this.instances.buffer().slice(..));
             pass.draw(0..6, 0..count as u32);
         });
-        color
+        targets.color
     }
 }
 

@@ -3,7 +3,7 @@
 
 use crate::geometry::triangulate::Mesh2D;
 use crate::gpu::{GrowableBuffer, RasterDesc, ShaderError, UniformBlock};
-use crate::graph::{FrameGraph, PassContext, TextureDesc, TextureHandle};
+use crate::graph::{FrameGraph, PassContext, RasterTargets, TextureHandle};
 use crate::params::ParamSet;
 use crate::time::FrameTime;
 
@@ -58,6 +58,8 @@ pub struct Renderer {
     wire: wgpu::RenderPipeline,
     open_loop: wgpu::RenderPipeline,
     block: UniformBlock,
+    /// Samples per pixel of the draw (the scene's `msaa`, as the adapter allows).
+    samples: u32,
     vertices: GrowableBuffer,
     triangles: GrowableBuffer,
     edges: GrowableBuffer,
@@ -75,6 +77,7 @@ impl Renderer {
         let (origin, source) = setup.shader_source("polygon_draw.wgsl", &[("u", 0)])?;
         let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
         let block = UniformBlock::new::<PolygonUniforms>(device, "polygon_draw_uniforms");
+        let samples = setup.samples_for(&[FORMAT]);
         let pipeline = |fragment: &str, topology| {
             crate::gpu::raster_pipeline(
                 device,
@@ -92,7 +95,7 @@ impl Renderer {
                     color: FORMAT,
                     depth: None,
                     additive: false,
-                    samples: 1,
+                    samples,
                 },
             )
         };
@@ -110,6 +113,7 @@ impl Renderer {
             wire,
             open_loop,
             block,
+            samples,
             vertices: buffer("polygon_draw_vertices", U::VERTEX),
             triangles: buffer("polygon_draw_triangles", U::INDEX),
             edges: buffer("polygon_draw_edges", U::INDEX),
@@ -149,20 +153,20 @@ impl Renderer {
         params: &ParamSet,
         time: &FrameTime,
     ) -> TextureHandle {
-        let color = graph.create_texture(format!("{name}/image"), TextureDesc::full(FORMAT));
-        let (w, h) = graph.texture_size(color);
+        let targets = graph.create_raster_targets(name, FORMAT, None, self.samples);
+        let (w, h) = graph.texture_size(targets.color);
         let uniforms = PolygonUniforms::new(params, time, w as f32 / h as f32);
         let wireframe = params.bool("wireframe");
-        graph.add_pass(format!("{name}/draw")).render_target(color).record(move |ctx| {
-            self.record(ctx, color, &uniforms, wireframe);
+        graph.add_pass(format!("{name}/draw")).draws_into(&targets).record(move |ctx| {
+            self.record(ctx, &targets, &uniforms, wireframe);
         });
-        color
+        targets.color
     }
 
-    fn record(&self, ctx: &mut PassContext<'_>, color: TextureHandle, uniforms: &PolygonUniforms, wireframe: bool) {
+    fn record(&self, ctx: &mut PassContext<'_>, targets: &RasterTargets, uniforms: &PolygonUniforms, wireframe: bool) {
         let [triangles, edges, open] = self.counts;
         ctx.queue.write_buffer(&self.block.buffer, 0, bytemuck::bytes_of(uniforms));
-        let mut pass = ctx.begin_color_pass(color, wgpu::Color::BLACK);
+        let mut pass = ctx.begin_draw(targets, wgpu::Color::BLACK);
         pass.set_bind_group(0, &self.block.bind_group, &[]);
         if triangles > 0 {
             pass.set_vertex_buffer(0, self.vertices.buffer().slice(..));

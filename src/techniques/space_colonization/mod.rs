@@ -367,7 +367,7 @@ impl Technique for SpaceColonization {
             },
         };
         let extras = Extras { floor: view.floor[3] > 0.0, mesh: view.ghost > 0.0 };
-        let samples = if params.choice("msaa") == 1 { render::MSAA } else { 1 };
+        let samples = if params.choice("msaa") == 1 { self.renderer.samples } else { 1 };
         self.renderer.targets.ensure(&self.device, (w, h), samples);
         self.renderer.prepare(&self.device, &self.queue, self.state.as_ref().expect("ensured"), &view);
         let b = linear(params.color("background"));

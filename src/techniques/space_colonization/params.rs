@@ -10,7 +10,7 @@ pub const VIEWS: [&str; 3] = ["Lines", "Tubes", "TubesLit"];
 /// Attraction sources, in the order of the `source` enum parameter.
 pub const SOURCES: [&str; 2] = ["Sphere", "Model"];
 /// Multisampling choices, in the order of the `msaa` enum parameter.
-pub const MSAA_MODES: [&str; 2] = ["off", "4x"];
+pub const MSAA_MODES: [&str; 2] = ["off", "on"];
 /// Most grid cells (the cell grows past the reach before the grid grows past this).
 pub const MAX_CELLS: u32 = 1 << 21;
 
@@ -102,7 +102,12 @@ pub fn params() -> Vec<ParamDecl> {
             .with_unit("m"),
         ParamDecl::new("camera_pitch", Float(0.0), Some((-89.0, 89.0)), "camera looks down by").with_unit("°"),
         ParamDecl::new("fov", Float(40.0), Some((5.0, 120.0)), "vertical field of view").with_unit("°"),
-        ParamDecl::choice("msaa", &MSAA_MODES, 1, "multisampling: 4 samples per pixel keep thin branches steady"),
+        ParamDecl::choice(
+            "msaa",
+            &MSAA_MODES,
+            1,
+            "multisampling (the scene's msaa, 4 samples by default) keeps thin branches steady",
+        ),
         ParamDecl::trigger("reset", "start the growth again (R in the window)").with_role(InputRole::Key('r')),
     ]
 }

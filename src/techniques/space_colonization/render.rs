@@ -16,8 +16,6 @@ const DRAW_BINDINGS: [(&str, u32); 6] =
     [("view", 0), ("posed", 1), ("nodes", 2), ("mesh_positions", 3), ("vertex_skins", 4), ("joint_matrices", 5)];
 /// Depth format of the tube pass.
 const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Samples per pixel with `msaa` on.
-pub const MSAA: u32 = 4;
 
 /// Indices of one capsule: quads between consecutive rings (two rings and the cap's).
 pub fn tube_indices() -> Vec<u32> {
@@ -56,9 +54,9 @@ pub struct Extras {
     pub mesh: bool,
 }
 
-/// The draw pipelines (lines and tubes, at 1 and [`MSAA`] samples) and targets.
+/// The draw pipelines (lines, tubes, floor and model, at 1 sample and the scene's) and targets.
 pub struct Renderer {
-    /// [lines, tubes, floor, mesh] × [1 sample, MSAA].
+    /// [lines, tubes, floor, mesh] × [1 sample, `samples`].
     pipelines: [[wgpu::RenderPipeline; 2]; 4],
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
@@ -67,6 +65,8 @@ pub struct Renderer {
     pub index_count: u32,
     /// Colour (multisampled) and depth attachments.
     pub targets: DrawTargets,
+    /// Samples per pixel with `msaa` on (the scene's, as the adapter allows).
+    pub samples: u32,
     groups: BindGroupCache<(u64, u64)>,
 }
 
@@ -93,6 +93,7 @@ impl Renderer {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
+        let samples = setup.samples_for(&[format, DEPTH]);
         let pipeline = |style: Style, samples| {
             let (vertex, fragment, topology, depth, additive) = match style {
                 // Lines add up regardless of depth, as the book draws them.
@@ -123,7 +124,7 @@ impl Renderer {
             raster_pipeline(device, &module, &pipeline_layout, &desc)
         };
         let pipelines = crate::gpu::validated(device, &origin, || {
-            [Style::Lines, Style::Tubes, Style::Floor, Style::Mesh].map(|s| [pipeline(s, 1), pipeline(s, MSAA)])
+            [Style::Lines, Style::Tubes, Style::Floor, Style::Mesh].map(|s| [pipeline(s, 1), pipeline(s, samples)])
         })?;
         let index_data = tube_indices();
         use wgpu::util::DeviceExt;
@@ -139,6 +140,7 @@ impl Renderer {
             indices,
             index_count: index_data.len() as u32,
             targets: DrawTargets::new("space_colonization/draw", format, Some(DEPTH)),
+            samples,
             groups: BindGroupCache::default(),
         })
     }

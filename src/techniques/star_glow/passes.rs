@@ -68,7 +68,8 @@ impl Plan {
         if self.resolution_independent {
             self.step_scale = graph.output_size().1 as f32 / super::REFERENCE_HEIGHT;
         }
-        let small = TextureDesc { extent: Extent::Relative(1, self.base.divide), format: FORMAT, layers: None };
+        let small =
+            TextureDesc { extent: Extent::Relative(1, self.base.divide), format: FORMAT, layers: None, samples: 1 };
         let mut passes = Vec::new();
         let k = &node.kernels;
         let bright = graph.create_texture("star_glow/bright", small);

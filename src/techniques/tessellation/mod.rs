@@ -43,8 +43,6 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 /// The colour format.
 pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Samples per pixel of the surface with `msaa` on (resolved before anything downstream sees it).
-pub const MSAA: u32 = 4;
 
 /// The per-frame buffers for one grid size.
 struct Buffers {
@@ -71,8 +69,11 @@ pub struct Tessellation {
     patches: ComputeKernel,
     scan: ComputeKernel,
     boundaries: ComputeKernel,
-    /// The draw pipeline for 1 and for [`MSAA`] samples.
+    /// The draw pipeline for 1 sample and for `samples`.
     draw: [wgpu::RenderPipeline; 2],
+    /// Samples per pixel with `msaa` on (the scene's, as the adapter allows; resolved before
+    /// anything downstream sees the image).
+    samples: u32,
     sampler: wgpu::Sampler,
     buffers: Option<Buffers>,
     targets: crate::gpu::DrawTargets,
@@ -182,7 +183,8 @@ impl Tessellation {
                 })
             })
         };
-        let draw = [pipeline(1)?, pipeline(MSAA)?];
+        let samples = setup.samples_for(&[FORMAT, DEPTH]);
+        let draw = [pipeline(1)?, pipeline(samples)?];
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("tessellation_height_sampler"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -208,6 +210,7 @@ impl Tessellation {
             scan,
             boundaries,
             draw,
+            samples,
             sampler,
             buffers: None,
             targets: crate::gpu::DrawTargets::new("tessellation/draw", FORMAT, Some(DEPTH)),
@@ -358,7 +361,7 @@ impl Technique for Tessellation {
         let size = graph.output_size();
         let u = TessUniforms::from_params(params, size);
         self.ensure_buffers(u.grid);
-        self.targets.ensure(&self.device, size, if params.choice("msaa") == 1 { MSAA } else { 1 });
+        self.targets.ensure(&self.device, size, if params.choice("msaa") == 1 { self.samples } else { 1 });
         self.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
         self.last = Some(u);
         self.draw_groups.get_mut().begin_frame();

@@ -12,7 +12,7 @@ pub const PLANE_SIZE: f32 = 10.0;
 /// View modes.
 pub const VIEWS: &[&str] = &["shaded", "wireframe", "level"];
 /// Multisampling choices (index 1 = 4×).
-pub const MSAA_MODES: &[&str] = &["off", "4x"];
+pub const MSAA_MODES: &[&str] = &["off", "on"];
 /// Which channel of the input is the height.
 pub const CHANNELS: &[&str] = &["red", "luminance"];
 
@@ -30,7 +30,7 @@ pub fn params() -> Vec<ParamDecl> {
             "msaa",
             MSAA_MODES,
             1,
-            "samples per pixel: 4× smooths edges; off is faster where fill is slow",
+            "multisampling: on uses the scene's msaa (4 samples by default); off is faster where fill is slow",
         ),
         ParamDecl::new("camera_distance", Float(10.0), Some((1.0, 100.0)), "camera distance from the origin"),
         ParamDecl::new("camera_yaw", Float(0.0), Some((-180.0, 180.0)), "camera orbit about y").with_unit("°"),
