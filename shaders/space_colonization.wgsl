@@ -11,7 +11,8 @@
 //   [grid]      counting sort of the nodes by cell: clear, count, take counts, scan, scatter
 //   remove      attractions within the kill distance of any node die
 //   grow        t += dt · growth speed · mass, at most 1
-// Node-sized dispatches are indirect (their size is on the GPU); nothing is read back.
+// Node-sized dispatches are indirect (their size is on the GPU), and so are search, attract
+// and remove: their arguments drop to zero once the pool is full. Nothing is read back.
 // Plus `pose`: node positions in world space for drawing (model transform or 4-weight skinning).
 
 struct Growth {
@@ -233,7 +234,7 @@ fn connect(@builtin(global_invocation_id) id: vec3<u32>) {
     nodes[slot] = Node(c.xyz, 0.0, nodes[i].depth + 1u, mass, i, bitcast<u32>(c.w));
 }
 
-fn write_args(count: u32) {
+fn write_args(count: u32, changed: bool) {
     let edges = count - min(count, g.seed_count);
     args[0] = (count + WG - 1u) / WG;
     args[1] = 1u;
@@ -249,6 +250,25 @@ fn write_args(count: u32) {
     args[9] = 0u;
     args[10] = 0u;
     args[11] = 0u;
+    // The growth work of the next step: none once the pool is full (nothing can change but t),
+    // so a finished forest costs only its grow.
+    let growing = count < g.capacity;
+    args[12] = select(0u, (count + WG - 1u) / WG, growing);
+    args[13] = 1u;
+    args[14] = 1u;
+    args[15] = select(0u, (g.attraction_count + WG - 1u) / WG, growing);
+    args[16] = 1u;
+    args[17] = 1u;
+    args[18] = select(0u, (g.capacity + WG - 1u) / WG, growing);
+    args[19] = 1u;
+    args[20] = 1u;
+    // The rest of this step (grid rebuild, remove): needed while this step could add nodes.
+    args[21] = select(0u, (count + WG - 1u) / WG, changed);
+    args[22] = 1u;
+    args[23] = 1u;
+    args[24] = select(0u, (g.attraction_count + WG - 1u) / WG, changed);
+    args[25] = 1u;
+    args[26] = 1u;
 }
 
 @compute @workgroup_size(1)
@@ -257,7 +277,7 @@ fn finalize() {
     let count = min(before + flags[g.capacity], g.capacity);
     counters.node_count = count;
     counters.added = count - before;
-    write_args(count);
+    write_args(count, before < g.capacity);
 }
 
 @compute @workgroup_size(WG)

@@ -161,6 +161,17 @@ fn the_pool_never_overflows_at_the_far_end_of_every_range() {
     assert!(nodes.len() as u32 <= r.node.capacity());
     assert_eq!(r.node.capacity() as usize, attractions.len());
     assert!(nodes.len() > 64, "it grew: {}", nodes.len());
+    // Full, the growth work is skipped on the GPU; the CPU reference agrees nothing changes.
+    assert_eq!(nodes.len() as u32, r.node.capacity(), "the pool fills at these settings");
+    let u = r.node.last_uniforms().unwrap();
+    let (mut cpu_attractions, mut cpu_nodes) = (attractions.clone(), nodes.clone());
+    reference::step(&mut cpu_attractions, &mut cpu_nodes, &u);
+    r.run(5);
+    let (after_attractions, after_nodes) = r.node.read();
+    let shape = |n: &[Node]| n.iter().map(|n| (n.pos, n.parent, n.depth, n.mass)).collect::<Vec<_>>();
+    let alive = |a: &[Attraction]| a.iter().map(|a| a.alive).collect::<Vec<_>>();
+    assert!(shape(&after_nodes) == shape(&nodes) && shape(&cpu_nodes) == shape(&nodes));
+    assert!(alive(&after_attractions) == alive(&attractions) && alive(&cpu_attractions) == alive(&attractions));
 }
 
 #[test]

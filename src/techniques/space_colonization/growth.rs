@@ -11,8 +11,20 @@ use crate::techniques::NodeSetup;
 pub const BLOCK: u64 = 256;
 /// i32s per node in the direction sums (Σx, Σy, Σz, count, first attraction).
 const ACCUM: u64 = 5;
-/// Bytes of the indirect arguments: dispatch (3), draw (4), indexed draw (5).
-const ARGS_BYTES: u64 = 12 * 4;
+/// Bytes of the indirect arguments: node dispatch (3), draw (4), indexed draw (5), the next
+/// step's growth work over nodes, attractions and slots (3 each; zero once the pool is full), and
+/// this step's grid rebuild and remove (3 each; zero if the pool was full before it).
+const ARGS_BYTES: u64 = 27 * 4;
+/// Byte offset of the growth work's node dispatch.
+const GROWING_NODES: u64 = 48;
+/// Byte offset of the growth work's attraction dispatch.
+const GROWING_ATTRACTIONS: u64 = 60;
+/// Byte offset of the growth work's slot dispatch.
+const GROWING_SLOTS: u64 = 72;
+/// Byte offset of the node dispatch of this step's grid rebuild.
+const CHANGED_NODES: u64 = 84;
+/// Byte offset of the attraction dispatch of this step's remove.
+const CHANGED_ATTRACTIONS: u64 = 96;
 /// Byte offset of the line draw's arguments.
 pub const LINE_ARGS: u64 = 12;
 /// Byte offset of the tube draw's (indexed) arguments.
@@ -258,7 +270,8 @@ impl GrowthState {
         queue.write_buffer(&nodes, 0, bytemuck::cast_slice(seeds));
         let count = seeds.len() as u32;
         queue.write_buffer(&counters, 0, bytemuck::cast_slice(&[count, 0, 0, 0]));
-        queue.write_buffer(&args, 0, bytemuck::cast_slice(&initial_args(count, seeds.len() as u32, tube_indices)));
+        let initial = initial_args(count, seeds.len() as u32, cloud.attractions.len() as u32, capacity, tube_indices);
+        queue.write_buffer(&args, 0, bytemuck::cast_slice(&initial));
         let args_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("sc_args_group"),
             layout: &kernels.args_layout,
@@ -426,32 +439,32 @@ impl GrowthState {
             let [x, y, z] = kernel.workgroups([threads.max(1), 1, 1]);
             pass.dispatch_workgroups(x, y, z);
         };
-        // Over the node count, which only the GPU knows.
-        let per_node = |pass: &mut wgpu::ComputePass<'_>, kernel: &ComputeKernel, block: u32| {
+        // Sizes only the GPU knows: the node count, or zero once the pool is full.
+        let indirect = |pass: &mut wgpu::ComputePass<'_>, kernel: &ComputeKernel, block: u32, offset: u64| {
             bind(pass, kernel, block);
-            pass.dispatch_workgroups_indirect(&self.args.buffer, 0);
+            pass.dispatch_workgroups_indirect(&self.args.buffer, offset);
         };
         for op in ops {
             match *op {
                 Op::BuildGrid { block, cells } => {
                     direct(pass, &k.clear_cells, block, cells);
-                    per_node(pass, &k.count_cells, block);
+                    indirect(pass, &k.count_cells, block, CHANGED_NODES);
                     direct(pass, &k.take_counts, block, cells);
                     k.scan.record(pass, cell_scan);
-                    per_node(pass, &k.scatter, block);
+                    indirect(pass, &k.scatter, block, CHANGED_NODES);
                 }
                 Op::Branch { block } => {
-                    per_node(pass, &k.clear_accum, block);
-                    direct(pass, &k.search, block, self.attraction_count);
-                    direct(pass, &k.attract, block, self.capacity);
+                    indirect(pass, &k.clear_accum, block, GROWING_NODES);
+                    indirect(pass, &k.search, block, GROWING_ATTRACTIONS);
+                    indirect(pass, &k.attract, block, GROWING_SLOTS);
                     k.scan.record(pass, &self.flag_scan);
-                    per_node(pass, &k.connect, block);
+                    indirect(pass, &k.connect, block, GROWING_NODES);
                     bind(pass, &k.finalize, block);
                     pass.set_bind_group(1, &self.args_group, &[]);
                     pass.dispatch_workgroups(1, 1, 1);
                 }
-                Op::Remove { block } => direct(pass, &k.remove, block, self.attraction_count),
-                Op::Grow { block } => per_node(pass, &k.grow, block),
+                Op::Remove { block } => indirect(pass, &k.remove, block, CHANGED_ATTRACTIONS),
+                Op::Grow { block } => indirect(pass, &k.grow, block, 0),
             }
         }
     }
@@ -479,8 +492,40 @@ impl GrowthState {
     }
 }
 
-/// The indirect arguments for `count` nodes of which `seeds` are roots (the shader's `write_args`).
-pub fn initial_args(count: u32, seeds: u32, tube_indices: u32) -> [u32; 12] {
+/// The indirect arguments for `count` nodes of which `seeds` are roots, `attractions` and
+/// `capacity` slots (the shader's `write_args`).
+pub fn initial_args(count: u32, seeds: u32, attractions: u32, capacity: u32, tube_indices: u32) -> [u32; 27] {
     let edges = count - count.min(seeds);
-    [count.div_ceil(128), 1, 1, 2, edges, 0, 0, tube_indices, edges, 0, 0, 0]
+    let growing = |n: u32| if count < capacity { n.div_ceil(128) } else { 0 };
+    let nodes = count.div_ceil(128);
+    let (a, c) = (growing(attractions), growing(count));
+    [
+        nodes,
+        1,
+        1,
+        2,
+        edges,
+        0,
+        0,
+        tube_indices,
+        edges,
+        0,
+        0,
+        0,
+        c,
+        1,
+        1,
+        a,
+        1,
+        1,
+        growing(capacity),
+        1,
+        1,
+        c,
+        1,
+        1,
+        a,
+        1,
+        1,
+    ]
 }
