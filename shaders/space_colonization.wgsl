@@ -70,7 +70,9 @@ struct Counters {
 @group(0) @binding(5) var<storage, read_write> candidates: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> cell_start: array<u32>;
 @group(0) @binding(7) var<storage, read_write> cell_fill: array<atomic<u32>>;
-@group(0) @binding(8) var<storage, read_write> sorted: array<u32>;
+// The nodes in cell order: position and index (bitcast into w), so a search reads each cell's
+// nodes from consecutive memory.
+@group(0) @binding(8) var<storage, read_write> sorted: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read_write> counters: Counters;
 
 // finalize only: indirect arguments (dispatch x y z, draw, indexed draw), never bound while used.
@@ -123,8 +125,9 @@ fn nearest_node(p: vec3<f32>, reach2: f32) -> u32 {
                 }
                 let cell = cell_index(n);
                 for (var s = cell_start[cell]; s < cell_start[cell + 1u]; s++) {
-                    let j = sorted[s];
-                    let d2 = distance2(nodes[j].pos, p);
+                    let entry = sorted[s];
+                    let j = bitcast<u32>(entry.w);
+                    let d2 = distance2(entry.xyz, p);
                     if d2 < best_d2 || (d2 == best_d2 && j < best) {
                         best_d2 = d2;
                         best = j;
@@ -308,8 +311,9 @@ fn take_counts(@builtin(global_invocation_id) id: vec3<u32>) {
 fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
     if i < counters.node_count {
-        let cell = cell_index(cell_of(nodes[i].pos));
-        sorted[cell_start[cell] + atomicAdd(&cell_fill[cell], 1u)] = i;
+        let pos = nodes[i].pos;
+        let cell = cell_index(cell_of(pos));
+        sorted[cell_start[cell] + atomicAdd(&cell_fill[cell], 1u)] = vec4<f32>(pos, bitcast<f32>(i));
     }
 }
 

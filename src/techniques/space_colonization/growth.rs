@@ -256,7 +256,7 @@ impl GrowthState {
         let accum = buffer(device, "sc_accum", cap * ACCUM * 4, none);
         let flags = buffer(device, "sc_flags", (cap + 1) * 4, none);
         let candidates = buffer(device, "sc_candidates", cap * 16, none);
-        let sorted = buffer(device, "sc_sorted", cap * 4, none);
+        let sorted = buffer(device, "sc_sorted", cap * 16, none);
         let pose_uniform = crate::gpu::uniform_buffer::<PoseUniforms>(device, "sc_pose");
         let joints = buffer(device, "sc_joints", 64 * 256, none);
         let skin_data: Vec<VertexSkin> = if skins.is_empty() {
