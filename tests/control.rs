@@ -257,11 +257,20 @@ fn a_recorded_session_replays_frame_exactly() {
     let dir = temp("replay");
     let session = script(&s, &dir);
     let path = dir.join("session.ron");
+    std::fs::write(&path, "an earlier recording\n").unwrap();
     let mut recorder = Recorder::create(&path).unwrap();
     for (frame, events) in &session {
         recorder.record(*frame, events, &s).unwrap();
     }
+    // Until it finishes, the earlier recording is whole (a kill now would leave it).
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "an earlier recording\n");
     drop(recorder);
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".recording"))
+        .collect();
+    assert!(leftovers.is_empty(), "the temporary recording is renamed, not left: {leftovers:?}");
     let replay = read_replay(&path, &s).unwrap();
     let original: std::collections::BTreeMap<u64, Vec<ControlEvent>> = session.into_iter().collect();
     assert_eq!(replay, original, "recording loses nothing");

@@ -6,7 +6,7 @@
 
 use std::collections::BTreeMap;
 use std::io::{BufWriter, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
@@ -49,18 +49,36 @@ pub enum RecordedEvent {
     ResumeTracks,
 }
 
-/// Writes events as they are applied.
+/// Writes events as they are applied — into a temporary file beside the target, renamed over it
+/// when the recording finishes (dropped): a show killed mid-recording leaves the previous
+/// recording whole and this one in `.<name>.<pid>.recording` (replayable up to its last line).
 pub struct Recorder {
     out: BufWriter<std::fs::File>,
+    temp: PathBuf,
+    target: PathBuf,
+    finished: bool,
     /// Events written so far.
     pub count: usize,
 }
 
 impl Recorder {
-    /// Creates (truncates) `path`.
+    /// Starts a recording that will replace `path` when it finishes.
     pub fn create(path: &Path) -> Result<Self, String> {
-        let file = std::fs::File::create(path).map_err(|e| format!("cannot record to {}: {e}", path.display()))?;
-        Ok(Self { out: BufWriter::new(file), count: 0 })
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let temp = path.with_file_name(format!(".{name}.{}.recording", std::process::id()));
+        let file = std::fs::File::create(&temp).map_err(|e| format!("cannot record to {}: {e}", path.display()))?;
+        Ok(Self { out: BufWriter::new(file), temp, target: path.to_path_buf(), finished: false, count: 0 })
+    }
+
+    /// Flushes to disk and renames the recording over its target (done on drop if not before).
+    pub fn finish(&mut self) -> Result<(), String> {
+        if self.finished {
+            return Ok(());
+        }
+        self.finished = true;
+        let done = self.out.flush().and_then(|()| self.out.get_ref().sync_all());
+        done.and_then(|()| std::fs::rename(&self.temp, &self.target))
+            .map_err(|e| format!("cannot finish the recording {}: {e}", self.target.display()))
     }
 
     /// Writes `events` applied before `frame`, and flushes (a crash loses at most one frame).
@@ -80,6 +98,14 @@ impl Recorder {
             self.out.flush().map_err(|e| e.to_string())?;
         }
         Ok(())
+    }
+}
+
+impl Drop for Recorder {
+    fn drop(&mut self) {
+        if let Err(e) = self.finish() {
+            log::error!("{e}");
+        }
     }
 }
 
