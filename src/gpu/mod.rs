@@ -18,7 +18,7 @@ pub use blit::{Blit, BlitTarget, DISPLAY_FORMAT};
 pub use cache::{BindGroupCache, DEFAULT_MAX_AGE};
 pub use compute::ComputeKernel;
 pub use context::{BackendChoice, Gpu, GpuError, GpuOptions, instance_descriptor};
-pub use msaa::DrawTargets;
+pub use msaa::{DrawTargets, begin_resolved_pass};
 pub use prefix_sum::{PrefixSum, SCAN_BINDINGS, SCAN_BLOCK, ScanTarget};
 pub use raster::{GrowableBuffer, RasterDesc, UniformBlock, raster_pipeline};
 pub use readback::{ReadbackError, read_buffer, read_texture_bytes, read_texture_rgba8};

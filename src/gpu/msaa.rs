@@ -65,27 +65,41 @@ impl DrawTargets {
         output: &wgpu::TextureView,
         clear: wgpu::Color,
     ) -> wgpu::RenderPass<'e> {
-        let (view, resolve_target) = match &self.color {
-            Some(samples) => (samples, Some(output)),
-            None => (output, None),
-        };
-        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(self.label),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(clear),
-                    store: if resolve_target.is_some() { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
-                },
-            })],
-            depth_stencil_attachment: self.depth.as_ref().map(|view| wgpu::RenderPassDepthStencilAttachment {
-                view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
-                stencil_ops: None,
-            }),
-            ..Default::default()
-        })
+        begin_resolved_pass(encoder, self.label, output, self.color.as_ref(), self.depth.as_ref(), clear)
     }
+}
+
+/// Begins a render pass that clears `msaa` (if given) and resolves it into `output` at the end —
+/// or clears and draws `output` directly — with an optional depth attachment (of the same sample
+/// count) cleared to 1.0 and discarded after the pass.
+pub fn begin_resolved_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    output: &wgpu::TextureView,
+    msaa: Option<&wgpu::TextureView>,
+    depth: Option<&wgpu::TextureView>,
+    clear: wgpu::Color,
+) -> wgpu::RenderPass<'e> {
+    let (view, resolve_target) = match msaa {
+        Some(samples) => (samples, Some(output)),
+        None => (output, None),
+    };
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(clear),
+                store: if resolve_target.is_some() { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
+            },
+        })],
+        depth_stencil_attachment: depth.map(|view| wgpu::RenderPassDepthStencilAttachment {
+            view,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+            stencil_ops: None,
+        }),
+        ..Default::default()
+    })
 }

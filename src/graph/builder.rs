@@ -332,28 +332,14 @@ impl PassContext<'_> {
         let color_view = self.view(color).clone();
         let msaa_view = msaa.map(|m| self.view(m).clone());
         let depth_view = depth.map(|d| self.view(d).clone());
-        let (view, resolve_target) = match &msaa_view {
-            Some(samples) => (samples, Some(&color_view)),
-            None => (&color_view, None),
-        };
-        self.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(self.pass_name),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(clear),
-                    store: if resolve_target.is_some() { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
-                },
-            })],
-            depth_stencil_attachment: depth_view.as_ref().map(|view| wgpu::RenderPassDepthStencilAttachment {
-                view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
-                stencil_ops: None,
-            }),
-            ..Default::default()
-        })
+        crate::gpu::begin_resolved_pass(
+            self.encoder,
+            self.pass_name,
+            &color_view,
+            msaa_view.as_ref(),
+            depth_view.as_ref(),
+            clear,
+        )
     }
 
     /// This pass's name, for labels.
