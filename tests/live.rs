@@ -239,6 +239,8 @@ fn a_reload_that_drops_a_node_while_its_events_are_queued_learned_and_recorded()
     }
     let k = player.instance().params(1);
     assert_eq!(k.target_at(scale), ParamValue::Float(3.0), "the remapped write reached k at its new index");
+    // The recording replaces controls.ron when it finishes (the hub, and its recorder, end).
+    drop(hub);
     let recorded = std::fs::read_to_string(root.join("controls.ron")).unwrap();
     let lines: Vec<&str> = recorded.lines().collect();
     assert_eq!(lines.len(), 3, "{recorded}");

@@ -38,6 +38,16 @@ pub fn run(
         )
     })?;
     let mut app = window::WindowApp::new(assets, gpu, scene, options, control, notices);
+    // Ctrl-C / SIGTERM close the window the normal way (a second one ends the process at once).
+    let interrupted = app.interrupt_flag();
+    let handler = ctrlc::set_handler(move || {
+        if interrupted.swap(true, std::sync::atomic::Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+    if let Err(e) = handler {
+        log::warn!("Ctrl-C will end the process without closing cleanly: {e}");
+    }
     event_loop.run_app(&mut app).map_err(|e| format!("the window's event loop failed: {e}"))?;
     app.into_result()
 }

@@ -1,5 +1,7 @@
 //! The winit application: window and surface lifetime, input, and the per-frame loop.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -54,6 +56,9 @@ pub struct WindowApp {
     notices: Vec<String>,
     running: Option<Running>,
     failure: Option<String>,
+    /// Set by Ctrl-C or SIGTERM: the window closes like a click on its close button, so that
+    /// recordings finish and everything is dropped in order.
+    interrupted: Arc<AtomicBool>,
 }
 
 impl WindowApp {
@@ -67,7 +72,22 @@ impl WindowApp {
         control: ControlOptions,
         notices: Vec<String>,
     ) -> Self {
-        Self { assets, gpu_options, scene: Some(scene), options, control, notices, running: None, failure: None }
+        Self {
+            assets,
+            gpu_options,
+            scene: Some(scene),
+            options,
+            control,
+            notices,
+            running: None,
+            failure: None,
+            interrupted: Arc::new(AtomicBool::new(false)),
+        }
+    }
+
+    /// The flag a signal handler sets to close the window cleanly.
+    pub fn interrupt_flag(&self) -> Arc<AtomicBool> {
+        self.interrupted.clone()
     }
 
     /// Ok when the window was closed normally, or why it could not run.
@@ -176,6 +196,13 @@ fn fullscreen_on(event_loop: &ActiveEventLoop, window: &Window, monitor: Option<
 }
 
 impl ApplicationHandler for WindowApp {
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        if self.interrupted.load(Ordering::Relaxed) {
+            log::info!("interrupted: closing the window (a recording in progress is finished)");
+            event_loop.exit();
+        }
+    }
+
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
         if self.running.is_some() {
             return;
