@@ -48,13 +48,12 @@ pub use params::{
 };
 pub use render::{TUBE_CAP_ROWS, TUBE_SIDES, tube_indices};
 
+use std::sync::Arc;
+
 use growth::{BLOCK, GrowthState, Kernels};
 use render::{Extras, Renderer, Style};
 
-use std::sync::Arc;
-
 use crate::geometry::skinned::SkinnedMesh;
-
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
 use crate::params::ParamSet;
