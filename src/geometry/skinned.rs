@@ -178,9 +178,17 @@ impl SkinnedMesh {
 
     /// Every node's world transform at `time` (seconds into the animation; clamped to it).
     pub fn world_transforms(&self, time: f32) -> Vec<Mat4> {
+        self.transforms(Some(time))
+    }
+
+    /// World transforms of the animation at `time`, or of the rest pose (`None`).
+    fn transforms(&self, time: Option<f32>) -> Vec<Mat4> {
         let mut local: Vec<(Vec3, Quat, Vec3)> =
             self.nodes.iter().map(|n| (n.translation, n.rotation, n.scale)).collect();
-        for c in &self.channels {
+        // The rest pose plays no channel.
+        let channels = if time.is_some() { &self.channels[..] } else { &[] };
+        let time = time.unwrap_or_default();
+        for c in channels {
             let target = &mut local[c.node];
             match &c.keys {
                 Keys::Translation(k) => target.0 = sample(&c.times, k, time, c.interpolation, Vec3::lerp),
@@ -204,7 +212,7 @@ impl SkinnedMesh {
     /// The bind pose's place in the world (the mesh node's rest transform): what skinning with
     /// the rest pose gives.
     pub fn bind_transform(&self) -> Mat4 {
-        SkinnedMesh { channels: Vec::new(), ..self.clone() }.world_transforms(0.0)[self.mesh_node]
+        self.transforms(None)[self.mesh_node]
     }
 
     /// Where vertex `v`'s skin takes a point `p` (bind pose) under `matrices`.

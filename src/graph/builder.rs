@@ -332,18 +332,46 @@ impl PassContext<'_> {
         let color_view = self.view(color).clone();
         let msaa_view = msaa.map(|m| self.view(m).clone());
         let depth_view = depth.map(|d| self.view(d).clone());
-        crate::gpu::begin_resolved_pass(
-            self.encoder,
-            self.pass_name,
-            &color_view,
-            msaa_view.as_ref(),
-            depth_view.as_ref(),
-            clear,
-        )
+        resolved_pass(self.encoder, self.pass_name, &color_view, msaa_view.as_ref(), depth_view.as_ref(), clear)
     }
 
     /// This pass's name, for labels.
     pub fn name(&self) -> &str {
         self.pass_name
     }
+}
+
+/// Begins a render pass that clears `msaa` (if given) and resolves it into `output` at the end —
+/// or clears and draws `output` directly — with an optional depth attachment (of the same sample
+/// count) cleared to 1.0 and discarded after the pass.
+fn resolved_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    output: &wgpu::TextureView,
+    msaa: Option<&wgpu::TextureView>,
+    depth: Option<&wgpu::TextureView>,
+    clear: wgpu::Color,
+) -> wgpu::RenderPass<'e> {
+    let (view, resolve_target) = match msaa {
+        Some(samples) => (samples, Some(output)),
+        None => (output, None),
+    };
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(clear),
+                store: if resolve_target.is_some() { wgpu::StoreOp::Discard } else { wgpu::StoreOp::Store },
+            },
+        })],
+        depth_stencil_attachment: depth.map(|view| wgpu::RenderPassDepthStencilAttachment {
+            view,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+            stencil_ops: None,
+        }),
+        ..Default::default()
+    })
 }

@@ -150,3 +150,8 @@ pub trait Technique {
 pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }
+
+/// An sRGB-encoded colour (as colour pickers and scene files give) in linear light; alpha as is.
+pub fn linear_rgba(c: [f32; 4]) -> [f32; 4] {
+    [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3]]
+}

@@ -4,7 +4,7 @@ use super::state::State;
 use crate::gpu::ShaderError;
 use crate::graph::{PassContext, RasterTargets};
 use crate::params::ParamSet;
-use crate::techniques::{NodeSetup, srgb_to_linear};
+use crate::techniques::{NodeSetup, linear_rgba};
 use crate::time::FrameTime;
 
 /// Depth format of the draw pass.
@@ -37,10 +37,6 @@ pub struct ClothView {
     pub background: wgpu::Color,
 }
 
-fn linear(c: [f32; 4]) -> [f32; 4] {
-    [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3]]
-}
-
 impl ClothView {
     /// Camera at (0, 0, −distance) looking down +z, y up (the sample's camera at (0, 0, −10)).
     pub fn from_params(p: &ParamSet, time: &FrameTime, aspect: f32) -> Self {
@@ -51,16 +47,16 @@ impl ClothView {
         let light = glam::Vec3::new(l[0], l[1], l[2]).normalize_or(glam::Vec3::NEG_Z);
         let c = super::sphere_center(p, time.seconds);
         let radius = if p.bool("sphere") { p.float("sphere_radius") } else { 0.0 };
-        let b = linear(p.color("background"));
+        let b = linear_rgba(p.color("background"));
         let half_width = (p.int("resolution").max(2) - 1) as f32 * p.float("rest_length") / 2.0;
-        let mut sphere_color = linear(p.color("sphere_color"));
+        let mut sphere_color = linear_rgba(p.color("sphere_color"));
         sphere_color[3] = aspect;
         Self {
             uniforms: ClothViewUniforms {
                 view_proj: (proj * view).to_cols_array_2d(),
                 camera: [eye.x, eye.y, eye.z, half_width],
                 light_dir: [light.x, light.y, light.z, 0.0],
-                color: linear(p.color("color")),
+                color: linear_rgba(p.color("color")),
                 sphere_color,
                 sphere: [c[0], c[1], c[2], radius],
             },

@@ -12,7 +12,7 @@ use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 
-use super::{NodeSetup, Technique, TechniqueInfo, srgb_to_linear};
+use super::{NodeSetup, Technique, TechniqueInfo, linear_rgba};
 
 /// The registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -85,7 +85,6 @@ pub struct KleinianUniforms {
 impl KleinianUniforms {
     /// All per-frame precomputation: colours to linear, bools to flags.
     pub fn from_params(p: &ParamSet, time: &FrameTime, size: (u32, u32)) -> Self {
-        let linear = |c: [f32; 4]| [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3]];
         Self {
             t: p.vec2("t"),
             scale: p.float("scale"),
@@ -96,8 +95,8 @@ impl KleinianUniforms {
             circle_center: p.vec2("circle_center"),
             circle_radius: p.float("circle_radius"),
             seed: time.seed as u32,
-            hit_color: linear(p.color("hit_color")),
-            back_color: linear(p.color("back_color")),
+            hit_color: linear_rgba(p.color("hit_color")),
+            back_color: linear_rgba(p.color("back_color")),
             size: [size.0, size.1],
             _pad: [0; 2],
         }

@@ -478,12 +478,17 @@ impl GrowthState {
         pass.dispatch_workgroups_indirect(&self.args.buffer, 0);
     }
 
+    /// Nodes in use after the last submitted frame (blocking; tests and tools).
+    pub fn node_count(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> u32 {
+        let bytes = crate::gpu::read_buffer(device, queue, &self.counters, 0, 4).unwrap_or_default();
+        bytes.get(..4).map_or(0, |c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+    }
+
     /// Reads the nodes in use and the attractions back (blocking; tests and tools).
     pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> (Vec<Attraction>, Vec<Node>) {
         let read =
             |b: &wgpu::Buffer, bytes: u64| crate::gpu::read_buffer(device, queue, b, 0, bytes).unwrap_or_default();
-        let count = read(&self.counters, 4);
-        let count = count.get(..4).map_or(0, |c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]));
+        let count = self.node_count(device, queue);
         let attractions =
             read(&self.attractions.buffer, u64::from(self.attraction_count) * size_of::<Attraction>() as u64);
         let nodes = read(&self.nodes.buffer, u64::from(count.max(1)) * size_of::<Node>() as u64);

@@ -55,11 +55,11 @@ use render::{Extras, Renderer, Style};
 
 use crate::geometry::skinned::SkinnedMesh;
 use crate::gpu::ShaderError;
-use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
+use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::ParamSet;
 use crate::time::FrameTime;
 
-use super::{NodeSetup, Technique, TechniqueInfo, srgb_to_linear};
+use super::{NodeSetup, Technique, TechniqueInfo, linear_rgba};
 
 /// The registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -178,7 +178,7 @@ impl SpaceColonization {
     /// Every node's drawn position (world, w = t) from the last drawn frame (blocking; tests).
     pub fn read_posed(&self) -> Vec<[f32; 4]> {
         let Some(state) = &self.state else { return Vec::new() };
-        let count = self.read().1.len() as u64;
+        let count = u64::from(state.node_count(&self.device, &self.queue));
         crate::gpu::read_buffer(&self.device, &self.queue, &state.posed.buffer, 0, count.max(1) * 16)
             .map(|b| bytemuck::pod_collect_to_vec(&b))
             .map(|v: Vec<[f32; 4]>| v[..count as usize].to_vec())
@@ -346,14 +346,13 @@ impl Technique for SpaceColonization {
         let state = self.state.as_ref().expect("ensured");
         state.set_pose(&self.queue, &pose, &joints);
         let (eye, view_proj) = params::view_proj(params, w as f32 / h.max(1) as f32);
-        let linear = |c: [f32; 4]| [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3]];
         let light = params.get("light_dir").components();
         let light = glam::Vec3::new(light[0], light[1], light[2]).normalize_or(glam::Vec3::Y);
         let view_mode = params.choice("view");
         let view = ViewUniforms {
             view_proj: view_proj.to_cols_array_2d(),
             camera: [eye.x, eye.y, eye.z, 1.0],
-            color: linear(params.color("color")),
+            color: linear_rgba(params.color("color")),
             light: [light.x, light.y, light.z, params.float("emission")],
             thickness: params.float("thickness"),
             seed_count: state.seed_count,
@@ -361,15 +360,14 @@ impl Technique for SpaceColonization {
             ghost: if params.bool("show_model") && self.mesh.is_some() { 0.6 } else { 0.0 },
             model: pose.model,
             floor: {
-                let c = linear(params.color("floor_color"));
+                let c = linear_rgba(params.color("floor_color"));
                 [c[0], c[1], c[2], if params.bool("floor") { 12.0 } else { 0.0 }]
             },
         };
         let extras = Extras { floor: view.floor[3] > 0.0, mesh: view.ghost > 0.0 };
         let samples = if params.choice("msaa") == 1 { self.renderer.samples } else { 1 };
-        self.renderer.targets.ensure(&self.device, (w, h), samples);
         self.renderer.prepare(&self.device, &self.queue, self.state.as_ref().expect("ensured"), &view);
-        let b = linear(params.color("background"));
+        let b = linear_rgba(params.color("background"));
         let clear = wgpu::Color { r: f64::from(b[0]), g: f64::from(b[1]), b: f64::from(b[2]), a: 1.0 };
         let style = if view_mode == 0 { Style::Lines } else { Style::Tubes };
 
@@ -392,9 +390,9 @@ impl Technique for SpaceColonization {
                 });
                 state.record(&mut pass, &this.kernels, &ops);
             });
-        let color = graph.create_texture("space_colonization/image", TextureDesc::full(FORMAT));
+        let targets = graph.create_raster_targets("space_colonization", FORMAT, Some(render::DEPTH), samples);
         if graph.is_simulation_only() {
-            return color;
+            return targets.color;
         }
         graph.add_pass("space_colonization/pose").read_buffer(nodes).read_buffer(args).write_buffer(posed).record(
             move |ctx| {
@@ -410,9 +408,9 @@ impl Technique for SpaceColonization {
             .read_buffer(posed)
             .read_buffer(nodes)
             .read_buffer(args)
-            .render_target(color)
-            .record(move |ctx| this.renderer.draw(ctx, state, color, style, extras, clear));
-        color
+            .draws_into(&targets)
+            .record(move |ctx| this.renderer.draw(ctx, state, &targets, style, extras, clear));
+        targets.color
     }
 }
 

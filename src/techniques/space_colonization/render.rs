@@ -3,8 +3,8 @@
 
 use super::growth::{GrowthState, LINE_ARGS, TUBE_ARGS};
 use super::params::ViewUniforms;
-use crate::gpu::{BindGroupCache, DrawTargets, RasterDesc, ShaderError, raster_pipeline};
-use crate::graph::PassContext;
+use crate::gpu::{BindGroupCache, RasterDesc, ShaderError, raster_pipeline};
+use crate::graph::{PassContext, RasterTargets};
 use crate::techniques::NodeSetup;
 
 /// Vertices around a tube (the draw shader's `SIDES`).
@@ -14,8 +14,8 @@ pub const TUBE_CAP_ROWS: u32 = 3;
 /// The draw shader's bindings, in the order of the draw group's entries.
 const DRAW_BINDINGS: [(&str, u32); 6] =
     [("view", 0), ("posed", 1), ("nodes", 2), ("mesh_positions", 3), ("vertex_skins", 4), ("joint_matrices", 5)];
-/// Depth format of the tube pass.
-const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Depth format of the draw.
+pub const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// Indices of one capsule: quads between consecutive rings (two rings and the cap's).
 pub fn tube_indices() -> Vec<u32> {
@@ -54,7 +54,7 @@ pub struct Extras {
     pub mesh: bool,
 }
 
-/// The draw pipelines (lines, tubes, floor and model, at 1 sample and the scene's) and targets.
+/// The draw pipelines (lines, tubes, floor and model, at 1 sample and the scene's).
 pub struct Renderer {
     /// [lines, tubes, floor, mesh] × [1 sample, `samples`].
     pipelines: [[wgpu::RenderPipeline; 2]; 4],
@@ -63,8 +63,6 @@ pub struct Renderer {
     indices: wgpu::Buffer,
     /// Indices per tube.
     pub index_count: u32,
-    /// Colour (multisampled) and depth attachments.
-    pub targets: DrawTargets,
     /// Samples per pixel with `msaa` on (the scene's, as the adapter allows).
     pub samples: u32,
     groups: BindGroupCache<(u64, u64)>,
@@ -139,7 +137,6 @@ impl Renderer {
             uniform: crate::gpu::uniform_buffer::<ViewUniforms>(device, "sc_view"),
             indices,
             index_count: index_data.len() as u32,
-            targets: DrawTargets::new("space_colonization/draw", format, Some(DEPTH)),
             samples,
             groups: BindGroupCache::default(),
         })
@@ -166,20 +163,19 @@ impl Renderer {
         });
     }
 
-    /// Records the draw of every grown edge into `color` (resolved if multisampled).
+    /// Records the draw of every grown edge into `targets` (resolved if multisampled).
     pub fn draw(
         &self,
         ctx: &mut PassContext<'_>,
         state: &GrowthState,
-        color: crate::graph::TextureHandle,
+        targets: &RasterTargets,
         style: Style,
         extras: Extras,
         clear: wgpu::Color,
     ) {
         let Some(group) = self.groups.get(&(state.posed.id, state.nodes.id)) else { return };
-        let output = ctx.view(color).clone();
-        let mut pass = self.targets.begin_pass(ctx.encoder, &output, clear);
-        let samples = usize::from(self.targets.samples() > 1);
+        let mut pass = ctx.begin_draw(targets, clear);
+        let samples = usize::from(targets.msaa.is_some());
         pass.set_bind_group(0, group, &[]);
         if extras.floor {
             pass.set_pipeline(&self.pipelines[2][samples]);

@@ -23,7 +23,7 @@ pub use params::{
 use std::cell::RefCell;
 
 use crate::gpu::{BindGroupCache, ComputeKernel, ShaderError, storage_entry as storage};
-use crate::graph::{BufferHandle, FrameGraph, PassContext, TextureDesc, TextureHandle};
+use crate::graph::{BufferHandle, FrameGraph, PassContext, RasterTargets, TextureHandle};
 use crate::params::ParamSet;
 use crate::time::FrameTime;
 
@@ -76,7 +76,8 @@ pub struct Tessellation {
     samples: u32,
     sampler: wgpu::Sampler,
     buffers: Option<Buffers>,
-    targets: crate::gpu::DrawTargets,
+    /// The output size of the last frame added (for the bench report).
+    output_size: (u32, u32),
     /// Draw bind groups by height texture id.
     draw_groups: RefCell<BindGroupCache<u64>>,
     /// The last frame's uniforms (tests compare against the CPU reference with them).
@@ -213,7 +214,7 @@ impl Tessellation {
             samples,
             sampler,
             buffers: None,
-            targets: crate::gpu::DrawTargets::new("tessellation/draw", FORMAT, Some(DEPTH)),
+            output_size: (0, 0),
             draw_groups: RefCell::default(),
             last: None,
         })
@@ -327,18 +328,17 @@ impl Tessellation {
         })
     }
 
-    /// Records the draw into `color`: multisampled and resolved, or directly.
-    fn record_draw(&self, ctx: &mut PassContext<'_>, height: TextureHandle, color: TextureHandle, clear: [f32; 4]) {
+    /// Records the draw into `targets`: multisampled and resolved, or directly.
+    fn record_draw(&self, ctx: &mut PassContext<'_>, height: TextureHandle, targets: &RasterTargets, clear: [f32; 4]) {
         let Some(b) = &self.buffers else { return };
         let group = self
             .draw_groups
             .borrow_mut()
             .get_or_create(ctx.texture_id(height), || self.make_draw_group(ctx.view(height), b))
             .clone();
-        let output = ctx.view(color).clone();
         let clear = wgpu::Color { r: f64::from(clear[0]), g: f64::from(clear[1]), b: f64::from(clear[2]), a: 1.0 };
-        let mut pass = self.targets.begin_pass(ctx.encoder, &output, clear);
-        pass.set_pipeline(&self.draw[usize::from(self.targets.samples() > 1)]);
+        let mut pass = ctx.begin_draw(targets, clear);
+        pass.set_pipeline(&self.draw[usize::from(targets.msaa.is_some())]);
         pass.set_bind_group(0, &self.uniform_group, &[]);
         pass.set_bind_group(1, &group, &[]);
         pass.draw_indirect(&b.args.0, 0);
@@ -361,7 +361,7 @@ impl Technique for Tessellation {
         let size = graph.output_size();
         let u = TessUniforms::from_params(params, size);
         self.ensure_buffers(u.grid);
-        self.targets.ensure(&self.device, size, if params.choice("msaa") == 1 { self.samples } else { 1 });
+        self.output_size = size;
         self.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
         self.last = Some(u);
         self.draw_groups.get_mut().begin_frame();
@@ -391,7 +391,8 @@ impl Technique for Tessellation {
                 this.patches.dispatch(&mut pass, &[&b.compute_group], [patches, 1, 1]);
                 this.scan.dispatch(&mut pass, &[&b.compute_group], [256, 1, 1]);
             });
-        let color = graph.create_texture("tessellation/image", TextureDesc::full(FORMAT));
+        let samples = if params.choice("msaa") == 1 { this.samples } else { 1 };
+        let targets = graph.create_raster_targets("tessellation", FORMAT, Some(DEPTH), samples);
         let clear = u.background;
         graph
             .add_pass("tessellation/draw")
@@ -400,9 +401,9 @@ impl Technique for Tessellation {
             .read_buffer(levels)
             .read_buffer(offsets)
             .read_buffer(args)
-            .render_target(color)
-            .record(move |ctx| this.record_draw(ctx, height, color, clear));
-        color
+            .draws_into(&targets)
+            .record(move |ctx| this.record_draw(ctx, height, &targets, clear));
+        targets.color
     }
 
     fn map_pointer(&self, view: [f32; 2]) -> Option<[f32; 2]> {
@@ -417,7 +418,7 @@ impl Technique for Tessellation {
             u.patch_count,
             u.grid,
             u.edge_px,
-            self.targets.size().0,
+            self.output_size.0,
             u.screen_height
         )]
     }
