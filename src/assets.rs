@@ -1,7 +1,9 @@
 //! Where shaders and scenes come from: files on disk win, the copies embedded at build time are
 //! the fallback, so a release binary copied anywhere still runs every scene.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 mod embedded {
     include!(concat!(env!("OUT_DIR"), "/embedded.rs"));
@@ -52,16 +54,34 @@ pub struct Asset {
     pub source: String,
 }
 
-/// Resolves asset names against a root folder on disk with the embedded copies as fallback.
+/// Resolves asset names against a root folder on disk with the embedded copies as fallback;
+/// shaders can be pinned to a given text (the versions a running show is built from).
 #[derive(Clone, Debug)]
 pub struct Assets {
     root: Option<PathBuf>,
+    /// Shader file name → the text to use instead of the disk or the embedded copy.
+    pinned: Arc<BTreeMap<String, Asset>>,
 }
 
 impl Assets {
     /// Looks for assets under `root`; `None` uses the embedded copies only.
     pub fn new(root: Option<PathBuf>) -> Self {
-        Self { root }
+        Self { root, pinned: Arc::default() }
+    }
+
+    /// These assets with shader `asset.name` pinned to `asset`'s text, whatever is on disk.
+    pub fn with_shader(&self, asset: Asset) -> Self {
+        let mut pinned = (*self.pinned).clone();
+        pinned.insert(asset.name.clone(), asset);
+        Self { root: self.root.clone(), pinned: Arc::new(pinned) }
+    }
+
+    /// These assets with every shader pinned to its text now: what a running show rebuilds from
+    /// when files on disk have changed since (a device loss, a reload rolled back).
+    pub fn with_shaders_pinned(&self) -> Self {
+        let loaded = self.names(AssetKind::Shader).into_iter().filter_map(|n| self.load(AssetKind::Shader, &n).ok());
+        let pinned = loaded.map(|a| (a.name.clone(), a)).collect();
+        Self { root: self.root.clone(), pinned: Arc::new(pinned) }
     }
 
     /// The default root: `$INDRA_ROOT`, else the current folder if it has `scenes/` or `shaders/`,
@@ -94,6 +114,9 @@ impl Assets {
     /// copy. The error says where it looked.
     pub fn load(&self, kind: AssetKind, name: &str) -> Result<Asset, String> {
         let file = with_ext(name, kind);
+        if let Some(asset) = self.pinned.get(&file).filter(|_| kind == AssetKind::Shader) {
+            return Ok(asset.clone());
+        }
         if let Some(dir) = self.dir(kind) {
             let path = dir.join(&file);
             if path.is_file() {
@@ -156,6 +179,24 @@ mod tests {
         assert!(scene.origin.starts_with("<embedded>"), "{}", scene.origin);
         let err = assets.load(AssetKind::Scene, "no_such_scene").unwrap_err();
         assert!(err.contains("no_such_scene.ron"), "{err}");
+        std::fs::remove_dir_all(tmp).unwrap();
+    }
+
+    #[test]
+    fn pinned_shaders_keep_their_text_when_the_file_changes() {
+        let tmp = std::env::temp_dir().join(format!("indra-assets-pin-{}", std::process::id()));
+        std::fs::create_dir_all(tmp.join("shaders")).unwrap();
+        std::fs::write(tmp.join("shaders/kleinian.wgsl"), "// first").unwrap();
+        let assets = Assets::new(Some(tmp.clone()));
+        let pinned = assets.with_shaders_pinned();
+        std::fs::write(tmp.join("shaders/kleinian.wgsl"), "// second").unwrap();
+        assert_eq!(pinned.load(AssetKind::Shader, "kleinian").unwrap().source, "// first");
+        assert_eq!(assets.load(AssetKind::Shader, "kleinian").unwrap().source, "// second");
+        let newer = pinned.load(AssetKind::Shader, "cloth").unwrap();
+        assert!(newer.origin.starts_with("<embedded>"), "shaders not on disk pin the built-in copy");
+        let repinned = pinned.with_shader(Asset { source: "// third".into(), ..newer });
+        assert_eq!(repinned.load(AssetKind::Shader, "cloth.wgsl").unwrap().source, "// third");
+        assert_eq!(repinned.load(AssetKind::Shader, "kleinian").unwrap().source, "// first");
         std::fs::remove_dir_all(tmp).unwrap();
     }
 }

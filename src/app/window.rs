@@ -15,9 +15,9 @@ use super::WindowOptions;
 use super::panel::{Overlay, draw_ui};
 use crate::assets::Assets;
 use crate::control::{ControlHub, ControlOptions};
-use crate::gpu::{Blit, BlitTarget, Gpu, GpuOptions};
+use crate::gpu::{Blit, BlitTarget, DEFAULT_STALL_TIMEOUT, Gpu, GpuOptions};
 use crate::graph::GraphRuntime;
-use crate::live::LiveReload;
+use crate::live::{GpuGuard, GpuState, GpuTrouble, LiveReload};
 use crate::params::ControlEvent;
 use crate::scene::{Player, Scene, SceneInstance};
 use crate::time::FixedClock;
@@ -44,6 +44,14 @@ struct Running {
     pointer: [f32; 2],
     /// Whether the left button is held over the scene (drag roles follow the pointer).
     dragging: bool,
+    /// Where shaders come from when no live reload pins them (recovery rebuilds from these).
+    assets: Assets,
+    /// Notices a lost or stuck device between frames.
+    guard: GpuGuard,
+    /// A device to replace that could not be replaced yet, and when to try again.
+    retry: Option<(GpuTrouble, Instant)>,
+    /// Since when frames wait for a stalled one to finish.
+    waiting_since: Option<Instant>,
 }
 
 /// The winit handler; creates the window on `resumed`, as winit 0.30 asks.
@@ -155,17 +163,7 @@ impl WindowApp {
         let hub = ControlHub::start(&self.control, instance.scene());
         let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
         let blit = Blit::new(&gpu.device);
-        let egui_ctx = egui::Context::default();
-        let max_side = gpu.device.limits().max_texture_dimension_2d as usize;
-        let egui_state = egui_winit::State::new(
-            egui_ctx,
-            egui::ViewportId::ROOT,
-            &window,
-            Some(window.scale_factor() as f32),
-            None,
-            Some(max_side),
-        );
-        let egui_renderer = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
+        let (egui_state, egui_renderer) = egui_parts(&window, &gpu, format);
         Ok(Running {
             window,
             surface,
@@ -183,8 +181,27 @@ impl WindowApp {
             ui_events: Vec::new(),
             pointer: [0.0, 0.0],
             dragging: false,
+            assets: self.assets.clone(),
+            guard: GpuGuard::new(DEFAULT_STALL_TIMEOUT),
+            retry: None,
+            waiting_since: None,
         })
     }
+}
+
+/// egui's input state and renderer for `window` on `gpu` (made again on a new device).
+fn egui_parts(window: &Window, gpu: &Gpu, format: wgpu::TextureFormat) -> (egui_winit::State, egui_wgpu::Renderer) {
+    let max_side = gpu.device.limits().max_texture_dimension_2d as usize;
+    let state = egui_winit::State::new(
+        egui::Context::default(),
+        egui::ViewportId::ROOT,
+        window,
+        Some(window.scale_factor() as f32),
+        None,
+        Some(max_side),
+    );
+    let renderer = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
+    (state, renderer)
 }
 
 fn fullscreen_on(event_loop: &ActiveEventLoop, window: &Window, monitor: Option<usize>) -> Fullscreen {
@@ -310,6 +327,9 @@ impl Running {
 
     /// Steps the clock by real time, renders the scene and the overlay, presents.
     fn frame(&mut self) {
+        if !self.device_ready() {
+            return;
+        }
         let now = Instant::now();
         let steps = self.player.accumulate((now - self.last).as_secs_f64());
         self.last = now;
@@ -354,8 +374,17 @@ impl Running {
         }
         self.overlay.timings = self.runtime.timings();
         let extra = self.draw_overlay(&mut encoder, &target, size);
-        self.gpu.queue.submit(extra.into_iter().chain([encoder.finish()]));
+        let submitted = self.gpu.queue.submit(extra.into_iter().chain([encoder.finish()]));
+        self.guard.submitted(submitted);
         self.runtime.after_submit();
+        // The frame must finish before it is shown: waiting here, within the watchdog's limit,
+        // is what catches a stuck GPU on drivers whose present would otherwise block for good
+        // (lavapipe). The unshown frame is dropped and the next one recovers.
+        let state = self.guard.check(&self.gpu);
+        if state != GpuState::Ready {
+            self.act_on(state);
+            return;
+        }
         self.window.pre_present_notify();
         self.gpu.queue.present(frame);
         self.hub.after_frame(self.player.instance());
@@ -364,6 +393,69 @@ impl Running {
         }
         for n in std::mem::take(&mut self.hub.notices) {
             self.overlay.report(n);
+        }
+    }
+
+    /// Whether the device can take a frame now (see [`Running::act_on`]).
+    fn device_ready(&mut self) -> bool {
+        if let Some((trouble, at)) = self.retry.clone() {
+            return Instant::now() >= at && self.move_to_new_device(trouble);
+        }
+        let state = self.guard.check(&self.gpu);
+        self.act_on(state)
+    }
+
+    /// Acts on the device's state; returns whether a frame may be drawn. A stall rolls the
+    /// newest shader reload back and waits for the GPU (frames are skipped, the window stays
+    /// responsive); a lost or stuck device is replaced.
+    fn act_on(&mut self, state: GpuState) -> bool {
+        match state {
+            GpuState::Ready => {
+                if let Some(since) = self.waiting_since.take() {
+                    let waited = since.elapsed().as_secs_f64();
+                    self.overlay
+                        .report(format!("the GPU finished the stuck frame after {waited:.1} s; the show goes on"));
+                }
+                true
+            }
+            GpuState::Waiting => false,
+            GpuState::Trouble(trouble @ GpuTrouble::Stalled(_)) => {
+                let size = (self.config.width, self.config.height);
+                let live = self.live.as_mut();
+                let message = crate::live::roll_back_stall(&trouble, &self.gpu, &mut self.player, live, size);
+                self.overlay.report(message);
+                self.waiting_since = Some(Instant::now());
+                false
+            }
+            GpuState::Trouble(trouble) => self.move_to_new_device(trouble),
+        }
+    }
+
+    /// Moves the show to a new device; while none can be made, tries again every second.
+    fn move_to_new_device(&mut self, trouble: GpuTrouble) -> bool {
+        let size = (self.config.width, self.config.height);
+        let live = self.live.as_mut();
+        match crate::live::recover(&trouble, &self.gpu, Some(&self.surface), &mut self.player, live, &self.assets, size)
+        {
+            Ok((gpu, message)) => {
+                self.surface.configure(&gpu.device, &self.config);
+                self.runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
+                self.blit = Blit::new(&gpu.device);
+                (self.egui_state, self.egui_renderer) = egui_parts(&self.window, &gpu, self.config.format);
+                self.gpu = gpu;
+                self.guard.reset();
+                self.retry = None;
+                self.waiting_since = None;
+                self.overlay.report(message);
+                true
+            }
+            Err(e) => {
+                if self.retry.is_none() {
+                    self.overlay.report(format!("{e}; trying again every second"));
+                }
+                self.retry = Some((trouble, Instant::now() + std::time::Duration::from_secs(1)));
+                false
+            }
         }
     }
 

@@ -66,6 +66,11 @@ pub struct Gpu {
     /// Validation errors wgpu raised outside an error scope, newest last. Read and cleared by the
     /// runtime to show them; wgpu's default handler would panic instead.
     pub uncaptured: Arc<Mutex<Vec<String>>>,
+    /// Set (with wgpu's reason) when the device is lost: a driver reset, a removed GPU, or
+    /// `Device::destroy`. Everything made on this device is then useless; see [`Gpu::replacement`].
+    lost: Arc<Mutex<Option<String>>>,
+    /// How the adapter was chosen, to choose again after a loss.
+    options: GpuOptions,
 }
 
 impl Gpu {
@@ -106,8 +111,27 @@ impl Gpu {
                 list.drain(..excess);
             }
         }));
+        let lost = Arc::new(Mutex::new(None));
+        let flag = lost.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            let text = if message.is_empty() { format!("{reason:?}") } else { format!("{reason:?}: {message}") };
+            if let Ok(mut slot) = flag.lock() {
+                slot.get_or_insert(text);
+            }
+        });
         log::debug!("adapter: {} ({:?}, {:?})", info.name, info.backend, info.device_type);
-        Ok(Self { instance, adapter, device, queue, uncaptured })
+        Ok(Self { instance, adapter, device, queue, uncaptured, lost, options: options.clone() })
+    }
+
+    /// A new device on the same instance, chosen as this one was, for a show to move to after
+    /// this device was lost or hung. `surface` (the window's, if any) must be presentable.
+    pub async fn replacement(&self, surface: Option<&wgpu::Surface<'_>>) -> Result<Self, GpuError> {
+        Self::with_instance(self.instance.clone(), &self.options, surface).await
+    }
+
+    /// Why the device was lost, once it has been (wgpu reports it while polling).
+    pub fn lost_reason(&self) -> Option<String> {
+        self.lost.lock().ok().and_then(|l| l.clone())
     }
 
     /// "name (backend)" of the adapter, for logs, reports and golden file names.

@@ -11,6 +11,7 @@ mod prefix_sum;
 mod raster;
 mod readback;
 mod shader;
+mod watchdog;
 
 pub use binding::{check_bindings, storage_entry, uniform_buffer, uniform_entry, wgsl_struct_size};
 pub use blit::{Blit, BlitTarget, DISPLAY_FORMAT};
@@ -21,3 +22,4 @@ pub use prefix_sum::{PrefixSum, SCAN_BINDINGS, SCAN_BLOCK, ScanTarget};
 pub use raster::{GrowableBuffer, RasterDesc, UniformBlock, raster_pipeline};
 pub use readback::{ReadbackError, read_buffer, read_texture_bytes, read_texture_rgba8};
 pub use shader::{ShaderError, compile_wgsl, validate_wgsl, validated};
+pub use watchdog::{DEFAULT_STALL_TIMEOUT, Stall, Watchdog};

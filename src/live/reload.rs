@@ -2,9 +2,10 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 use super::watcher::{Watcher, read_stable};
-use crate::assets::{AssetKind, Assets};
+use crate::assets::{Asset, AssetKind, Assets};
 use crate::gpu::{Gpu, validate_wgsl};
 use crate::params::Remap;
 use crate::scene::{Player, SceneInstance, parse_scene};
@@ -28,9 +29,23 @@ pub struct ReloadReport {
 /// Watches the asset folders and applies changes to a running scene.
 pub struct LiveReload {
     watcher: Option<Watcher>,
-    assets: Assets,
+    /// The assets with every shader pinned to the version the show runs: what nodes are rebuilt
+    /// from, whatever is on disk right now.
+    running: Assets,
     /// File → its current error, while broken.
     broken: BTreeMap<PathBuf, String>,
+    /// The newest shader reload applied, to roll back if the GPU stalls or is lost soon after.
+    newest: Option<AppliedShader>,
+    /// File → the text that stalled the GPU: saved again unchanged, it is not tried again.
+    stalled: BTreeMap<PathBuf, String>,
+}
+
+/// A shader reload that was applied, with the version it replaced.
+struct AppliedShader {
+    path: PathBuf,
+    previous: Asset,
+    source: String,
+    at: Instant,
 }
 
 impl LiveReload {
@@ -38,12 +53,41 @@ impl LiveReload {
     pub fn new(assets: &Assets) -> Result<Self, String> {
         let dirs: Vec<PathBuf> = [AssetKind::Shader, AssetKind::Scene].iter().filter_map(|k| assets.dir(*k)).collect();
         let watcher = if dirs.iter().any(|d| d.is_dir()) { Some(Watcher::watch(&dirs)?) } else { None };
-        Ok(Self { watcher, assets: assets.clone(), broken: BTreeMap::new() })
+        let running = assets.with_shaders_pinned();
+        Ok(Self { watcher, running, broken: BTreeMap::new(), newest: None, stalled: BTreeMap::new() })
     }
 
     /// Marks a file as broken from the start (the show began with the built-in copy).
     pub fn mark_broken(&mut self, path: PathBuf, error: String) {
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+        if let Ok(built_in) = Assets::new(None).load(AssetKind::Shader, name) {
+            self.running = self.running.with_shader(built_in);
+        }
         self.broken.insert(path, error);
+    }
+
+    /// The assets the running show is built from (shaders as last applied).
+    pub fn running_assets(&self) -> &Assets {
+        &self.running
+    }
+
+    /// How long ago the newest shader reload was applied, if one was.
+    pub fn newest_reload_age(&self) -> Option<Duration> {
+        self.newest.as_ref().map(|n| n.at.elapsed())
+    }
+
+    /// Takes the newest shader reload back (the GPU stalled or was lost after it): the version
+    /// before it is what nodes are built from again, and the file counts as broken with `why`
+    /// until it is saved with different text. Returns the shader's name and the message for the
+    /// performer; the caller rebuilds the nodes that use it.
+    pub fn roll_back_newest(&mut self, why: &str) -> Option<(String, String)> {
+        let newest = self.newest.take()?;
+        let shader = newest.previous.name.clone();
+        self.running = self.running.with_shader(newest.previous);
+        let message = format!("{}: {why}; rolled back to the version before it", newest.path.display());
+        self.broken.insert(newest.path.clone(), message.clone());
+        self.stalled.insert(newest.path, newest.source);
+        Some((shader, message))
     }
 
     /// Files currently broken, with their errors.
@@ -96,7 +140,7 @@ impl LiveReload {
 
     /// Ok(true) if nodes were rebuilt, Ok(false) if no node uses the shader.
     fn reload_shader(
-        &self,
+        &mut self,
         path: &Path,
         instance: &mut SceneInstance,
         gpu: &Gpu,
@@ -104,8 +148,20 @@ impl LiveReload {
     ) -> Result<bool, String> {
         let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default().to_string();
         let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        validate_wgsl(&path.display().to_string(), &source).map_err(|e| e.to_string())?;
-        instance.rebuild_nodes_using(&name, gpu, &self.assets, size).map_err(|e| e.to_string())
+        if self.stalled.get(path) == Some(&source) {
+            return Err(self.broken.get(path).cloned().unwrap_or_default());
+        }
+        self.stalled.remove(path);
+        let origin = path.display().to_string();
+        validate_wgsl(&origin, &source).map_err(|e| e.to_string())?;
+        let next = self.running.with_shader(Asset { name: name.clone(), origin, source: source.clone() });
+        let used = instance.rebuild_nodes_using(&name, gpu, &next, size).map_err(|e| e.to_string())?;
+        let previous = self.running.load(AssetKind::Shader, &name).ok();
+        self.running = next;
+        if let Some(previous) = previous.filter(|_| used) {
+            self.newest = Some(AppliedShader { path: path.to_path_buf(), previous, source, at: Instant::now() });
+        }
+        Ok(used)
     }
 
     /// Ok(true) if the running scene was replaced by its edited file.
@@ -124,7 +180,7 @@ impl LiveReload {
         }
         let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
         let scene = parse_scene(&path.display().to_string(), &source).map_err(|e| e.to_string())?;
-        let remap = instance.replace_scene(scene, gpu, &self.assets, size).map_err(|e| e.to_string())?;
+        let remap = instance.replace_scene(scene, gpu, &self.running, size).map_err(|e| e.to_string())?;
         report.scene_changed = true;
         report.remap = Some(remap);
         Ok(true)

@@ -3,9 +3,10 @@
 use std::path::Path;
 
 use crate::assets::Assets;
+use crate::gpu::DEFAULT_STALL_TIMEOUT;
 use crate::gpu::{Blit, BlitTarget, DISPLAY_FORMAT, Gpu, read_texture_rgba8};
 use crate::graph::{FrameStats, GraphRuntime};
-use crate::live::{LiveReload, ReloadReport};
+use crate::live::{GpuGuard, GpuState, GpuTrouble, LiveReload, ReloadReport};
 use crate::params::ControlEvent;
 use crate::scene::{Player, Scene, SceneInstance, SeekError};
 use crate::time::{FixedClock, FrameTime};
@@ -31,6 +32,7 @@ pub struct OffscreenRenderer {
     blit: Blit,
     size: (u32, u32),
     target: wgpu::Texture,
+    guard: GpuGuard,
 }
 
 impl OffscreenRenderer {
@@ -48,17 +50,45 @@ impl OffscreenRenderer {
         let instance = SceneInstance::new(&gpu, assets, scene, size)?;
         let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
         let blit = Blit::new(&gpu.device);
-        let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("offscreen_target"),
-            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DISPLAY_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        Ok(Self { gpu, player: Player::new(instance, clock), runtime, blit, size, target })
+        let target = display_target(&gpu, size);
+        let guard = GpuGuard::new(DEFAULT_STALL_TIMEOUT);
+        Ok(Self { gpu, player: Player::new(instance, clock), runtime, blit, size, target, guard })
+    }
+
+    /// Waits (within the watchdog's limit) for the last frame; reports a lost or stuck device,
+    /// as the window checks between frames.
+    pub fn check_gpu(&mut self) -> GpuState {
+        self.guard.check(&self.gpu)
+    }
+
+    /// Sets how long a frame may take before [`OffscreenRenderer::check_gpu`] calls it stalled,
+    /// and how long a stalled frame may take before the device counts as stuck.
+    pub fn set_gpu_limits(&mut self, stall: std::time::Duration, stuck: std::time::Duration) {
+        self.guard = GpuGuard::with_limits(stall, stuck);
+    }
+
+    /// After a stall: rolls `live`'s newest shader reload back on this device, as the window
+    /// does ([`crate::live::roll_back_stall`]). Returns the message for the user.
+    pub fn roll_back_stall(&mut self, trouble: &GpuTrouble, live: Option<&mut LiveReload>) -> String {
+        crate::live::roll_back_stall(trouble, &self.gpu, &mut self.player, live, self.size)
+    }
+
+    /// Moves to a new device after `trouble`, exactly as the window does ([`crate::live::recover`]):
+    /// parameters, clock and script kept, nodes rebuilt from `live`'s last good shaders (else
+    /// `assets`). Returns the message for the user.
+    pub fn recover(
+        &mut self,
+        trouble: &GpuTrouble,
+        live: Option<&mut LiveReload>,
+        assets: &Assets,
+    ) -> Result<String, String> {
+        let (gpu, message) = crate::live::recover(trouble, &self.gpu, None, &mut self.player, live, assets, self.size)?;
+        self.runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
+        self.blit = Blit::new(&gpu.device);
+        self.target = display_target(&gpu, self.size);
+        self.guard.reset();
+        self.gpu = gpu;
+        Ok(message)
     }
 
     /// The live scene (to change parameters between frames).
@@ -108,7 +138,8 @@ impl OffscreenRenderer {
             &output.view,
             BlitTarget { view: &target_view, format: DISPLAY_FORMAT, size: self.size },
         );
-        self.gpu.queue.submit([encoder.finish()]);
+        let index = self.gpu.queue.submit([encoder.finish()]);
+        self.guard.submitted(index);
         self.runtime.after_submit();
         Ok((time, output.stats))
     }
@@ -136,6 +167,20 @@ impl OffscreenRenderer {
         self.runtime.drain_timings(&self.gpu.device);
         self.runtime.reset_timings();
     }
+}
+
+/// The texture a frame is encoded into for readback.
+fn display_target(gpu: &Gpu, size: (u32, u32)) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("offscreen_target"),
+        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: DISPLAY_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
 }
 
 /// Why an off-screen frame could not be produced; each is one sentence for the user.

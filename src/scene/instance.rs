@@ -35,11 +35,7 @@ pub struct SceneInstance {
 impl SceneInstance {
     /// Creates every node's technique (pipelines, persistent resources) for `output_size`.
     pub fn new(gpu: &Gpu, assets: &Assets, scene: Scene, output_size: (u32, u32)) -> Result<Self, ShaderError> {
-        let nodes = scene
-            .nodes
-            .iter()
-            .map(|n| (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa: scene.msaa }))
-            .collect::<Result<Vec<_>, _>>()?;
+        let nodes = create_nodes(&scene, gpu, assets, output_size)?;
         let params = scene.nodes.iter().map(|n| n.params.clone()).collect();
         Ok(Self {
             scene,
@@ -189,6 +185,15 @@ impl SceneInstance {
             self.nodes[*i] = node;
         }
         Ok(!using.is_empty())
+    }
+
+    /// Recreates every node on `gpu` (a new device after the old one was lost or hung).
+    /// Parameters, overrides, morphs and messages are kept; simulations start again from their
+    /// initial state, since their state lived on the old device. Either every node builds or
+    /// nothing changes and the error is returned.
+    pub fn rebuild_all(&mut self, gpu: &Gpu, assets: &Assets, output_size: (u32, u32)) -> Result<(), ShaderError> {
+        self.nodes = create_nodes(&self.scene, gpu, assets, output_size)?;
+        Ok(())
     }
 
     /// Switches to an edited version of the scene. Nodes whose id and technique are unchanged
@@ -387,4 +392,15 @@ impl SceneInstance {
         let graph = self.build_graph(output_size, time);
         runtime.execute(&gpu.device, &gpu.queue, graph, encoder)
     }
+}
+
+/// Every node's technique instance for `scene`, in node order.
+fn create_nodes(
+    scene: &Scene,
+    gpu: &Gpu,
+    assets: &Assets,
+    output_size: (u32, u32),
+) -> Result<Vec<Box<dyn Technique>>, ShaderError> {
+    let msaa = scene.msaa;
+    scene.nodes.iter().map(|n| (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa })).collect()
 }
