@@ -208,6 +208,7 @@ fn scene_with_sets(assets: &Assets, name: &str, sets: &[String], msaa: Option<u3
     }
     if let Some(samples) = msaa {
         scene.msaa = samples;
+        scene.check_texture_budget(scene.size)?;
     }
     Ok(scene)
 }
@@ -249,6 +250,7 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
         Some(path) => indra::control::record::read_replay(path, &scene)?,
         None => Default::default(),
     };
+    scene.check_texture_budget(args.size.unwrap_or(scene.size))?;
     let stem = Path::new(&args.scene).file_stem().map_or("frame".into(), |s| s.to_string_lossy().into_owned());
     std::fs::create_dir_all(&args.out).map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
@@ -355,6 +357,7 @@ pub fn list(assets: &Assets) -> Result<(), String> {
 pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), String> {
     check_timing(args.start, args.frames.saturating_add(args.warmup), None)?;
     let scene = scene_with_sets(assets, &args.scene, &args.sets, args.msaa)?;
+    scene.check_texture_budget(args.size)?;
     let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
     let adapter = device.adapter_label();
     let timestamps = device.has_timestamps();

@@ -104,6 +104,34 @@ impl Scene {
         self.nodes.iter().position(|n| n.id == id)
     }
 
+    /// An upper estimate of the texture memory the scene takes at `size` with its `msaa`: per
+    /// node, its output and one working texture in HDR (8 bytes a pixel each) and, when
+    /// multisampled, a colour and depth target per sample (12 bytes a pixel-sample). Simulation
+    /// buffers are bounded by each technique's parameter ranges instead.
+    pub fn texture_bytes(&self, size: (u32, u32)) -> u64 {
+        let pixels = u64::from(size.0) * u64::from(size.1);
+        let multisampled = if self.msaa > 1 { 12 * u64::from(self.msaa) } else { 0 };
+        self.nodes.len() as u64 * pixels * (16 + multisampled)
+    }
+
+    /// Whether the scene fits [`MAX_TEXTURE_BYTES`] at `size`; the error says what to lower.
+    pub fn check_texture_budget(&self, size: (u32, u32)) -> Result<(), String> {
+        let bytes = self.texture_bytes(size);
+        if bytes <= MAX_TEXTURE_BYTES {
+            return Ok(());
+        }
+        let gib = |b: u64| b as f64 / f64::from(1u32 << 30);
+        Err(format!(
+            "{} nodes at {}x{} with msaa {} need about {:.1} GiB of textures; a scene may use at most {:.0} GiB (lower the size, the msaa or the number of nodes)",
+            self.nodes.len(),
+            size.0,
+            size.1,
+            self.msaa,
+            gib(bytes),
+            gib(MAX_TEXTURE_BYTES)
+        ))
+    }
+
     /// Applies `node.param=value` (value: numbers separated by commas, or true/false), as the
     /// CLI's `--set` does. The value is typed and clamped like any other.
     pub fn set_from_str(&mut self, assignment: &str) -> Result<(), String> {
@@ -213,6 +241,9 @@ const MAX_REPORTED_ERRORS: usize = 50;
 /// Most nodes a scene may have (each builds pipelines and textures): a bound that `check` reports,
 /// rather than a render that runs out of memory.
 pub const MAX_NODES: usize = 256;
+/// Most texture memory a scene may ask for (see [`Scene::texture_bytes`]): a bound `check`
+/// reports, rather than a render that exhausts the machine's memory.
+pub const MAX_TEXTURE_BYTES: u64 = 8 << 30;
 
 /// Collects every semantic error of one file, each located by anchors.
 struct Validator<'a> {
@@ -289,7 +320,7 @@ impl Validator<'_> {
         if !self.errors.is_empty() {
             return Err(self.failure());
         }
-        Ok(Scene {
+        let scene = Scene {
             origin: self.origin.into(),
             name: file.name,
             description: file.description,
@@ -302,7 +333,12 @@ impl Validator<'_> {
             tracks,
             osc_aliases,
             midi,
-        })
+        };
+        if let Err(message) = scene.check_texture_budget(scene.size) {
+            self.error(&["size"], message);
+            return Err(self.failure());
+        }
+        Ok(scene)
     }
 
     /// Resolves OSC aliases and MIDI mappings to parameters.
@@ -595,6 +631,22 @@ mod tests {
         let src = format!("(name: \"many\", size: (64, 64), nodes: [{}], output: \"k0\")", nodes.join(", "));
         let e = first_error(&src);
         assert!(e.message.contains("at most 256"), "{e}");
+    }
+
+    #[test]
+    fn a_scene_asking_for_too_much_texture_memory_is_refused_at_check_time() {
+        let nodes: Vec<String> = (0..100).map(|i| format!("(id: \"k{i}\", technique: \"kleinian\")")).collect();
+        let scene = |size: &str, msaa: u32| {
+            format!("(name: \"big\", size: {size}, msaa: {msaa}, nodes: [{}], output: \"k0\")", nodes.join(", "))
+        };
+        // 100 nodes at 4K: 100 × 8.3 Mpx × 16 B = 12.4 GiB without multisampling.
+        let e = first_error(&scene("(3840, 2160)", 1));
+        assert!(e.message.contains("12.4 GiB") && e.message.contains("at most 8 GiB"), "{e}");
+        assert!(parse_scene("ok.ron", &scene("(1920, 1080)", 1)).is_ok(), "100 nodes at 1080p fit (3.1 GiB)");
+        let e = first_error(&scene("(1920, 1080)", 8));
+        assert!(e.message.contains("msaa 8"), "{e}");
+        let one = parse_scene("one.ron", &scene("(64, 64)", 1)).unwrap();
+        assert!(one.check_texture_budget((16384, 16384)).is_err(), "an override of the size is checked too");
     }
 
     #[test]
