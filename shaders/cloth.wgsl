@@ -8,9 +8,10 @@
 //             corrections averaged per particle; plus long-range attachments [Kim, Chentanez &
 //             Mueller 2012]: no particle farther from its pins than its rest distance, which a
 //             Jacobi sweep (one row per substep) cannot achieve on a tall hanging cloth.
-// Positions are vec4: xyz, w = inverse mass (0 = pinned). The two kernels that read neighbours
-// run 16x16 workgroups over the res x res grid and stage a 20x20 tile (a halo of 2) in workgroup
-// memory, so each of the 12 neighbour reads is local; the others run one invocation per particle.
+// Wind pushes along the local normal (see `wind_at`). Positions are vec4: xyz, w = inverse mass
+// (0 = pinned). Each substep is one dispatch of 16x16 workgroups over the res x res grid that
+// stages a 20x20 tile (a halo of 2) in workgroup memory, so each of the 12 neighbour reads is
+// local; the normals for drawing run one invocation per particle.
 
 struct ClothUniforms {
     res: u32,            // particles per side
@@ -25,8 +26,9 @@ struct ClothUniforms {
     compliance: f32,     // xpbd: inverse stiffness (m/N); 0 = inextensible
     sphere_radius: f32,  // collision sphere radius (0 = no sphere)
     attachments: u32,    // xpbd long-range attachments: 0 off, 1 top row, 2 two top corners
-    acceleration: vec4<f32>, // gravity + wind force / mass (xyz)
+    acceleration: vec4<f32>, // gravity (xyz)
     sphere: vec4<f32>,       // collision sphere centre (xyz)
+    wind: vec4<f32>,         // wind force / mass (xyz), felt along the local normal
 };
 
 @group(0) @binding(0) var<uniform> u: ClothUniforms;
@@ -34,6 +36,9 @@ struct ClothUniforms {
 @group(0) @binding(2) var<storage, read> cur: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> next: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read_write> status: array<atomic<u32>>;
+// Vertex normals, written once per clock step after the substeps (for drawing, and for the
+// wind of the next step's substeps).
+@group(0) @binding(5) var<storage, read_write> normals: array<vec4<f32>>;
 
 // The 12 neighbours: the 8-ring, then the four distance-2 diagonals (see `spring`).
 
@@ -124,6 +129,15 @@ fn attach(p: vec3<f32>, c: vec2<i32>) -> vec3<f32> {
     return p;
 }
 
+// Wind acts on a sheet through the pressure on its faces: only the component of the wind along
+// the normal pushes (a uniform force would shear the whole cloth sideways, which an
+// inextensible grid without bending stiffness answers with grid-scale wrinkles). The normal is
+// the one drawn last: the shape at the start of the clock step.
+fn wind_at(i: u32) -> vec3<f32> {
+    let n = normals[i].xyz;
+    return dot(u.wind.xyz, n) * n;
+}
+
 // Pushes p out of the sphere onto its surface.
 fn collide(p: vec3<f32>) -> vec3<f32> {
     let d = p - u.sphere.xyz;
@@ -160,7 +174,7 @@ fn verlet(
         return;
     }
     let v = (x.xyz - prev[i].xyz) / u.dt;
-    var force = u.acceleration.xyz * u.mass - u.damping * v;
+    var force = (u.acceleration.xyz + wind_at(i)) * u.mass - u.damping * v;
     let p0 = x.xyz;
     force += spring(p0, c, origin, vec2<i32>(-1, -1), SQRT2) + spring(p0, c, origin, vec2<i32>(0, -1), 1.0);
     force += spring(p0, c, origin, vec2<i32>(1, -1), SQRT2) + spring(p0, c, origin, vec2<i32>(1, 0), 1.0);
@@ -173,32 +187,31 @@ fn verlet(
     next[i] = vec4<f32>(p, x.w);
 }
 
-// XPBD step 1: inertial prediction with external acceleration (writes `next`).
-@compute @workgroup_size(256, 1, 1)
-fn predict(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
-    if (i >= u.count) {
-        return;
-    }
-    let x = cur[i];
-    if (x.w == 0.0) {
-        next[i] = x;
-        return;
-    }
-    let keep = max(1.0 - u.damping * u.dt, 0.0);
-    let p = x.xyz + (x.xyz - prev[i].xyz) * keep + u.acceleration.xyz * u.dt * u.dt;
-    next[i] = vec4<f32>(p, x.w);
-}
-
-// XPBD step 2: one Jacobi projection of the 12 distance constraints of each particle, reading
-// the predicted positions (bound as `cur`) and writing the projected ones; then collision.
+// XPBD, one small step in one pass: inertial prediction with gravity and wind, then one Jacobi
+// projection of the 12 distance constraints of each particle, the long-range attachments and
+// the collision. The workgroup predicts its tile and halo itself, so no predicted buffer goes
+// through memory.
 @compute @workgroup_size(16, 16, 1)
-fn project(
+fn xpbd(
     @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
     @builtin(workgroup_id) group: vec3<u32>,
 ) {
-    let origin = load_tile(local, group.xy);
+    let origin = vec2<i32>(group.xy * TILE) - vec2<i32>(2);
+    let last = vec2<i32>(i32(u.res) - 1);
+    let keep = max(1.0 - u.damping * u.dt, 0.0);
+    for (var k = local; k < SPAN * SPAN; k = k + TILE * TILE) {
+        let c = clamp(origin + vec2<i32>(i32(k % SPAN), i32(k / SPAN)), vec2<i32>(0), last);
+        let j = u32(c.y) * u.res + u32(c.x);
+        let x = cur[j];
+        var p = x.xyz;
+        if (x.w != 0.0) {
+            let a = u.acceleration.xyz + wind_at(j);
+            p = x.xyz + (x.xyz - prev[j].xyz) * keep + a * u.dt * u.dt;
+        }
+        tile[k] = vec4<f32>(p, x.w);
+    }
+    workgroupBarrier();
     let c = vec2<i32>(id.xy);
     if (any(id.xy >= vec2<u32>(u.res))) {
         return;
@@ -224,8 +237,6 @@ fn project(
 
 // Vertex normals from central differences of the grid (one-sided at the borders), oriented
 // consistently (+z facing for the undeformed cloth); never divides by zero.
-@group(0) @binding(5) var<storage, read_write> normals: array<vec4<f32>>;
-
 @compute @workgroup_size(256, 1, 1)
 fn compute_normals(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;

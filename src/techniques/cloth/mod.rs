@@ -41,8 +41,7 @@ pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// The simulation pipelines and the layout they share.
 struct Kernels {
     verlet: ComputeKernel,
-    predict: ComputeKernel,
-    project: ComputeKernel,
+    xpbd: ComputeKernel,
     normals: ComputeKernel,
     layout: wgpu::BindGroupLayout,
 }
@@ -85,13 +84,8 @@ impl Cloth {
         let bindings = [("u", 0), ("prev", 1), ("cur", 2), ("next", 3), ("status", 4), ("normals", 5)];
         let (origin, source) = setup.shader_source("cloth.wgsl", &bindings)?;
         let kernel = |entry| ComputeKernel::new(device, &origin, &source, entry, &[&layout]);
-        let kernels = Kernels {
-            verlet: kernel("verlet")?,
-            predict: kernel("predict")?,
-            project: kernel("project")?,
-            normals: kernel("compute_normals")?,
-            layout,
-        };
+        let kernels =
+            Kernels { verlet: kernel("verlet")?, xpbd: kernel("xpbd")?, normals: kernel("compute_normals")?, layout };
         let renderer = Renderer::new(setup)?;
         let uniforms = (0..MAX_CATCH_UP_STEPS.max(1))
             .map(|_| crate::gpu::uniform_buffer::<ClothUniforms>(device, "cloth_uniforms"))
@@ -116,6 +110,11 @@ impl Cloth {
     /// Reads the previous positions back (blocking; for tests and tools).
     pub fn previous_positions(&self) -> Vec<[f32; 4]> {
         self.state.as_ref().map(|s| s.read_previous(&self.device, &self.queue)).unwrap_or_default()
+    }
+
+    /// Reads the normals back (blocking; for tests and tools).
+    pub fn normals(&self) -> Vec<[f32; 4]> {
+        self.state.as_ref().map(|s| s.read_normals(&self.device, &self.queue)).unwrap_or_default()
     }
 
     /// (Re)creates the buffers if the resolution or pinning changed, or a reset was asked for.
@@ -190,15 +189,14 @@ impl Technique for Cloth {
                 label: Some("cloth/simulate"),
                 timestamp_writes: None,
             });
-            // The neighbour kernels run over the 2-D grid (tiled); prediction per particle.
-            let (grid, flat) = ([state.res, state.res, 1], [count, 1, 1]);
+            // Both solvers run one tiled dispatch per substep over the 2-D grid.
+            let grid = [state.res, state.res, 1];
             for d in &dispatches {
-                let (kernel, threads) = match d.kernel {
-                    state::Kernel::Verlet => (&this.kernels.verlet, grid),
-                    state::Kernel::Predict => (&this.kernels.predict, flat),
-                    state::Kernel::Project => (&this.kernels.project, grid),
+                let kernel = match d.kernel {
+                    state::Kernel::Verlet => &this.kernels.verlet,
+                    state::Kernel::Xpbd => &this.kernels.xpbd,
                 };
-                kernel.dispatch(&mut pass, &[&state.bind_groups[&d.key]], threads);
+                kernel.dispatch(&mut pass, &[&state.bind_groups[&d.key]], grid);
             }
             drop(pass);
             state.nan.after_simulate(ctx.encoder, &state.status, &state.status_readback);

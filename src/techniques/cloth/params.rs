@@ -109,10 +109,12 @@ pub struct ClothUniforms {
     pub sphere_radius: f32,
     /// XPBD long-range attachments: 0 off, 1 top row, 2 two corners.
     pub attachments: u32,
-    /// Gravity + wind / mass.
+    /// Gravity.
     pub acceleration: [f32; 4],
     /// Sphere centre.
     pub sphere: [f32; 4],
+    /// Wind force / mass; each particle feels its component along the cloth's normal there.
+    pub wind: [f32; 4],
 }
 
 impl ClothUniforms {
@@ -140,11 +142,12 @@ impl ClothUniforms {
             } else {
                 0
             },
-            acceleration: [g[0] + wind[0] / mass, g[1] + wind[1] / mass, g[2] + wind[2] / mass, 0.0],
+            acceleration: [g[0], g[1], g[2], 0.0],
             sphere: {
                 let c = sphere_center(p, time.seconds);
                 [c[0], c[1], c[2], 0.0]
             },
+            wind: [wind[0] / mass, wind[1] / mass, wind[2] / mass, 0.0],
         }
     }
 }

@@ -6,8 +6,9 @@ use super::ClothUniforms;
 const OFFSETS: [(i32, i32); 12] =
     [(-1, -1), (0, -1), (1, -1), (1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-2, -2), (2, -2), (2, 2), (-2, 2)];
 
-/// One explicit Verlet substep: (previous, current) → next.
-pub fn verlet_step(u: &ClothUniforms, prev: &[[f32; 4]], cur: &[[f32; 4]]) -> Vec<[f32; 4]> {
+/// One explicit Verlet substep: (previous, current) → next, the wind pushing along `normals`
+/// (the normals buffer as the last clock step left it).
+pub fn verlet_step(u: &ClothUniforms, prev: &[[f32; 4]], cur: &[[f32; 4]], normals: &[[f32; 4]]) -> Vec<[f32; 4]> {
     let res = u.res as i32;
     (0..cur.len())
         .map(|i| {
@@ -16,10 +17,11 @@ pub fn verlet_step(u: &ClothUniforms, prev: &[[f32; 4]], cur: &[[f32; 4]]) -> Ve
                 return x;
             }
             let (ci, cj) = (i as i32 % res, i as i32 / res);
+            let wind = wind_on(u, normals[i]);
             let mut f = [0.0f32; 3];
             for k in 0..3 {
                 let v = (x[k] - prev[i][k]) / u.dt;
-                f[k] = u.acceleration[k] * u.mass - u.damping * v;
+                f[k] = (u.acceleration[k] + wind[k]) * u.mass - u.damping * v;
             }
             for (dx, dy) in OFFSETS {
                 let (ni, nj) = (ci + dx, cj + dy);
@@ -49,4 +51,10 @@ pub fn verlet_step(u: &ClothUniforms, prev: &[[f32; 4]], cur: &[[f32; 4]]) -> Ve
             [p[0], p[1], p[2], x[3]]
         })
         .collect()
+}
+
+/// The wind's acceleration along the normal `n`.
+fn wind_on(u: &ClothUniforms, n: [f32; 4]) -> [f32; 3] {
+    let along = u.wind[0] * n[0] + u.wind[1] * n[1] + u.wind[2] * n[2];
+    [along * n[0], along * n[1], along * n[2]]
 }

@@ -1,5 +1,5 @@
-//! The cloth's GPU state at one resolution: four particle buffers that rotate through the roles
-//! previous / current / scratch (so no step copies), normals, the NaN flag, and the plan of one
+//! The cloth's GPU state at one resolution: three particle buffers that rotate through the roles
+//! previous / current / next (so no step copies), normals, the NaN flag, and the plan of one
 //! frame's dispatches with their bind groups made ahead of time.
 
 use std::sync::Arc;
@@ -18,10 +18,8 @@ pub type Key = (usize, usize, usize, usize);
 pub enum Kernel {
     /// One explicit Verlet substep.
     Verlet,
-    /// XPBD prediction.
-    Predict,
-    /// XPBD Jacobi projection.
-    Project,
+    /// One XPBD small step (prediction and one Jacobi projection).
+    Xpbd,
 }
 
 /// One dispatch of a frame's simulation.
@@ -84,8 +82,8 @@ pub struct State {
     pub res: u32,
     /// Pin mode index.
     pub pin: u32,
-    particles: [wgpu::Buffer; 4],
-    ids: [u64; 4],
+    particles: [wgpu::Buffer; 3],
+    ids: [u64; 3],
     /// Index of the previous-positions buffer.
     pub prev: usize,
     /// Index of the current-positions buffer.
@@ -155,7 +153,7 @@ impl State {
     }
 
     /// The particle buffers.
-    pub fn particles(&self) -> &[wgpu::Buffer; 4] {
+    pub fn particles(&self) -> &[wgpu::Buffer; 3] {
         &self.particles
     }
 
@@ -164,12 +162,15 @@ impl State {
         for i in [self.prev, self.cur] {
             queue.write_buffer(&self.particles[i], 0, bytemuck::cast_slice(pose));
         }
+        // The rest pose is flat, facing +z: the normals the first step's wind pushes along.
+        let flat: Vec<[f32; 4]> = vec![[0.0, 0.0, 1.0, 0.0]; pose.len()];
+        queue.write_buffer(&self.normals, 0, bytemuck::cast_slice(&flat));
         queue.write_buffer(&self.status, 0, &[0; 4]);
     }
 
     /// The lowest buffer index not among `used`.
     fn free(used: &[usize]) -> usize {
-        (0..4).find(|i| !used.contains(i)).expect("four buffers, at most three in use")
+        (0..3).find(|i| !used.contains(i)).expect("three buffers, at most two in use")
     }
 
     /// Plans one frame: `substeps` substeps for each queued step, rotating buffer roles, with
@@ -187,17 +188,10 @@ impl State {
         let mut out = Vec::new();
         for (slot, u) in steps.iter().enumerate() {
             for _ in 0..substeps {
-                if u.solver == 0 {
-                    let next = Self::free(&[self.prev, self.cur]);
-                    out.push(Dispatch { kernel: Kernel::Verlet, key: (slot, self.prev, self.cur, next) });
-                    (self.prev, self.cur) = (self.cur, next);
-                } else {
-                    let predicted = Self::free(&[self.prev, self.cur]);
-                    let projected = Self::free(&[self.prev, self.cur, predicted]);
-                    out.push(Dispatch { kernel: Kernel::Predict, key: (slot, self.prev, self.cur, predicted) });
-                    out.push(Dispatch { kernel: Kernel::Project, key: (slot, self.prev, predicted, projected) });
-                    (self.prev, self.cur) = (self.cur, projected);
-                }
+                let kernel = if u.solver == 0 { Kernel::Verlet } else { Kernel::Xpbd };
+                let next = Self::free(&[self.prev, self.cur]);
+                out.push(Dispatch { kernel, key: (slot, self.prev, self.cur, next) });
+                (self.prev, self.cur) = (self.cur, next);
             }
         }
         let keys: Vec<Key> = out.iter().map(|d| d.key).chain([self.normals_key()]).collect();
@@ -244,7 +238,7 @@ impl State {
     }
 
     /// Imports the particle buffers into this frame's graph.
-    pub fn import(&self, graph: &mut FrameGraph<'_>) -> [BufferHandle; 4] {
+    pub fn import(&self, graph: &mut FrameGraph<'_>) -> [BufferHandle; 3] {
         std::array::from_fn(|i| graph.import_buffer(format!("cloth/particles{i}"), &self.particles[i], self.ids[i]))
     }
 
@@ -258,9 +252,18 @@ impl State {
         self.read(device, queue, self.prev)
     }
 
+    /// Copies the normals to the CPU (blocking).
+    pub fn read_normals(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Vec<[f32; 4]> {
+        Self::read_all(device, queue, &self.normals, self.res)
+    }
+
     fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue, which: usize) -> Vec<[f32; 4]> {
-        let size = u64::from(self.res * self.res) * 16;
-        crate::gpu::read_buffer(device, queue, &self.particles[which], 0, size)
+        Self::read_all(device, queue, &self.particles[which], self.res)
+    }
+
+    fn read_all(device: &wgpu::Device, queue: &wgpu::Queue, buffer: &wgpu::Buffer, res: u32) -> Vec<[f32; 4]> {
+        let size = u64::from(res * res) * 16;
+        crate::gpu::read_buffer(device, queue, buffer, 0, size)
             .map(|bytes| bytemuck::cast_slice(&bytes).to_vec())
             .unwrap_or_default()
     }
