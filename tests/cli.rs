@@ -280,6 +280,18 @@ fn triangulate_reads_json_and_svg_and_writes_the_mesh() {
 }
 
 #[test]
+fn triangulate_fills_a_bow_tie_and_says_it_crosses_itself() {
+    // Was: "ring 0 left out: its points are collinear" and no triangles.
+    let dir = temp_dir("triangulate-bow-tie");
+    let path = dir.join("bow-tie.json");
+    std::fs::write(&path, "[[[-5.33, -3], [5.33, 3], [5.33, -3], [-5.33, 3]]]").unwrap();
+    let o = indra(&["triangulate", path.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("→ 2 triangles") && text(&o).contains("area deviation 0.000e0"), "{}", text(&o));
+    assert!(text(&o).contains("ring 0 crosses itself") && !text(&o).contains("collinear"), "{}", text(&o));
+}
+
+#[test]
 fn triangulate_bad_input_is_one_clear_message() {
     let dir = temp_dir("triangulate-bad");
     let bad = dir.join("bad.json");

@@ -241,6 +241,23 @@ proptest! {
     }
 
     #[test]
+    fn scribbles_that_cross_themselves_are_covered_exactly(
+        points in prop::collection::vec(prop::array::uniform2(-1000i32..1000), 4..14),
+    ) {
+        // A ring drawn at random crosses itself many times. Cut at its crossings into loops
+        // that nest, it must be covered exactly, every triangle counter-clockwise.
+        let ring: Ring = points.iter().map(|p| [f64::from(p[0]) + 0.37, f64::from(p[1]) * 1.01 + 0.11]).collect();
+        prop_assume!(in_general_position(std::slice::from_ref(&ring)));
+        let mesh = triangulate(&[ring]).unwrap();
+        prop_assert!(mesh.report.dropped.is_empty() || mesh.report.polygon_area == 0.0, "{:?}", mesh.report);
+        prop_assert!(mesh.report.area_deviation() <= 1e-9, "{:?}", mesh.report);
+        for t in mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| mesh.positions[i as usize]);
+            prop_assert!((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) > 0.0);
+        }
+    }
+
+    #[test]
     fn garbage_never_panics(rings in prop::collection::vec(prop::collection::vec(prop::array::uniform2(-3i8..3), 0..40), 0..6)) {
         // Integer grids are full of repeats, collinear runs, touching and crossing rings.
         let rings: Vec<Ring> = rings.iter().map(|r| r.iter().map(|p| [p[0] as f64, p[1] as f64]).collect()).collect();

@@ -10,6 +10,7 @@
 //! half-triangulated, and the ear search is near-linear on real outlines (z-order hash) instead of
 //! O(n²)–O(n³).
 
+mod crossings;
 mod ear;
 mod holes;
 mod linked;
@@ -74,6 +75,9 @@ pub struct TriangulationReport {
     pub holes: usize,
     /// Rings left out, with the reason.
     pub dropped: Vec<DroppedRing>,
+    /// Rings that crossed themselves, with the number of crossings: each was cut there into
+    /// simple loops (the crossing points added to the positions), filled even-odd.
+    pub crossed: Vec<(usize, usize)>,
     /// Area enclosed by the kept rings: Σ |outer| − Σ |hole|.
     pub polygon_area: f64,
     /// Σ |triangle area| of the output.
@@ -97,6 +101,9 @@ impl TriangulationReport {
                 DropReason::ZeroArea => format!("ring {} left out: its points are collinear", d.ring),
             })
             .collect();
+        out.extend(self.crossed.iter().map(|&(ring, crossings)| {
+            format!("ring {ring} crosses itself ({crossings} crossing(s)): each of its loops is filled")
+        }));
         let deviation = self.area_deviation();
         if deviation > 1e-9 {
             out.push(format!(
@@ -111,7 +118,8 @@ impl TriangulationReport {
 /// A triangulated polygon set.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Mesh2D {
-    /// Every input vertex, rings concatenated in input order (triangles index into this).
+    /// Every input vertex, rings concatenated in input order (triangles index into this); then,
+    /// for rings that cross themselves, the crossing points and the vertices of their loops.
     pub positions: Vec<[f64; 2]>,
     /// Counter-clockwise triangles, three indices each.
     pub indices: Vec<u32>,
@@ -212,6 +220,8 @@ impl Triangulator {
         check_count(positions.len())?;
 
         let mut report = TriangulationReport::default();
+        let (ranges, ring_of) = split_crossing_rings(&mut positions, ranges, &mut report);
+        check_count(positions.len())?;
         let mut kept = Vec::new();
         let mut areas = Vec::new();
         for (index, range) in ranges.iter().enumerate() {
@@ -221,10 +231,22 @@ impl Triangulator {
                     kept.push(index);
                     areas.push(area.abs());
                 }
-                Err(reason) => report.dropped.push(DroppedRing { ring: index, reason }),
+                Err(reason) => {
+                    let dropped = DroppedRing { ring: ring_of[index], reason };
+                    if !report.dropped.contains(&dropped) {
+                        report.dropped.push(dropped);
+                    }
+                }
             }
         }
-        let shapes: Vec<RingShape> = kept.iter().map(|&r| RingShape::new(&positions[ranges[r].clone()])).collect();
+        let crossed = |ring: usize| report.crossed.iter().any(|&(r, _)| r == ring);
+        let shapes: Vec<RingShape> = kept
+            .iter()
+            .map(|&r| RingShape {
+                family: crossed(ring_of[r]).then_some(ring_of[r]),
+                ..RingShape::new(&positions[ranges[r].clone()])
+            })
+            .collect();
         let mut indices = Vec::new();
         let mut hole_ranges = Vec::new();
         for group in nesting::nest(&shapes) {
@@ -271,6 +293,35 @@ impl Triangulator {
         });
         Slicer { rings: &mut self.rings, hash, out, scratch: &mut self.scratch, jobs: &mut self.jobs }.run(node);
     }
+}
+
+/// Cuts every ring that crosses itself into simple loops (see [`crossings`]), appending the
+/// crossing points and each loop's vertices to `positions`. Returns the ranges to triangulate
+/// and, for each, the input ring it came from.
+fn split_crossing_rings(
+    positions: &mut Vec<[f64; 2]>,
+    ranges: Vec<Range<usize>>,
+    report: &mut TriangulationReport,
+) -> (Vec<Range<usize>>, Vec<usize>) {
+    let (mut out, mut ring_of) = (Vec::with_capacity(ranges.len()), Vec::with_capacity(ranges.len()));
+    for (ring, range) in ranges.into_iter().enumerate() {
+        let split = (range.len() <= crossings::MAX_CHECKED_POINTS)
+            .then(|| crossings::split_crossings((range.start as u32..range.end as u32).collect(), positions))
+            .filter(|split| split.crossings > 0);
+        let Some(split) = split else {
+            out.push(range);
+            ring_of.push(ring);
+            continue;
+        };
+        report.crossed.push((ring, split.crossings));
+        for lobe in split.loops {
+            let start = positions.len();
+            positions.extend(lobe.iter().map(|&i| positions[i as usize]).collect::<Vec<_>>());
+            out.push(start..positions.len());
+            ring_of.push(ring);
+        }
+    }
+    (out, ring_of)
 }
 
 fn check_finite(ring: &[[f64; 2]], index: usize) -> Result<(), TriangulateError> {

@@ -7,6 +7,9 @@ pub(super) struct RingShape<'a> {
     pub vertices: &'a [[f64; 2]],
     pub min: [f64; 2],
     pub max: [f64; 2],
+    /// The input ring a face came from, for the faces of a ring cut at its crossings: faces of
+    /// one ring never lie inside each other (they only share edges and points).
+    pub family: Option<usize>,
 }
 
 impl<'a> RingShape<'a> {
@@ -20,7 +23,7 @@ impl<'a> RingShape<'a> {
                 max[k] = max[k].max(v[k]);
             }
         }
-        Self { vertices, min, max }
+        Self { vertices, min, max, family: None }
     }
 
     fn box_area(&self) -> f64 {
@@ -58,7 +61,8 @@ impl<'a> RingShape<'a> {
     /// Whether `other` lies inside this ring: decided by its first vertex not on this ring's
     /// boundary (rings may touch). A ring lying wholly on this one's boundary is not inside.
     fn contains(&self, other: &Self) -> bool {
-        self.box_contains(other) && other.vertices.iter().find_map(|&v| self.locate(v)).unwrap_or(false)
+        let siblings = self.family.is_some() && self.family == other.family;
+        !siblings && self.box_contains(other) && other.vertices.iter().find_map(|&v| self.locate(v)).unwrap_or(false)
     }
 }
 

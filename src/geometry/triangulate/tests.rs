@@ -123,3 +123,59 @@ fn large_comb_uses_the_hash_and_stays_exact() {
     assert_ccw(&mesh);
     assert!(mesh.triangle_count() <= ring.len() - 2);
 }
+
+#[test]
+fn a_bow_tie_fills_both_lobes_and_says_it_crosses_itself() {
+    // The defect: the symmetric bow-tie has zero signed area and was dropped as "collinear".
+    let mesh = triangulate(&[vec![[-5.33, -3.0], [5.33, 3.0], [5.33, -3.0], [-5.33, 3.0]]]).unwrap();
+    assert_eq!(mesh.triangle_count(), 2);
+    assert!((mesh.report.polygon_area - 2.0 * 5.33 * 3.0).abs() < 1e-9, "{}", mesh.report.polygon_area);
+    assert!(mesh.report.area_deviation() <= 1e-9);
+    assert_ccw(&mesh);
+    let warnings = mesh.report.warnings().join("\n");
+    assert!(warnings.contains("crosses itself") && !warnings.contains("collinear"), "{warnings}");
+    // Asymmetric: lobes of different size; was one triangle covering the wrong area.
+    let mesh = triangulate(&[vec![[0.0, 0.0], [4.0, 2.0], [4.0, 0.0], [0.0, 6.0]]]).unwrap();
+    // The diagonals cross at x = 4·6/(6+2)·… : lobe areas from the crossing point.
+    let x = mesh.positions[4];
+    let expected = 0.5 * 6.0 * x[0] + 0.5 * 2.0 * (4.0 - x[0]);
+    assert!((mesh.report.triangle_area - expected).abs() < 1e-9, "{} vs {expected}", mesh.report.triangle_area);
+    assert!(mesh.report.area_deviation() <= 1e-9);
+}
+
+#[test]
+fn a_ring_that_loops_inside_itself_is_covered_exactly() {
+    // A square traced around, then a small loop drawn inside it that crosses the path back:
+    // the small loop's inside is wound twice, so it stays filled (non-zero), and the bit of the
+    // stroke that pokes out below the square is filled too.
+    let ring = vec![
+        [0.0, 0.0],
+        [10.0, 0.0],
+        [10.0, 10.0],
+        [0.0, 10.0],
+        [0.0, 2.0],
+        [6.0, 2.0],
+        [6.0, 6.0],
+        [2.0, 6.0],
+        [2.0, -1.0],
+    ];
+    let mesh = triangulate(&[ring]).unwrap();
+    assert!(!mesh.report.crossed.is_empty());
+    assert!(mesh.report.area_deviation() <= 1e-9, "{:?}", mesh.report);
+    assert_ccw(&mesh);
+}
+
+#[test]
+fn a_pentagram_is_filled_whole_by_non_zero_winding() {
+    let star: Vec<[f64; 2]> = (0..5)
+        .map(|k| {
+            let a = std::f64::consts::TAU * f64::from(k * 2) / 5.0;
+            [a.cos(), a.sin()]
+        })
+        .collect();
+    let mesh = triangulate(&[star]).unwrap();
+    assert_eq!((mesh.report.outers, mesh.report.holes), (6, 0));
+    assert_eq!(mesh.triangle_count(), 5 + 3, "one triangle per point, three for the pentagon");
+    assert!(mesh.report.area_deviation() <= 1e-9, "{:?}", mesh.report);
+    assert_ccw(&mesh);
+}
