@@ -102,7 +102,9 @@ impl TriangulationReport {
             })
             .collect();
         out.extend(self.crossed.iter().map(|&(ring, crossings)| {
-            format!("ring {ring} crosses itself ({crossings} crossing(s)): each of its loops is filled")
+            format!(
+                "ring {ring} crosses itself ({crossings} crossing(s)): filled where it winds around (non-zero rule)"
+            )
         }));
         let deviation = self.area_deviation();
         if deviation > 1e-9 {
