@@ -4,7 +4,7 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use indra::assets::Assets;
@@ -17,16 +17,7 @@ const SIZE: (u32, u32) = (64, 64);
 
 /// A private copy of the project's scenes/ and shaders/ to edit.
 fn sandbox(name: &str) -> PathBuf {
-    let root = std::env::temp_dir().join(format!("indra-recovery-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
-    for dir in ["scenes", "shaders"] {
-        std::fs::create_dir_all(root.join(dir)).unwrap();
-        for entry in std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(dir)).unwrap() {
-            let entry = entry.unwrap();
-            std::fs::copy(entry.path(), root.join(dir).join(entry.file_name())).unwrap();
-        }
-    }
-    root
+    common::sandbox(&format!("recovery-{name}"))
 }
 
 /// Checks the device until something other than `skip` shows (wgpu reports a loss while

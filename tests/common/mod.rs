@@ -46,3 +46,18 @@ pub fn bright(frame: &RenderedFrame, x: u32, y: u32) -> bool {
     let p = &frame.rgba[i..i + 3];
     (u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2])) > 3 * 128
 }
+
+/// A private copy of the project's scenes/ and shaders/ (in the temporary folder, named after
+/// `name` and this process) for a test to edit.
+pub fn sandbox(name: &str) -> std::path::PathBuf {
+    let root = std::env::temp_dir().join(format!("indra-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    for dir in ["scenes", "shaders"] {
+        std::fs::create_dir_all(root.join(dir)).unwrap();
+        for entry in std::fs::read_dir(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(dir)).unwrap() {
+            let entry = entry.unwrap();
+            std::fs::copy(entry.path(), root.join(dir).join(entry.file_name())).unwrap();
+        }
+    }
+    root
+}
