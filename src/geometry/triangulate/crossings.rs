@@ -217,13 +217,7 @@ mod tests {
 
     #[test]
     fn a_pentagram_fills_its_five_points_and_the_pentagon_it_winds_around_twice() {
-        let star: Vec<[f64; 2]> = (0..5)
-            .map(|k| {
-                let a = std::f64::consts::TAU * f64::from(k * 2) / 5.0;
-                [a.cos(), a.sin()]
-            })
-            .collect();
-        let (s, _) = split(&star);
+        let (s, _) = split(&super::super::tests::pentagram());
         assert_eq!(s.crossings, 5);
         let mut sizes: Vec<usize> = s.loops.iter().map(Vec::len).collect();
         sizes.sort_unstable();

@@ -5,6 +5,16 @@ fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<[f64; 2]> {
     vec![[x0, y0], [x0, y1], [x1, y1], [x1, y0]]
 }
 
+/// The five-pointed star drawn in one stroke: every other point of a regular pentagon.
+pub(super) fn pentagram() -> Vec<[f64; 2]> {
+    (0..5)
+        .map(|k| {
+            let a = std::f64::consts::TAU * f64::from(k * 2) / 5.0;
+            [a.cos(), a.sin()]
+        })
+        .collect()
+}
+
 /// Every triangle counter-clockwise with positive area.
 fn assert_ccw(mesh: &Mesh2D) {
     for t in mesh.indices.chunks_exact(3) {
@@ -167,13 +177,7 @@ fn a_ring_that_loops_inside_itself_is_covered_exactly() {
 
 #[test]
 fn a_pentagram_is_filled_whole_by_non_zero_winding() {
-    let star: Vec<[f64; 2]> = (0..5)
-        .map(|k| {
-            let a = std::f64::consts::TAU * f64::from(k * 2) / 5.0;
-            [a.cos(), a.sin()]
-        })
-        .collect();
-    let mesh = triangulate(&[star]).unwrap();
+    let mesh = triangulate(&[pentagram()]).unwrap();
     assert_eq!((mesh.report.outers, mesh.report.holes), (6, 0));
     assert_eq!(mesh.triangle_count(), 5 + 3, "one triangle per point, three for the pentagon");
     assert!(mesh.report.area_deviation() <= 1e-9, "{:?}", mesh.report);
