@@ -94,8 +94,10 @@ const FIXTURES: &[(&str, usize, f64)] = &[
 /// Deviation bound for the fixtures whose rings cross each other (no exact triangulation exists;
 /// the result depends on where the cuts fall): water-huge, water-huge2, bad-hole. The `earcut`
 /// crate itself reaches 0.072 on them under rotation and mirroring (measured with the same
-/// deviation); earcut's suite allows 1.8e-3, 3e-3 and 0.019 at 0° only.
-const CROSSING: f64 = 0.12;
+/// deviation); earcut's suite allows 1.8e-3, 3e-3 and 0.019 at 0° only. Ours reaches 0.130
+/// (water-huge2 at 0°), up from 0.095 before corners were tested from a queue: on crossing
+/// input the order of cuts decides what is covered.
+const CROSSING: f64 = 0.14;
 
 #[test]
 fn earcut_fixtures_in_four_rotations() {

@@ -1,6 +1,5 @@
 //! The working state of ear slicing: vertex rings as circular doubly-linked lists in one arena
-//! (indices, not pointers), each node also on a z-order list for the spatial hash, plus the
-//! geometric predicates the slicer asks of them.
+//! (indices, not pointers), plus the geometric predicates the slicer asks of them.
 //!
 //! Convention: y up, outer rings counter-clockwise, holes clockwise; `area(p, q, r) > 0` is a
 //! left turn.
@@ -17,12 +16,10 @@ pub(super) struct Node {
     pub vertex: u32,
     pub prev: u32,
     pub next: u32,
-    /// Morton code of the quantised position (0 until hashed).
-    pub z: u32,
-    pub prev_z: u32,
-    pub next_z: u32,
     /// A hole of one point: never filtered away.
     pub steiner: bool,
+    /// Whether the node waits in the slicer's queue.
+    pub queued: bool,
 }
 
 /// The node arena (reused between calls).
@@ -118,7 +115,7 @@ impl Rings {
     /// Appends a node for `vertex` after `last` (or as a ring of one) and returns it.
     fn insert(&mut self, vertex: u32, [x, y]: [f64; 2], last: u32) -> u32 {
         let id = self.nodes.len() as u32;
-        let mut node = Node { x, y, vertex, prev: id, next: id, z: 0, prev_z: NIL, next_z: NIL, steiner: false };
+        let mut node = Node { x, y, vertex, prev: id, next: id, steiner: false, queued: false };
         if last != NIL {
             node.prev = last;
             node.next = self.next(last);
@@ -130,17 +127,11 @@ impl Rings {
         id
     }
 
-    /// Unlinks a node from its ring and its z-order list.
+    /// Unlinks a node from its ring (it keeps its own links).
     pub fn remove(&mut self, p: u32) {
-        let Node { prev, next, prev_z, next_z, .. } = *self.get(p);
+        let Node { prev, next, .. } = *self.get(p);
         self.nodes[next as usize].prev = prev;
         self.nodes[prev as usize].next = next;
-        if prev_z != NIL {
-            self.nodes[prev_z as usize].next_z = next_z;
-        }
-        if next_z != NIL {
-            self.nodes[next_z as usize].prev_z = prev_z;
-        }
     }
 
     /// Links `points` (vertex index, position) into a ring that runs counter-clockwise when

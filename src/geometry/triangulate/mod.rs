@@ -15,11 +15,13 @@ mod ear;
 mod holes;
 mod linked;
 mod nesting;
+mod zorder;
 
-use ear::{HASH_THRESHOLD, Slicer, ZHash};
+use ear::{HASH_THRESHOLD, Slicer};
 use linked::{NIL, Rings, signed_area};
 use nesting::RingShape;
 use std::ops::Range;
+use zorder::{ZHash, ZIndex};
 
 /// Why a triangulation could not be made at all.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -164,11 +166,12 @@ pub fn triangulate_flat(coords: &[f64], hole_starts: &[usize]) -> Result<Vec<u32
 #[derive(Default)]
 pub struct Triangulator {
     rings: Rings,
-    scratch: Vec<u64>,
+    zindex: ZIndex,
     holes: Vec<u32>,
     bands: holes::Bands,
     ranges: Vec<Range<usize>>,
     jobs: Vec<(u32, ear::Pass)>,
+    queue: std::collections::VecDeque<u32>,
 }
 
 impl Triangulator {
@@ -293,7 +296,15 @@ impl Triangulator {
             let shape = RingShape::new(outer_vertices);
             ZHash::new(shape.min, shape.max)
         });
-        Slicer { rings: &mut self.rings, hash, out, scratch: &mut self.scratch, jobs: &mut self.jobs }.run(node);
+        Slicer {
+            rings: &mut self.rings,
+            hash,
+            out,
+            index: &mut self.zindex,
+            jobs: &mut self.jobs,
+            queue: &mut self.queue,
+        }
+        .run(node);
     }
 }
 

@@ -2,6 +2,9 @@
 //! first, each placed under the deepest ring that contains it. Odd depth = an outer ring (filled),
 //! even depth = a hole; islands inside holes come out as outer rings of their own.
 
+use rstar::primitives::{GeomWithData, Rectangle};
+use rstar::{AABB, RTree};
+
 /// What the tree needs to know of one ring.
 pub(super) struct RingShape<'a> {
     pub vertices: &'a [[f64; 2]],
@@ -73,29 +76,36 @@ pub(super) struct Group {
     pub holes: Vec<usize>,
 }
 
-/// Builds the nesting tree and returns it as outer rings with their holes.
+/// Builds the nesting tree and returns it as outer rings with their holes. Rings are placed
+/// largest box first; a ring's parent is the deepest placed ring that contains it, found among
+/// the rings whose boxes contain its box's corner (an R-tree query, so 10⁵ separate rings do not
+/// test each other pairwise).
 pub(super) fn nest(shapes: &[RingShape]) -> Vec<Group> {
     let mut order: Vec<usize> = (0..shapes.len()).collect();
     order.sort_by(|&a, &b| shapes[b].box_area().total_cmp(&shapes[a].box_area()).then(a.cmp(&b)));
-    // children[i + 1] = rings directly inside ring i; children[0] = the top level.
-    let mut children: Vec<Vec<usize>> = vec![Vec::new(); shapes.len() + 1];
+    let mut rank = vec![0; shapes.len()];
+    for (place, &ring) in order.iter().enumerate() {
+        rank[ring] = place;
+    }
+    let boxes = RTree::bulk_load(
+        shapes.iter().enumerate().map(|(i, s)| GeomWithData::new(Rectangle::from_corners(s.min, s.max), i)).collect(),
+    );
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); shapes.len()];
     let mut depth = vec![0usize; shapes.len()];
     for &ring in &order {
-        let mut parent = None;
-        loop {
-            let list = &children[parent.map_or(0, |p| p + 1)];
-            match list.iter().copied().find(|&c| shapes[c].contains(&shapes[ring])) {
-                Some(c) => parent = Some(c),
-                None => break,
-            }
-        }
+        let corner = AABB::from_point(shapes[ring].min);
+        let parent = boxes
+            .locate_in_envelope_intersecting(&corner)
+            .map(|candidate| candidate.data)
+            .filter(|&c| rank[c] < rank[ring] && shapes[c].contains(&shapes[ring]))
+            .max_by_key(|&c| (depth[c], rank[c]));
         depth[ring] = parent.map_or(1, |p| depth[p] + 1);
-        children[parent.map_or(0, |p| p + 1)].push(ring);
+        if let Some(p) = parent {
+            children[p].push(ring);
+        }
     }
-    let mut groups: Vec<Group> = (0..shapes.len())
+    (0..shapes.len())
         .filter(|&r| depth[r] % 2 == 1)
-        .map(|outer| Group { outer, holes: children[outer + 1].clone() })
-        .collect();
-    groups.sort_by_key(|g| g.outer);
-    groups
+        .map(|outer| Group { outer, holes: std::mem::take(&mut children[outer]) })
+        .collect()
 }

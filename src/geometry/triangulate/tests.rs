@@ -183,3 +183,44 @@ fn a_pentagram_is_filled_whole_by_non_zero_winding() {
     assert!(mesh.report.area_deviation() <= 1e-9, "{:?}", mesh.report);
     assert_ccw(&mesh);
 }
+
+/// A star of `n` points whose spikes reach twice the inner radius: every spike's ear is long and
+/// thin, and once the spikes are cut the rest is one large convex ring.
+fn spiky_star(n: usize) -> Vec<[f64; 2]> {
+    (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            let r = if i % 2 == 0 { 1000.0 } else { 500.0 };
+            [r * a.cos(), r * a.sin()]
+        })
+        .collect()
+}
+
+#[test]
+fn long_spikes_and_the_convex_rest_triangulate_exactly() {
+    // Above the hash threshold: exercises the z-order walk with its jumps and removals.
+    let mesh = triangulate(&[spiky_star(20_000)]).unwrap();
+    assert_eq!(mesh.triangle_count(), 19_998);
+    assert!(mesh.report.area_deviation() < 1e-12, "{}", mesh.report.area_deviation());
+    assert_ccw(&mesh);
+}
+
+#[test]
+fn many_separate_rings_and_rings_in_rings_nest() {
+    // 40 × 40 squares, every fourth with a hole holding an island.
+    let mut rings = Vec::new();
+    for i in 0..1600 {
+        let (x, y) = (f64::from(i % 40) * 3.0, f64::from(i / 40) * 3.0);
+        rings.push(rect(x, y, x + 2.0, y + 2.0));
+        if i % 4 == 0 {
+            rings.push(rect(x + 0.5, y + 0.5, x + 1.5, y + 1.5));
+            rings.push(rect(x + 0.75, y + 0.75, x + 1.25, y + 1.25));
+        }
+    }
+    let mesh = triangulate(&rings).unwrap();
+    assert_eq!((mesh.report.outers, mesh.report.holes), (1600 + 400, 400));
+    let expected = 1600.0 * 4.0 - 400.0 * 1.0 + 400.0 * 0.25;
+    assert!((mesh.report.polygon_area - expected).abs() < 1e-9);
+    assert!(mesh.report.area_deviation() < 1e-12);
+    assert_ccw(&mesh);
+}
