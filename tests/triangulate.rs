@@ -268,3 +268,73 @@ proptest! {
         prop_assert!(mesh.report.area_deviation().is_finite() || mesh.report.polygon_area == 0.0);
     }
 }
+
+/// Holes that touch: `k` thin triangles fanned around one shared point `apex` (inside the outer
+/// rectangle or on its boundary), like earcut's touching-holes fixtures.
+fn fan_of_holes(apex: [f64; 2], k: usize, from: f64, spread: f64) -> Vec<Ring> {
+    let outer = vec![[-20.0, 0.0], [20.0, 0.0], [20.0, 25.0], [-20.0, 25.0]];
+    let mut rings = vec![outer];
+    for i in 0..k {
+        let a = from + spread * i as f64 / k as f64;
+        let b = a + 0.6 * spread / k as f64;
+        rings.push(vec![
+            apex,
+            [apex[0] + 12.0 * a.cos(), apex[1] + 9.0 * a.sin()],
+            [apex[0] + 12.0 * b.cos(), apex[1] + 9.0 * b.sin()],
+        ]);
+    }
+    rings
+}
+
+/// A checkerboard of square holes that touch at their corners, and a 2 × 2 block of holes that
+/// share edges, inside a square.
+fn touching_squares(block: bool) -> Vec<Ring> {
+    let square = |x: f64, y: f64| vec![[x, y], [x + 1.0, y], [x + 1.0, y + 1.0], [x, y + 1.0]];
+    let mut rings = vec![vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]];
+    if block {
+        rings.extend([square(2.0, 2.0), square(3.0, 2.0), square(2.0, 3.0), square(3.0, 3.0)]);
+        // And one touching the outer ring along an edge and at a corner.
+        rings.push(vec![[6.0, 0.0], [7.0, 1.0], [8.0, 0.0], [7.0, 2.0]]);
+        rings.push(vec![[10.0, 10.0], [9.0, 9.5], [9.5, 9.0]]);
+    } else {
+        for i in 1..9 {
+            for j in 1..9 {
+                if (i + j) % 2 == 0 {
+                    rings.push(square(f64::from(i), f64::from(j)));
+                }
+            }
+        }
+    }
+    rings
+}
+
+#[test]
+fn touching_holes_are_exact_in_every_layout_and_rotation() {
+    let tau = std::f64::consts::TAU;
+    let cases = [
+        ("fan inside", fan_of_holes([2.0, 12.0], 26, 0.3, 0.8 * tau)),
+        ("fan all round", fan_of_holes([0.0, 12.0], 52, 0.0, tau)),
+        ("fan on the outer edge", fan_of_holes([2.0, 0.0], 20, 0.1, 0.45 * tau)),
+        ("fan at the outer corner", fan_of_holes([-20.0, 0.0], 12, 0.05, 0.22 * tau)),
+        ("checkerboard", touching_squares(false)),
+        ("shared edges", touching_squares(true)),
+    ];
+    let mut failures = Vec::new();
+    for (name, base) in cases {
+        for turn in 0..4 {
+            let rings = rotate(&base, turn);
+            let mesh = triangulate(&rings).unwrap();
+            let (coords, starts) = flat(&rings);
+            let flat_dev = deviation(&rings, &triangulate_flat(&coords, &starts).unwrap());
+            let dev = mesh.report.area_deviation();
+            if dev > 1e-9 || flat_dev > 1e-9 || mesh.report.holes != rings.len() - 1 {
+                failures.push(format!(
+                    "{name} @{}°: deviation {dev:.3e} (flat {flat_dev:.3e}), {} holes",
+                    turn * 90,
+                    mesh.report.holes
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

@@ -8,6 +8,8 @@
 //! [`BANDS_FROM_HOLES`] holes the ring's edges are bucketed into horizontal bands so that both
 //! searches only visit edges near the hole's y.
 
+use std::collections::HashMap;
+
 use super::linked::{NIL, Rings, point_in_triangle};
 
 /// Holes from which the band index pays for itself.
@@ -95,11 +97,21 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
         bands.add_ring(rings, outer);
         rings.recording = true;
     }
+    let mut touching = Touching::new(rings, outer, holes);
     for &hole in holes.iter() {
-        let search = if banded { Search::Bands(bands) } else { Search::Ring(outer) };
-        let Some(bridge) = find_bridge(rings, hole, search) else {
-            // No outer edge to the right: the hole is not inside this ring. Leave it out.
-            continue;
+        // A hole that shares a point with the ring so far is joined there, in the copy of the
+        // point whose corner it sits in: bridging it elsewhere would leave the ring touching
+        // itself at that point, where ears can reach across.
+        let (bridge, hole) = match touching.find(rings, hole) {
+            Some(joint) => joint,
+            None => {
+                let search = if banded { Search::Bands(bands) } else { Search::Ring(outer) };
+                match find_bridge(rings, hole, search) {
+                    Some(bridge) => (bridge, hole),
+                    // No outer edge to the right: the hole is not inside this ring. Leave it out.
+                    None => continue,
+                }
+            }
         };
         rings.touched.clear();
         if banded {
@@ -113,7 +125,10 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
                 }
             }
         }
+        touching.add_ring(rings, hole);
         let reverse = rings.split(bridge, hole);
+        touching.add(rings, reverse);
+        touching.add(rings, rings.next(reverse));
         // Tidy collinear points around both cuts.
         rings.filter(reverse, rings.next(reverse));
         outer = rings.filter(bridge, rings.next(bridge));
@@ -135,6 +150,103 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
     rings.recording = false;
     // Bridges line up with edges often enough that a pass over the merged ring pays off.
     rings.filter(outer, NIL)
+}
+
+/// Points that two or more input rings share (holes touching each other or the outer ring), and
+/// the nodes of the merged ring at each (some may have been filtered away since).
+struct Touching {
+    copies: HashMap<(u64, u64), Vec<u32>>,
+}
+
+fn key(rings: &Rings, p: u32) -> (u64, u64) {
+    let n = rings.get(p);
+    // +0.0 and −0.0 are one point.
+    ((n.x + 0.0).to_bits(), (n.y + 0.0).to_bits())
+}
+
+impl Touching {
+    /// Finds the shared points (a sort of every node by position) and records the outer ring's
+    /// nodes at them.
+    fn new(rings: &Rings, outer: u32, holes: &[u32]) -> Self {
+        let mut all = Vec::new();
+        for (ring, &start) in std::iter::once(&outer).chain(holes).enumerate() {
+            let mut p = start;
+            loop {
+                all.push((key(rings, p), ring));
+                p = rings.next(p);
+                if p == start {
+                    break;
+                }
+            }
+        }
+        all.sort_unstable();
+        let mut copies = HashMap::new();
+        for pair in all.windows(2) {
+            if pair[0].0 == pair[1].0 && pair[0].1 != pair[1].1 {
+                copies.entry(pair[0].0).or_insert_with(Vec::new);
+            }
+        }
+        let mut touching = Self { copies };
+        touching.add_ring(rings, outer);
+        touching
+    }
+
+    /// Records a node of the merged ring if it sits at a shared point.
+    fn add(&mut self, rings: &Rings, p: u32) {
+        if let Some(list) = self.copies.get_mut(&key(rings, p)) {
+            list.push(p);
+        }
+    }
+
+    fn add_ring(&mut self, rings: &Rings, start: u32) {
+        if self.copies.is_empty() {
+            return;
+        }
+        let mut p = start;
+        loop {
+            self.add(rings, p);
+            p = rings.next(p);
+            if p == start {
+                break;
+            }
+        }
+    }
+
+    /// A node of the merged ring and a node of the hole at the same point, the hole sitting in
+    /// that node's corner.
+    fn find(&self, rings: &Rings, hole: u32) -> Option<(u32, u32)> {
+        if self.copies.is_empty() {
+            return None;
+        }
+        let mut h = hole;
+        loop {
+            if let Some(list) = self.copies.get(&key(rings, h)) {
+                let fits = |&&q: &&u32| rings.alive(q) && rings.equals(q, h) && corner_holds(rings, q, h);
+                if let Some(&q) = list.iter().find(fits) {
+                    return Some((q, h));
+                }
+            }
+            h = rings.next(h);
+            if h == hole {
+                return None;
+            }
+        }
+    }
+}
+
+/// Whether the hole's corner at `h` lies inside the ring's corner at `q` (same point): going
+/// counter-clockwise around the point from the ring's outgoing edge, the hole's edges come (in
+/// the hole's clockwise order: incoming, then outgoing) before the ring's incoming edge.
+fn corner_holds(rings: &Rings, q: u32, h: u32) -> bool {
+    let at = rings.get(q);
+    let direction = |p: u32| {
+        let n = rings.get(p);
+        (n.y - at.y).atan2(n.x - at.x)
+    };
+    let start = direction(rings.next(q));
+    let turn = |p: u32| (direction(p) - start).rem_euclid(std::f64::consts::TAU);
+    let (hole_in, hole_out, ring_in) = (turn(rings.prev(h)), turn(rings.next(h)), turn(rings.prev(q)));
+    hole_in < hole_out && hole_out <= ring_in
 }
 
 /// The node of a ring with the largest x (lowest y among ties).
