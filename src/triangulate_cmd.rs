@@ -19,6 +19,21 @@ pub struct TriangulateArgs {
     /// Curve flattening tolerance for SVG input, in path units.
     #[arg(long, default_value_t = 0.1)]
     pub tolerance: f64,
+    /// How rings are read: `nesting` (any order and orientation; rings inside rings are holes,
+    /// rings inside holes are filled again; rings that cross themselves are cut; single points
+    /// are Steiner points of the area around them) or `earcut` (the first ring is the outer
+    /// ring, every other ring a hole, single points Steiner points — GIS and font data).
+    #[arg(long, value_enum, default_value_t = Layout::Nesting)]
+    pub layout: Layout,
+}
+
+/// How `indra triangulate` reads its rings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Layout {
+    /// By nesting, in any order and orientation (the book's DrawTest).
+    Nesting,
+    /// First ring outer, the rest holes, single points Steiner points (earcut's layout).
+    Earcut,
 }
 
 /// Runs the command.
@@ -27,14 +42,19 @@ pub fn triangulate(args: &TriangulateArgs) -> Result<(), String> {
     let rings = read_rings(&text, args.tolerance).map_err(|e| format!("{}: {e}", args.file.display()))?;
     let mut triangulator = Triangulator::new();
     let start = Instant::now();
-    let mesh = triangulator.rings(&rings).map_err(|e| format!("{}: {e}", args.file.display()))?;
+    let mesh = match args.layout {
+        Layout::Nesting => triangulator.rings(&rings),
+        Layout::Earcut => triangulator.outer_and_holes(&rings),
+    }
+    .map_err(|e| format!("{}: {e}", args.file.display()))?;
     let elapsed = start.elapsed();
     let report = &mesh.report;
     println!(
-        "{} rings ({} filled, {} holes), {} vertices → {} triangles",
+        "{} rings ({} filled, {} holes, {} Steiner points), {} vertices → {} triangles",
         rings.len(),
         report.outers,
         report.holes,
+        report.steiner,
         mesh.positions.len(),
         mesh.triangle_count()
     );

@@ -260,7 +260,11 @@ fn triangulate_reads_json_and_svg_and_writes_the_mesh() {
     let o = indra(&["triangulate", &fixture]);
     assert!(o.status.success(), "{}", text(&o));
     // dude: 104 vertices, 2 holes → 106 triangles, exact area.
-    assert!(text(&o).contains("3 rings (1 filled, 2 holes), 104 vertices → 106 triangles"), "{}", text(&o));
+    assert!(
+        text(&o).contains("3 rings (1 filled, 2 holes, 0 Steiner points), 104 vertices → 106 triangles"),
+        "{}",
+        text(&o)
+    );
     let deviation: f64 = text(&o).split("area deviation ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
     assert!(deviation < 1e-12, "{}", text(&o));
 
@@ -277,6 +281,28 @@ fn triangulate_reads_json_and_svg_and_writes_the_mesh() {
     assert_eq!(json["indices"].as_array().unwrap().len(), 8 * 3);
     assert_eq!(json["positions"].as_array().unwrap().len(), 8);
     assert_eq!(json["uvs"][2], serde_json::json!([1.0, 1.0]));
+}
+
+#[test]
+fn triangulate_reads_earcut_layout_and_steiner_points() {
+    let dir = temp_dir("triangulate-layout");
+    let path = dir.join("square.json");
+    // Outer ring, a hole, a Steiner point inside the filled area.
+    std::fs::write(&path, "[[[0,0],[10,0],[10,10],[0,10]], [[2,2],[4,2],[4,4],[2,4]], [[7,7]]]").unwrap();
+    for layout in ["nesting", "earcut"] {
+        let o = indra(&["triangulate", path.to_str().unwrap(), "--layout", layout]);
+        assert!(o.status.success(), "{}", text(&o));
+        // 8 ring vertices and 1 hole: 8 triangles, and 2 more for the Steiner point.
+        let expected = "3 rings (1 filled, 1 holes, 1 Steiner points), 9 vertices → 10 triangles";
+        assert!(text(&o).contains(expected) && text(&o).contains("area deviation 0.000e0"), "{layout}: {}", text(&o));
+    }
+    // The same rings listed hole first: nesting finds the outer ring anyway; earcut's layout
+    // takes the first ring as the outer one and says the area does not add up.
+    std::fs::write(&path, "[[[2,2],[4,2],[4,4],[2,4]], [[0,0],[10,0],[10,10],[0,10]]]").unwrap();
+    let nesting = indra(&["triangulate", path.to_str().unwrap()]);
+    assert!(text(&nesting).contains("area deviation 0.000e0"), "{}", text(&nesting));
+    let earcut = indra(&["triangulate", path.to_str().unwrap(), "--layout", "earcut"]);
+    assert!(earcut.status.success() && text(&earcut).contains("warning: triangles cover"), "{}", text(&earcut));
 }
 
 #[test]
@@ -303,4 +329,9 @@ fn triangulate_bad_input_is_one_clear_message() {
     std::fs::write(&path, "M0 0 L10 x").unwrap();
     let o = indra(&["triangulate", path.to_str().unwrap()]);
     assert!(!o.status.success() && text(&o).contains("SVG path data"), "{}", text(&o));
+    // Was: exit 0 with "area deviation NaN" (a curve through 1e300).
+    std::fs::write(&path, "M0 0 C 1e300 1e300 -1e300 1e300 0 10 Z").unwrap();
+    let o = indra(&["triangulate", path.to_str().unwrap()]);
+    assert!(!o.status.success() && text(&o).contains("is too large"), "{}", text(&o));
+    assert_eq!(text(&o).lines().count(), 1, "{}", text(&o));
 }

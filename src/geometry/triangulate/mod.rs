@@ -34,6 +34,19 @@ pub enum TriangulateError {
         /// Vertex index within the ring.
         vertex: usize,
     },
+    /// A coordinate so large that areas (products of coordinate differences) could overflow.
+    #[error(
+        "ring {ring}, vertex {vertex}: coordinate {value:e} is too large (|x| and |y| must stay within \
+         {MAX_COORDINATE:e}, so that areas stay finite); scale the input down"
+    )]
+    TooLarge {
+        /// Ring index.
+        ring: usize,
+        /// Vertex index within the ring.
+        vertex: usize,
+        /// The coordinate.
+        value: f64,
+    },
     /// More vertices than 32-bit indices can address.
     #[error("{0} vertices: at most {max} fit 32-bit indices", max = u32::MAX - 1)]
     TooManyVertices(usize),
@@ -57,6 +70,8 @@ pub enum DropReason {
     TooFewPoints,
     /// All points on one line: the ring encloses nothing.
     ZeroArea,
+    /// A single point (a Steiner point) outside every filled area or on its boundary.
+    SteinerOutside,
 }
 
 /// An input ring that is not in the mesh.
@@ -75,6 +90,8 @@ pub struct TriangulationReport {
     pub outers: usize,
     /// Rings cut out (even nesting depth).
     pub holes: usize,
+    /// Single-point rings placed inside a filled area as Steiner points (mesh vertices).
+    pub steiner: usize,
     /// Rings left out, with the reason.
     pub dropped: Vec<DroppedRing>,
     /// Rings that crossed themselves, with the number of crossings: each was cut there into
@@ -90,7 +107,12 @@ impl TriangulationReport {
     /// |Σ triangle area − polygon area| / polygon area (0 for an empty polygon covered by nothing).
     pub fn area_deviation(&self) -> f64 {
         let diff = (self.triangle_area - self.polygon_area).abs();
-        if self.polygon_area == 0.0 { if diff == 0.0 { 0.0 } else { f64::INFINITY } } else { diff / self.polygon_area }
+        // |…| of the polygon area: earcut's layout can list holes larger than the outer ring.
+        if self.polygon_area == 0.0 {
+            if diff == 0.0 { 0.0 } else { f64::INFINITY }
+        } else {
+            diff / self.polygon_area.abs()
+        }
     }
 
     /// One line per thing the caller should know: dropped rings, area not covered.
@@ -101,6 +123,9 @@ impl TriangulationReport {
             .map(|d| match d.reason {
                 DropReason::TooFewPoints => format!("ring {} left out: fewer than 3 distinct points", d.ring),
                 DropReason::ZeroArea => format!("ring {} left out: its points are collinear", d.ring),
+                DropReason::SteinerOutside => {
+                    format!("ring {} left out: a single point (Steiner point) outside the filled area", d.ring)
+                }
             })
             .collect();
         out.extend(self.crossed.iter().map(|&(ring, crossings)| {
@@ -201,7 +226,7 @@ impl Triangulator {
             ranges.push(start..end);
             start = end;
         }
-        let checked = ranges.iter().enumerate().try_for_each(|(ring, r)| check_finite(&vertices[r.clone()], ring));
+        let checked = ranges.iter().enumerate().try_for_each(|(ring, r)| check_coordinates(&vertices[r.clone()], ring));
         if checked.is_ok() {
             self.group(vertices, ranges[0].clone(), &ranges[1..], out);
         }
@@ -218,7 +243,7 @@ impl Triangulator {
         let mut ranges = Vec::with_capacity(rings.len());
         for (index, ring) in rings.iter().enumerate() {
             let ring = ring.as_ref();
-            check_finite(ring, index)?;
+            check_coordinates(ring, index)?;
             ranges.push(positions.len()..positions.len() + ring.len());
             positions.extend_from_slice(ring);
         }
@@ -229,8 +254,13 @@ impl Triangulator {
         check_count(positions.len())?;
         let mut kept = Vec::new();
         let mut areas = Vec::new();
+        let mut points = Vec::new();
         for (index, range) in ranges.iter().enumerate() {
             let ring = &positions[range.clone()];
+            if ring.first().is_some_and(|&first| ring.iter().all(|&p| p == first)) {
+                points.push(index);
+                continue;
+            }
             match classify(ring) {
                 Ok(area) => {
                     kept.push(index);
@@ -252,15 +282,61 @@ impl Triangulator {
                 ..RingShape::new(&positions[ranges[r].clone()])
             })
             .collect();
+        let groups = nesting::nest(&shapes);
+        // Steiner points join the group whose filled area holds them, as holes of one point.
+        let mut steiner = vec![Vec::new(); groups.len()];
+        for &point in &points {
+            let at = positions[ranges[point].start];
+            match groups.iter().position(|g| nesting::fills(&shapes, g, at)) {
+                Some(group) => {
+                    steiner[group].push(ranges[point].start..ranges[point].start + 1);
+                    report.steiner += 1;
+                }
+                None => report.dropped.push(DroppedRing { ring: ring_of[point], reason: DropReason::SteinerOutside }),
+            }
+        }
+        report.dropped.sort_by_key(|d| d.ring);
         let mut indices = Vec::new();
         let mut hole_ranges = Vec::new();
-        for group in nesting::nest(&shapes) {
+        for (group, steiner) in groups.iter().zip(steiner) {
             report.outers += 1;
             report.holes += group.holes.len();
             report.polygon_area += areas[group.outer] - group.holes.iter().map(|&h| areas[h]).sum::<f64>();
             hole_ranges.clear();
             hole_ranges.extend(group.holes.iter().map(|&h| ranges[kept[h]].clone()));
+            hole_ranges.extend(steiner);
             self.group(&positions, ranges[kept[group.outer]].clone(), &hole_ranges, &mut indices);
+        }
+        report.triangle_area = triangle_area(&positions, &indices);
+        let uvs = bounding_rect_uvs(&positions);
+        Ok(Mesh2D { positions, indices, uvs, report })
+    }
+
+    /// Triangulates rings in earcut's layout: the first ring is the outer ring, every other
+    /// ring a hole in it, a ring of one point a Steiner point (a vertex the mesh must contain).
+    /// Nothing is nested or split: the report's polygon area is |outer| − Σ |hole|, earcut's.
+    ///
+    /// # Errors
+    /// As [`triangulate`].
+    pub fn outer_and_holes<R: AsRef<[[f64; 2]]>>(&mut self, rings: &[R]) -> Result<Mesh2D, TriangulateError> {
+        let mut positions = Vec::new();
+        let mut ranges = Vec::with_capacity(rings.len());
+        for (index, ring) in rings.iter().enumerate() {
+            let ring = ring.as_ref();
+            check_coordinates(ring, index)?;
+            ranges.push(positions.len()..positions.len() + ring.len());
+            positions.extend_from_slice(ring);
+        }
+        check_count(positions.len())?;
+        let mut report = TriangulationReport::default();
+        let mut indices = Vec::new();
+        if let Some((outer, holes)) = ranges.split_first() {
+            let area = |r: &Range<usize>| signed_area(&positions[r.clone()]).abs();
+            report.outers = 1;
+            report.steiner = holes.iter().filter(|r| r.len() == 1).count();
+            report.holes = holes.len() - report.steiner;
+            report.polygon_area = area(outer) - holes.iter().map(area).sum::<f64>();
+            self.group(&positions, outer.clone(), holes, &mut indices);
         }
         report.triangle_area = triangle_area(&positions, &indices);
         let uvs = bounding_rect_uvs(&positions);
@@ -337,11 +413,22 @@ fn split_crossing_rings(
     (out, ring_of)
 }
 
-fn check_finite(ring: &[[f64; 2]], index: usize) -> Result<(), TriangulateError> {
-    match ring.iter().position(|v| !v[0].is_finite() || !v[1].is_finite()) {
-        Some(vertex) => Err(TriangulateError::NonFinite { ring: index, vertex }),
-        None => Ok(()),
+/// The largest coordinate magnitude accepted: differences stay below 2e150, so the products
+/// in areas and orientation tests (and sums of them) stay far below f64's 1.8e308.
+pub const MAX_COORDINATE: f64 = 1e150;
+
+fn check_coordinates(ring: &[[f64; 2]], index: usize) -> Result<(), TriangulateError> {
+    for (vertex, v) in ring.iter().enumerate() {
+        for value in *v {
+            if !value.is_finite() {
+                return Err(TriangulateError::NonFinite { ring: index, vertex });
+            }
+            if value.abs() > MAX_COORDINATE {
+                return Err(TriangulateError::TooLarge { ring: index, vertex, value });
+            }
+        }
     }
+    Ok(())
 }
 
 fn check_count(vertices: usize) -> Result<(), TriangulateError> {

@@ -39,7 +39,7 @@ impl<'a> RingShape<'a> {
 
     /// Inside (`Some(true)`), outside (`Some(false)`) or on the boundary (`None`), by counting
     /// crossings of a ray to +x.
-    fn locate(&self, p: [f64; 2]) -> Option<bool> {
+    pub fn locate(&self, p: [f64; 2]) -> Option<bool> {
         let mut inside = false;
         let mut j = *self.vertices.last()?;
         for &i in self.vertices {
@@ -67,6 +67,14 @@ impl<'a> RingShape<'a> {
         let siblings = self.family.is_some() && self.family == other.family;
         !siblings && self.box_contains(other) && other.vertices.iter().find_map(|&v| self.locate(v)).unwrap_or(false)
     }
+}
+
+/// Whether a point lies strictly inside the area a group fills: inside its outer ring and
+/// outside each of its holes (on no boundary).
+pub(super) fn fills(shapes: &[RingShape], group: &Group, p: [f64; 2]) -> bool {
+    let outer = &shapes[group.outer];
+    let in_box = (0..2).all(|k| outer.min[k] <= p[k] && p[k] <= outer.max[k]);
+    in_box && outer.locate(p) == Some(true) && group.holes.iter().all(|&h| shapes[h].locate(p) == Some(false))
 }
 
 /// An outer ring and the holes directly inside it (indices into the shapes).

@@ -81,7 +81,10 @@ fn degenerate_rings_are_reported_not_meshed() {
     let mesh = triangulate(&rings).unwrap();
     assert_eq!(mesh.triangle_count(), 2);
     let reasons: Vec<_> = mesh.report.dropped.iter().map(|d| (d.ring, d.reason)).collect();
-    assert_eq!(reasons, vec![(1, DropReason::ZeroArea), (2, DropReason::TooFewPoints), (3, DropReason::TooFewPoints)]);
+    assert_eq!(
+        reasons,
+        vec![(1, DropReason::ZeroArea), (2, DropReason::SteinerOutside), (3, DropReason::TooFewPoints)]
+    );
     assert_eq!(mesh.report.warnings().len(), 3);
 }
 
@@ -115,6 +118,25 @@ fn bad_input_is_an_error() {
     assert_eq!(triangulate_flat(&[0.0, 1.0, 2.0], &[]).unwrap_err(), TriangulateError::OddCoordinates(3));
     assert!(matches!(triangulate_flat(&[0.0; 8], &[7]), Err(TriangulateError::BadHoleIndex { .. })));
     assert!(triangulate::<Vec<[f64; 2]>>(&[]).unwrap().indices.is_empty());
+}
+
+#[test]
+fn coordinates_whose_areas_would_overflow_are_an_error_and_large_ones_still_work() {
+    // Was: "its points are collinear" (the area overflowed to infinity and back to NaN).
+    let huge = rect(-1.7e308, -1.7e308, 1.7e308, 1.7e308);
+    let error = triangulate(std::slice::from_ref(&huge)).unwrap_err();
+    assert!(matches!(error, TriangulateError::TooLarge { ring: 0, vertex: 0, .. }), "{error:?}");
+    assert!(error.to_string().contains("too large"), "{error}");
+    let mut out = Vec::new();
+    let flat: Vec<f64> = huge.iter().flatten().copied().collect();
+    assert!(matches!(Triangulator::new().flat(&flat, &[], &mut out), Err(TriangulateError::TooLarge { .. })));
+    assert!(matches!(Triangulator::new().outer_and_holes(&[huge]), Err(TriangulateError::TooLarge { .. })));
+    // At the limit everything is finite and exact.
+    let big = rect(-MAX_COORDINATE, -MAX_COORDINATE, MAX_COORDINATE, MAX_COORDINATE);
+    let hole = rect(-1e149, -1e149, 1e149, 1e149);
+    let mesh = triangulate(&[big, hole]).unwrap();
+    assert_eq!(mesh.triangle_count(), 8);
+    assert!(mesh.report.polygon_area.is_finite() && mesh.report.area_deviation() < 1e-12, "{:?}", mesh.report);
 }
 
 #[test]
@@ -221,6 +243,34 @@ fn many_separate_rings_and_rings_in_rings_nest() {
     assert_eq!((mesh.report.outers, mesh.report.holes), (1600 + 400, 400));
     let expected = 1600.0 * 4.0 - 400.0 * 1.0 + 400.0 * 0.25;
     assert!((mesh.report.polygon_area - expected).abs() < 1e-9);
+    assert!(mesh.report.area_deviation() < 1e-12);
+    assert_ccw(&mesh);
+}
+
+#[test]
+fn single_points_inside_are_steiner_vertices_of_the_mesh() {
+    // A square with a hole; points inside the filled area, in the hole, outside, on an edge.
+    let rings = vec![
+        rect(0.0, 0.0, 4.0, 4.0),
+        vec![[1.0, 1.0]],
+        rect(2.0, 2.0, 3.0, 3.0),
+        vec![[3.5, 0.5], [3.5, 0.5]],
+        vec![[2.5, 2.5]],
+        vec![[9.0, 9.0]],
+        vec![[0.0, 2.0]],
+    ];
+    let mesh = triangulate(&rings).unwrap();
+    assert_eq!(mesh.report.steiner, 2);
+    let reasons: Vec<_> = mesh.report.dropped.iter().map(|d| (d.ring, d.reason)).collect();
+    let outside = DropReason::SteinerOutside;
+    assert_eq!(reasons, vec![(4, outside), (5, outside), (6, outside)]);
+    // Each Steiner point (input vertices 4 and 9) is a corner of some triangle.
+    let used: std::collections::HashSet<u32> = mesh.indices.iter().copied().collect();
+    for point in [4, 9] {
+        assert!(used.contains(&point), "Steiner point {point} not in the mesh");
+    }
+    // n + 2h − 2 with the hole, and two more per Steiner point.
+    assert_eq!(mesh.triangle_count(), 8 + 2 - 2 + 2 * 2);
     assert!(mesh.report.area_deviation() < 1e-12);
     assert_ccw(&mesh);
 }
