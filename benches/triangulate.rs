@@ -2,6 +2,10 @@
 //! earcut's fixtures (building 15 vertices … water-huge2 5,488 vertices / 443 rings) and a
 //! generated star polygon of 20,000 vertices with 400 holes. Each library reuses its buffers where
 //! its API allows. Run: `cargo bench --bench triangulate`; report ours/earcut as ratios.
+//!
+//! The `scale` group times ours alone on inputs where both crates take seconds to minutes (they
+//! grow quadratically there): a 10⁶-point star with spikes of twice the inner radius, a wavy
+//! 10⁶-gon, and 10⁵ separate squares read by nesting.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use indra::geometry::triangulate::Triangulator;
@@ -84,5 +88,55 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+/// `n` points, every other one at half the radius.
+fn spiky_star(n: usize) -> Vec<[f64; 2]> {
+    (0..n)
+        .map(|i| {
+            let t = i as f64 / n as f64 * std::f64::consts::TAU;
+            let r = if i.is_multiple_of(2) { 1000.0 } else { 500.0 };
+            [r * t.cos(), r * t.sin()]
+        })
+        .collect()
+}
+
+/// The outer ring of [`generated`] alone.
+fn wavy(n: usize) -> Vec<[f64; 2]> {
+    let input = generated(n, 0);
+    input.coords.chunks_exact(2).map(|p| [p[0], p[1]]).collect()
+}
+
+/// `count` unit squares on a grid, apart.
+fn squares(count: usize) -> Vec<Vec<[f64; 2]>> {
+    let side = (count as f64).sqrt().ceil() as usize;
+    (0..count)
+        .map(|i| {
+            let (x, y) = ((i % side) as f64 * 3.0, (i / side) as f64 * 3.0);
+            vec![[x, y], [x + 1.0, y], [x + 1.0, y + 1.0], [x, y + 1.0]]
+        })
+        .collect()
+}
+
+fn scale(c: &mut Criterion) {
+    let mut group = c.benchmark_group("scale");
+    group.sample_size(10);
+    let mut ours = Triangulator::new();
+    for (name, ring) in [("spiky-star-1e6", spiky_star(1_000_000)), ("wavy-1e6", wavy(1_000_000))] {
+        let coords: Vec<f64> = ring.iter().flatten().copied().collect();
+        let mut out = Vec::new();
+        group.bench_function(BenchmarkId::new("indra", name), |b| {
+            b.iter(|| {
+                out.clear();
+                ours.flat(&coords, &[], &mut out).unwrap();
+                out.len()
+            })
+        });
+    }
+    let rings = squares(100_000);
+    group.bench_function(BenchmarkId::new("indra", "squares-1e5"), |b| {
+        b.iter(|| ours.rings(&rings).unwrap().indices.len())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, scale);
 criterion_main!(benches);

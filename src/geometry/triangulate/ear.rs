@@ -227,12 +227,15 @@ impl Slicer<'_> {
         let hash = self.hash.expect("hashed ear test without a hash");
         let (min_z, max_z) = (hash.z(corner.min[0], corner.min[1]), hash.z(corner.max[0], corner.max[1]));
         let mut at = self.index.live_from(self.index.first_at_or_after(min_z));
+        // Codes outside the box met in a row: a few are stepped over, more are jumped.
+        let mut misses = 0;
         while let Some(&key) = self.index.keys.get(at) {
             let z = code(key);
             if z > max_z {
                 return true;
             }
             if in_box(z, min_z, max_z) {
+                misses = 0;
                 let p = key as u32;
                 if corner.covers(self.index.positions[at]) && !own.contains(&p) {
                     if !self.convex(p) {
@@ -243,14 +246,13 @@ impl Slicer<'_> {
                 at = self.index.live_from(at + 1);
                 continue;
             }
+            misses += 1;
+            if misses < 4 {
+                at = self.index.live_from(at + 1);
+                continue;
+            }
             let Some(target) = bigmin(z, min_z, max_z) else { return true };
-            // The next few codes usually reach the target; search only when they do not.
-            let near = &self.index.keys[at + 1..(at + 8).min(self.index.keys.len())];
-            at = match near.iter().position(|&key| code(key) >= target) {
-                Some(step) => at + 1 + step,
-                None => self.index.first_at_or_after(target),
-            };
-            at = self.index.live_from(at);
+            at = self.index.live_from(self.index.first_at_or_after(target));
         }
         true
     }

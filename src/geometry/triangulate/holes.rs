@@ -165,28 +165,32 @@ fn key(rings: &Rings, p: u32) -> (u64, u64) {
 }
 
 impl Touching {
-    /// Finds the shared points (a sort of every node by position) and records the outer ring's
-    /// nodes at them.
+    /// Finds the shared points — hole points that another hole or the outer ring also has (a
+    /// sort of the hole points, a binary search per outer point) — and records the outer
+    /// ring's nodes at them. Without holes nothing is sorted or allocated.
     fn new(rings: &Rings, outer: u32, holes: &[u32]) -> Self {
-        let mut all = Vec::new();
-        for (ring, &start) in std::iter::once(&outer).chain(holes).enumerate() {
-            let mut p = start;
-            loop {
-                all.push((key(rings, p), ring));
-                p = rings.next(p);
-                if p == start {
-                    break;
-                }
-            }
+        let mut touching = Self { copies: HashMap::new() };
+        if holes.is_empty() {
+            return touching;
         }
-        all.sort_unstable();
-        let mut copies = HashMap::new();
-        for pair in all.windows(2) {
-            if pair[0].0 == pair[1].0 && pair[0].1 != pair[1].1 {
-                copies.entry(pair[0].0).or_insert_with(Vec::new);
-            }
+        let mut hole_points = Vec::new();
+        for (ring, &start) in holes.iter().enumerate() {
+            for_each_node(rings, start, |p| hole_points.push((key(rings, p), ring)));
         }
-        let mut touching = Self { copies };
+        hole_points.sort_unstable();
+        let mut shared: Vec<(u64, u64)> = hole_points
+            .windows(2)
+            .filter(|pair| pair[0].0 == pair[1].0 && pair[0].1 != pair[1].1)
+            .map(|pair| pair[0].0)
+            .collect();
+        for_each_node(rings, outer, |p| {
+            let k = key(rings, p);
+            let at = hole_points.partition_point(|probe| probe.0 < k);
+            if hole_points.get(at).is_some_and(|probe| probe.0 == k) {
+                shared.push(k);
+            }
+        });
+        touching.copies.extend(shared.into_iter().map(|k| (k, Vec::new())));
         touching.add_ring(rings, outer);
         touching
     }
@@ -199,16 +203,8 @@ impl Touching {
     }
 
     fn add_ring(&mut self, rings: &Rings, start: u32) {
-        if self.copies.is_empty() {
-            return;
-        }
-        let mut p = start;
-        loop {
-            self.add(rings, p);
-            p = rings.next(p);
-            if p == start {
-                break;
-            }
+        if !self.copies.is_empty() {
+            for_each_node(rings, start, |p| self.add(rings, p));
         }
     }
 
@@ -230,6 +226,18 @@ impl Touching {
             if h == hole {
                 return None;
             }
+        }
+    }
+}
+
+/// Calls `visit` with every node of the ring of `start`.
+fn for_each_node(rings: &Rings, start: u32, mut visit: impl FnMut(u32)) {
+    let mut p = start;
+    loop {
+        visit(p);
+        p = rings.next(p);
+        if p == start {
+            break;
         }
     }
 }

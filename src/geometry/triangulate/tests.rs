@@ -212,7 +212,7 @@ fn spiky_star(n: usize) -> Vec<[f64; 2]> {
     (0..n)
         .map(|i| {
             let a = std::f64::consts::TAU * i as f64 / n as f64;
-            let r = if i % 2 == 0 { 1000.0 } else { 500.0 };
+            let r = if i.is_multiple_of(2) { 1000.0 } else { 500.0 };
             [r * a.cos(), r * a.sin()]
         })
         .collect()
