@@ -239,15 +239,7 @@ impl Triangulator {
     /// # Errors
     /// As [`triangulate`].
     pub fn rings<R: AsRef<[[f64; 2]]>>(&mut self, rings: &[R]) -> Result<Mesh2D, TriangulateError> {
-        let mut positions = Vec::new();
-        let mut ranges = Vec::with_capacity(rings.len());
-        for (index, ring) in rings.iter().enumerate() {
-            let ring = ring.as_ref();
-            check_coordinates(ring, index)?;
-            ranges.push(positions.len()..positions.len() + ring.len());
-            positions.extend_from_slice(ring);
-        }
-        check_count(positions.len())?;
+        let (mut positions, ranges) = concatenate(rings)?;
 
         let mut report = TriangulationReport::default();
         let (ranges, ring_of) = split_crossing_rings(&mut positions, ranges, &mut report);
@@ -319,15 +311,7 @@ impl Triangulator {
     /// # Errors
     /// As [`triangulate`].
     pub fn outer_and_holes<R: AsRef<[[f64; 2]]>>(&mut self, rings: &[R]) -> Result<Mesh2D, TriangulateError> {
-        let mut positions = Vec::new();
-        let mut ranges = Vec::with_capacity(rings.len());
-        for (index, ring) in rings.iter().enumerate() {
-            let ring = ring.as_ref();
-            check_coordinates(ring, index)?;
-            ranges.push(positions.len()..positions.len() + ring.len());
-            positions.extend_from_slice(ring);
-        }
-        check_count(positions.len())?;
+        let (positions, ranges) = concatenate(rings)?;
         let mut report = TriangulationReport::default();
         let mut indices = Vec::new();
         if let Some((outer, holes)) = ranges.split_first() {
@@ -416,6 +400,23 @@ fn split_crossing_rings(
 /// The largest coordinate magnitude accepted: differences stay below 2e150, so the products
 /// in areas and orientation tests (and sums of them) stay far below f64's 1.8e308.
 pub const MAX_COORDINATE: f64 = 1e150;
+
+/// Every ring's points in one array, and each ring's range in it.
+type Concatenated = (Vec<[f64; 2]>, Vec<Range<usize>>);
+
+/// [`Concatenated`] rings, their coordinates and count checked.
+fn concatenate<R: AsRef<[[f64; 2]]>>(rings: &[R]) -> Result<Concatenated, TriangulateError> {
+    let mut positions = Vec::new();
+    let mut ranges = Vec::with_capacity(rings.len());
+    for (index, ring) in rings.iter().enumerate() {
+        let ring = ring.as_ref();
+        check_coordinates(ring, index)?;
+        ranges.push(positions.len()..positions.len() + ring.len());
+        positions.extend_from_slice(ring);
+    }
+    check_count(positions.len())?;
+    Ok((positions, ranges))
+}
 
 fn check_coordinates(ring: &[[f64; 2]], index: usize) -> Result<(), TriangulateError> {
     for (vertex, v) in ring.iter().enumerate() {
