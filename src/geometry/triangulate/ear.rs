@@ -1,10 +1,11 @@
 //! Ear slicing of one linked ring (an outer ring with its holes already bridged in), after
-//! Eberly's ear clipping and Held's FIST as refined in mapbox's earcut: ears are taken as found
-//! walking the ring, the next search starts two nodes on (fewer slivers than the sample's FIFO),
+//! Eberly's ear clipping and Held's FIST as refined in mapbox's earcut: corners are tested in ring
+//! order and then as their neighbours are clipped, the clipped ear's next neighbour waiting one
+//! turn (fewer slivers than the sample's FIFO),
 //! and, above [`HASH_THRESHOLD`] vertices, the "no vertex inside the ear" test only visits the
-//! reflex nodes whose z-order code falls in the ear's bounding box. Rings that stop yielding ears go through
-//! three fallbacks: drop collinear/repeated points, cut off local self-intersections, split along
-//! any valid diagonal.
+//! reflex nodes whose z-order code falls in the ear's bounding box. Rings that stop yielding ears
+//! go through three fallbacks: drop collinear/repeated points, cut off local self-intersections,
+//! split along any valid diagonal.
 
 use std::collections::VecDeque;
 
@@ -261,15 +262,10 @@ impl Slicer<'_> {
     fn index_curve(&mut self, start: u32) {
         let hash = self.hash.expect("indexing without a hash");
         self.index.keys.clear();
-        let mut p = start;
-        loop {
+        self.rings.for_each_node(start, |p| {
             let node = self.rings.get(p);
             self.index.keys.push((u64::from(hash.z(node.x, node.y)) << 32) | u64::from(p));
-            p = node.next;
-            if p == start {
-                break;
-            }
-        }
+        });
         let nodes = &self.rings.nodes;
         self.index.build(|p| [nodes[p as usize].x, nodes[p as usize].y]);
     }

@@ -49,14 +49,7 @@ impl Bands {
     }
 
     fn add_ring(&mut self, rings: &Rings, start: u32) {
-        let mut p = start;
-        loop {
-            self.add_edge(rings, p);
-            p = rings.next(p);
-            if p == start {
-                break;
-            }
-        }
+        rings.for_each_node(start, |p| self.add_edge(rings, p));
     }
 }
 
@@ -83,16 +76,11 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
     let banded = holes.len() >= BANDS_FROM_HOLES;
     if banded {
         let (mut lo, mut hi, mut count) = (f64::INFINITY, f64::NEG_INFINITY, 0);
-        let mut p = outer;
-        loop {
+        rings.for_each_node(outer, |p| {
             lo = lo.min(rings.get(p).y);
             hi = hi.max(rings.get(p).y);
             count += 1;
-            p = rings.next(p);
-            if p == outer {
-                break;
-            }
-        }
+        });
         bands.reset(lo, hi, count / 4);
         bands.add_ring(rings, outer);
         rings.recording = true;
@@ -116,14 +104,9 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
         rings.touched.clear();
         if banded {
             // The hole's edges join the ring: note them while the hole is still a ring of its own.
-            let mut p = hole;
-            loop {
-                rings.touched.push(p);
-                p = rings.next(p);
-                if p == hole {
-                    break;
-                }
-            }
+            let mut touched = std::mem::take(&mut rings.touched);
+            rings.for_each_node(hole, |p| touched.push(p));
+            rings.touched = touched;
         }
         touching.add_ring(rings, hole);
         let reverse = rings.split(bridge, hole);
@@ -175,7 +158,7 @@ impl Touching {
         }
         let mut hole_points = Vec::new();
         for (ring, &start) in holes.iter().enumerate() {
-            for_each_node(rings, start, |p| hole_points.push((key(rings, p), ring)));
+            rings.for_each_node(start, |p| hole_points.push((key(rings, p), ring)));
         }
         hole_points.sort_unstable();
         let mut shared: Vec<(u64, u64)> = hole_points
@@ -183,7 +166,7 @@ impl Touching {
             .filter(|pair| pair[0].0 == pair[1].0 && pair[0].1 != pair[1].1)
             .map(|pair| pair[0].0)
             .collect();
-        for_each_node(rings, outer, |p| {
+        rings.for_each_node(outer, |p| {
             let k = key(rings, p);
             let at = hole_points.partition_point(|probe| probe.0 < k);
             if hole_points.get(at).is_some_and(|probe| probe.0 == k) {
@@ -204,7 +187,7 @@ impl Touching {
 
     fn add_ring(&mut self, rings: &Rings, start: u32) {
         if !self.copies.is_empty() {
-            for_each_node(rings, start, |p| self.add(rings, p));
+            rings.for_each_node(start, |p| self.add(rings, p));
         }
     }
 
@@ -226,18 +209,6 @@ impl Touching {
             if h == hole {
                 return None;
             }
-        }
-    }
-}
-
-/// Calls `visit` with every node of the ring of `start`.
-fn for_each_node(rings: &Rings, start: u32, mut visit: impl FnMut(u32)) {
-    let mut p = start;
-    loop {
-        visit(p);
-        p = rings.next(p);
-        if p == start {
-            break;
         }
     }
 }

@@ -93,6 +93,18 @@ impl Rings {
         self.nodes[i as usize].prev
     }
 
+    /// Calls `visit` with every node of the ring of `start`, in ring order.
+    pub fn for_each_node(&self, start: u32, mut visit: impl FnMut(u32)) {
+        let mut p = start;
+        loop {
+            visit(p);
+            p = self.next(p);
+            if p == start {
+                break;
+            }
+        }
+    }
+
     /// Twice the signed area of the triangle of three nodes.
     #[inline]
     pub fn area(&self, p: u32, q: u32, r: u32) -> f64 {

@@ -95,7 +95,7 @@ pub struct TriangulationReport {
     /// Rings left out, with the reason.
     pub dropped: Vec<DroppedRing>,
     /// Rings that crossed themselves, with the number of crossings: each was cut there into
-    /// simple loops (the crossing points added to the positions), filled even-odd.
+    /// simple loops (the crossing points added to the positions), filled by non-zero winding.
     pub crossed: Vec<(usize, usize)>,
     /// Area enclosed by the kept rings: Σ |outer| − Σ |hole|.
     pub polygon_area: f64,
