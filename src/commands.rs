@@ -7,7 +7,7 @@ use std::time::Instant;
 use clap::Args;
 use indra::assets::{AssetKind, Assets};
 use indra::gpu::{Gpu, GpuOptions, validate_wgsl};
-use indra::offscreen::{OffscreenRenderer, write_png};
+use indra::offscreen::{OffscreenRenderer, RenderedFrame, VideoSettings, VideoWriter, write_png};
 use indra::scene::{Scene, load_scene};
 
 /// Prints a line to stdout, ignoring a closed pipe (`indra list | head` must not panic).
@@ -122,6 +122,18 @@ pub struct RenderArgs {
     /// Output folder; frames are written as <scene>_<frame>.png.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
+    /// Write the frames as one video file instead of PNGs (.mp4 and .mkv: H.264; .mov: ProRes
+    /// 422 HQ; .webm: VP9), through ffmpeg, at 1/dt frames per second.
+    #[arg(long, value_name = "FILE")]
+    pub video: Option<PathBuf>,
+    /// Video codec: h264, h265, prores, vp9, av1, ffv1, or an ffmpeg encoder name (default:
+    /// the container's).
+    #[arg(long, requires = "video")]
+    pub codec: Option<String>,
+    /// Video quality: the CRF for h264/h265/vp9/av1 (lower is better; default 18, 20, 30, 30),
+    /// the ProRes profile (0 proxy … 3 HQ, 4 4444).
+    #[arg(long, requires = "video")]
+    pub quality: Option<u32>,
     /// Set a parameter (repeatable): node.param=value — 0.5, true, an option name, a vector as
     /// 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
     #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
@@ -252,7 +264,24 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     };
     scene.check_texture_budget(args.size.unwrap_or(scene.size))?;
     let stem = Path::new(&args.scene).file_stem().map_or("frame".into(), |s| s.to_string_lossy().into_owned());
-    std::fs::create_dir_all(&args.out).map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+    let size = args.size.unwrap_or(scene.size);
+    let fps = 1.0 / f64::from(args.dt.unwrap_or(scene.dt));
+    // ffmpeg starts before the GPU and the seek, so a missing one or a bad codec fails at once.
+    let mut sink = match &args.video {
+        Some(path) => {
+            let settings =
+                VideoSettings { path: path.clone(), size, fps, codec: args.codec.clone(), quality: args.quality };
+            if settings.encoded_size() != size {
+                let (w, h) = settings.encoded_size();
+                eprintln!("the video is {w}x{h}: odd sides are padded by one black pixel (4:2:0 chroma)");
+            }
+            FrameSink::Video(VideoWriter::start(settings).map_err(|e| e.to_string())?)
+        }
+        None => {
+            std::fs::create_dir_all(&args.out).map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+            FrameSink::Png { folder: args.out.clone(), stem }
+        }
+    };
     let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
     eprintln!("rendering '{}' on {}", scene.name, device.adapter_label());
     let mut renderer =
@@ -272,16 +301,42 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     );
     for _ in 0..args.frames {
         let frame = renderer.render_next().map_err(|e| e.to_string())?;
-        let path = args.out.join(format!("{stem}_{:05}.png", frame.time.frame));
-        write_png(&path, frame.size, &frame.rgba)?;
+        sink.write(&frame)?;
         bar.inc(1);
     }
     bar.finish_and_clear();
     for e in renderer.gpu().take_uncaptured_errors() {
         eprintln!("GPU error during the render: {e}");
     }
-    eprintln!("wrote {} frame(s) to {}", args.frames, args.out.display());
+    let place = match sink {
+        FrameSink::Video(video) => {
+            let path = video.settings().path.display().to_string();
+            video.finish().map_err(|e| e.to_string())?;
+            path
+        }
+        FrameSink::Png { folder, .. } => folder.display().to_string(),
+    };
+    eprintln!("wrote {} frame(s) to {place}", args.frames);
     Ok(())
+}
+
+/// Where `render` puts its frames.
+enum FrameSink {
+    /// `<folder>/<stem>_<frame>.png`.
+    Png { folder: PathBuf, stem: String },
+    /// One video file.
+    Video(VideoWriter),
+}
+
+impl FrameSink {
+    fn write(&mut self, frame: &RenderedFrame) -> Result<(), String> {
+        match self {
+            FrameSink::Png { folder, stem } => {
+                write_png(&folder.join(format!("{stem}_{:05}.png", frame.time.frame)), frame.size, &frame.rgba)
+            }
+            FrameSink::Video(video) => video.write(&frame.rgba).map_err(|e| e.to_string()),
+        }
+    }
 }
 
 /// Validates scenes and shaders; prints every located error.

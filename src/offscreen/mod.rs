@@ -1,8 +1,10 @@
-//! The headless runtime: a fixed clock, N frames, PNG output and image comparison against
-//! golden references. Knows nothing of windows or UI.
+//! The headless runtime: a fixed clock, N frames, PNG or video output and image comparison
+//! against golden references. Knows nothing of windows or UI.
 
 mod golden;
 mod renderer;
+pub mod video;
 
 pub use golden::{FlipScore, GoldenCheck, flip_score};
 pub use renderer::{OffscreenRenderer, RenderError, RenderedFrame, write_png};
+pub use video::{VideoError, VideoSettings, VideoWriter};

@@ -1,0 +1,340 @@
+//! Video files through an `ffmpeg` process: raw RGBA frames are streamed into its standard input,
+//! so the video holds exactly the frames the PNG path would write, encoded by a well-kept encoder
+//! instead of one of ours.
+//!
+//! The container follows the file's extension and picks a codec a client can play: H.264 (CRF 18,
+//! yuv420p) in `.mp4` and `.mkv`, ProRes 422 HQ in `.mov`, VP9 in `.webm`. Odd sizes are padded by
+//! one black row or column (4:2:0 chroma needs even sides). Colours are tagged BT.709.
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::thread::JoinHandle;
+
+/// The environment variable that names the `ffmpeg` to run (default: `ffmpeg` on the PATH).
+pub const FFMPEG_ENV: &str = "INDRA_FFMPEG";
+
+/// What to encode and how.
+#[derive(Clone, Debug)]
+pub struct VideoSettings {
+    /// The file to write; its extension picks the container.
+    pub path: PathBuf,
+    /// Frame size in pixels (the RGBA rows given to [`VideoWriter::write`]).
+    pub size: (u32, u32),
+    /// Frames per second (1 / the scene's dt).
+    pub fps: f64,
+    /// Codec: `h264`, `h265`, `prores`, `vp9`, `av1`, `ffv1`, or any ffmpeg encoder name
+    /// (default: the container's, see the module docs).
+    pub codec: Option<String>,
+    /// Quality: the CRF for H.264/H.265/VP9/AV1 (lower is better), the ProRes profile (0 proxy …
+    /// 3 HQ, 4 4444); lossless FFV1 ignores it.
+    pub quality: Option<u32>,
+}
+
+/// Why a video could not be written; each is one sentence for the user.
+#[derive(Debug, thiserror::Error)]
+pub enum VideoError {
+    /// No ffmpeg to run.
+    #[error(
+        "ffmpeg was not found ({0}): install it (`apt-get install ffmpeg`, or tools/setup-system run) or name it in {FFMPEG_ENV}"
+    )]
+    NoFfmpeg(String),
+    /// The extension names no container we know.
+    #[error("{0}: write a video as .mp4, .mov, .webm or .mkv")]
+    Container(String),
+    /// A codec that does not fit the container, or a quality out of range.
+    #[error("{0}")]
+    Settings(String),
+    /// ffmpeg stopped, or ended with an error.
+    #[error("ffmpeg failed writing {path}: {detail}")]
+    Ffmpeg {
+        /// The video file.
+        path: String,
+        /// ffmpeg's own last lines, or how it ended.
+        detail: String,
+    },
+}
+
+/// A running encoder; frames go in with [`VideoWriter::write`], [`VideoWriter::finish`] closes
+/// the file. Dropping it without `finish` kills ffmpeg (the file is then incomplete).
+pub struct VideoWriter {
+    child: Child,
+    stdin: Option<ChildStdin>,
+    /// Collects ffmpeg's standard error, so a failure can say what ffmpeg said.
+    stderr: Option<JoinHandle<String>>,
+    settings: VideoSettings,
+    frames: u64,
+}
+
+/// The codec's ffmpeg arguments: encoder, pixel format and quality.
+fn codec_args(codec: &str, quality: Option<u32>) -> Result<Vec<String>, VideoError> {
+    let crf = |default: u32, max: u32, encoder: &str, pix: &str| -> Result<Vec<String>, VideoError> {
+        let q = quality.unwrap_or(default);
+        if q > max {
+            return Err(VideoError::Settings(format!("--quality {q} is past {max}, the worst CRF of {codec}")));
+        }
+        let mut args = vec!["-c:v".into(), encoder.into(), "-pix_fmt".into(), pix.into(), "-crf".into(), q.to_string()];
+        if encoder == "libvpx-vp9" || encoder == "libaom-av1" {
+            // Constant quality for VP9/AV1 needs the bitrate cap switched off.
+            args.extend(["-b:v".into(), "0".into()]);
+        }
+        Ok(args)
+    };
+    match codec {
+        "h264" | "libx264" => crf(18, 51, "libx264", "yuv420p"),
+        "h265" | "hevc" | "libx265" => crf(20, 51, "libx265", "yuv420p"),
+        "vp9" | "libvpx-vp9" => crf(30, 63, "libvpx-vp9", "yuv420p"),
+        "av1" | "libaom-av1" => crf(30, 63, "libaom-av1", "yuv420p"),
+        "prores" | "prores_ks" => {
+            let profile = quality.unwrap_or(3);
+            if profile > 4 {
+                return Err(VideoError::Settings(format!(
+                    "--quality {profile} is no ProRes profile: 0 proxy, 1 LT, 2 standard, 3 HQ, 4 4444"
+                )));
+            }
+            let pix = if profile == 4 { "yuva444p10le" } else { "yuv422p10le" };
+            Ok(["-c:v", "prores_ks", "-profile:v", &profile.to_string(), "-pix_fmt", pix].map(String::from).to_vec())
+        }
+        "ffv1" => Ok(["-c:v", "ffv1", "-level", "3", "-pix_fmt", "bgr0"].map(String::from).to_vec()),
+        other => {
+            let mut args = vec!["-c:v".into(), other.into(), "-pix_fmt".into(), "yuv420p".into()];
+            if let Some(q) = quality {
+                args.extend(["-q:v".into(), q.to_string()]);
+            }
+            Ok(args)
+        }
+    }
+}
+
+/// The container's default codec, from the file's extension.
+fn default_codec(path: &Path) -> Result<&'static str, VideoError> {
+    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+    match ext.as_str() {
+        "mp4" | "mkv" => Ok("h264"),
+        "mov" => Ok("prores"),
+        "webm" => Ok("vp9"),
+        _ => Err(VideoError::Container(path.display().to_string())),
+    }
+}
+
+/// `fps` as the exact fraction ffmpeg should use: whole rates stay whole, NTSC rates become
+/// n·1000/1001, anything else is kept to a thousandth. A dt of 0.0166667 is 60, not 59.99988.
+pub fn frame_rate(fps: f64) -> String {
+    let whole = fps.round();
+    if (fps - whole).abs() < 1e-3 * fps.max(1.0) && whole >= 1.0 {
+        return format!("{whole}");
+    }
+    let ntsc = (fps * 1.001).round();
+    if (fps - ntsc * 1000.0 / 1001.0).abs() < 1e-4 * fps {
+        return format!("{}/1001", ntsc * 1000.0);
+    }
+    format!("{}/1000", (fps * 1000.0).round().max(1.0))
+}
+
+/// Asks `program` whether it has `encoder` (`ffmpeg -h encoder=NAME` names it when it does).
+fn check_encoder(program: &std::ffi::OsStr, encoder: &str) -> Result<(), VideoError> {
+    let output = Command::new(program)
+        .args(["-hide_banner", "-h", &format!("encoder={encoder}")])
+        .stdin(Stdio::null())
+        .output()
+        .map_err(|e| VideoError::NoFfmpeg(format!("{}: {e}", program.to_string_lossy())))?;
+    let text = String::from_utf8_lossy(&output.stdout);
+    if text.contains(&format!("Encoder {encoder} ")) {
+        Ok(())
+    } else {
+        Err(VideoError::Settings(format!(
+            "this ffmpeg has no encoder '{encoder}' (`ffmpeg -encoders` lists those it has)"
+        )))
+    }
+}
+
+impl VideoSettings {
+    /// The size of the encoded picture: odd sides grow by one (padded black), as 4:2:0 needs.
+    pub fn encoded_size(&self) -> (u32, u32) {
+        (self.size.0.next_multiple_of(2), self.size.1.next_multiple_of(2))
+    }
+
+    /// The full ffmpeg command line after the program name.
+    pub fn ffmpeg_args(&self) -> Result<Vec<String>, VideoError> {
+        let container = default_codec(&self.path)?;
+        let codec = self.codec.as_deref().unwrap_or(container);
+        if !(self.fps.is_finite() && self.fps > 0.0) {
+            return Err(VideoError::Settings(format!("{} frames per second is no frame rate", self.fps)));
+        }
+        let (w, h) = self.size;
+        let mut args: Vec<String> = [
+            "-hide_banner",
+            "-nostdin",
+            "-loglevel",
+            "error",
+            "-y",
+            "-f",
+            "rawvideo",
+            "-pix_fmt",
+            "rgba",
+            "-s",
+            &format!("{w}x{h}"),
+            "-framerate",
+            &frame_rate(self.fps),
+            "-i",
+            "pipe:0",
+        ]
+        .map(String::from)
+        .to_vec();
+        // Pad odd sides (4:2:0 needs even ones) and convert with the BT.709 matrix players assume
+        // for HD, instead of swscale's BT.601 default.
+        args.extend([
+            "-vf".into(),
+            "pad=ceil(iw/2)*2:ceil(ih/2)*2,scale=out_color_matrix=bt709:out_range=tv".into(),
+            "-colorspace".into(),
+            "bt709".into(),
+            "-color_primaries".into(),
+            "bt709".into(),
+            "-color_trc".into(),
+            "bt709".into(),
+        ]);
+        args.extend(codec_args(codec, self.quality)?);
+        if matches!(self.path.extension().and_then(|e| e.to_str()), Some("mp4" | "mov")) {
+            // The index at the front: the file plays while it still downloads.
+            args.extend(["-movflags".into(), "+faststart".into()]);
+        }
+        args.push(self.path.display().to_string());
+        Ok(args)
+    }
+}
+
+impl VideoWriter {
+    /// Starts ffmpeg writing `settings.path` (its folder is created). A missing ffmpeg, or one
+    /// without the encoder, fails here rather than after the frames were rendered.
+    pub fn start(settings: VideoSettings) -> Result<Self, VideoError> {
+        let args = settings.ffmpeg_args()?;
+        let program = std::env::var_os(FFMPEG_ENV).unwrap_or_else(|| "ffmpeg".into());
+        let encoder = args.iter().skip_while(|a| *a != "-c:v").nth(1).cloned().unwrap_or_default();
+        check_encoder(&program, &encoder)?;
+        if let Some(folder) = settings.path.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(folder).map_err(|e| VideoError::Ffmpeg {
+                path: settings.path.display().to_string(),
+                detail: format!("cannot create {}: {e}", folder.display()),
+            })?;
+        }
+        let mut child = Command::new(&program)
+            .args(&args)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .map_err(|e| VideoError::NoFfmpeg(format!("{}: {e}", program.to_string_lossy())))?;
+        let stdin = child.stdin.take();
+        let stderr = child.stderr.take().map(|mut pipe| {
+            std::thread::spawn(move || {
+                let mut text = String::new();
+                let _ = pipe.read_to_string(&mut text);
+                text
+            })
+        });
+        Ok(Self { child, stdin, stderr, settings, frames: 0 })
+    }
+
+    /// Frames written so far.
+    pub fn frames(&self) -> u64 {
+        self.frames
+    }
+
+    /// The settings it was started with.
+    pub fn settings(&self) -> &VideoSettings {
+        &self.settings
+    }
+
+    /// Appends one frame: `rgba` is width × height × 4 bytes, top row first.
+    pub fn write(&mut self, rgba: &[u8]) -> Result<(), VideoError> {
+        let (w, h) = self.settings.size;
+        let expected = w as usize * h as usize * 4;
+        if rgba.len() != expected {
+            return Err(VideoError::Settings(format!(
+                "a frame of {} bytes does not fit the video's {w}x{h} ({expected} bytes)",
+                rgba.len()
+            )));
+        }
+        let Some(stdin) = self.stdin.as_mut() else {
+            return Err(self.failure("the encoder was already closed".into()));
+        };
+        if let Err(e) = stdin.write_all(rgba) {
+            // ffmpeg quit (bad codec, full disk): its own words say why better than a broken pipe.
+            self.stdin = None;
+            let _ = self.child.wait();
+            return Err(self.failure(format!("it stopped taking frames ({e})")));
+        }
+        self.frames += 1;
+        Ok(())
+    }
+
+    /// Closes the input and waits for ffmpeg to finish the file; returns the frames written.
+    pub fn finish(mut self) -> Result<u64, VideoError> {
+        drop(self.stdin.take());
+        let status = self.child.wait().map_err(|e| self.failure(format!("cannot wait for it: {e}")))?;
+        if !status.success() {
+            return Err(self.failure(format!("it ended with {status}")));
+        }
+        Ok(self.frames)
+    }
+
+    /// An error carrying ffmpeg's last words (or `fallback` when it said nothing).
+    fn failure(&mut self, fallback: String) -> VideoError {
+        let said = self.stderr.take().and_then(|t| t.join().ok()).unwrap_or_default();
+        let lines: Vec<&str> = said.lines().filter(|l| !l.trim().is_empty()).collect();
+        let tail = lines[lines.len().saturating_sub(3)..].join(" / ");
+        let detail = if tail.is_empty() { fallback } else { format!("{fallback}: {tail}") };
+        VideoError::Ffmpeg { path: self.settings.path.display().to_string(), detail }
+    }
+}
+
+impl Drop for VideoWriter {
+    fn drop(&mut self) {
+        if self.stdin.is_some() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn settings(path: &str) -> VideoSettings {
+        VideoSettings { path: path.into(), size: (64, 48), fps: 60.0, codec: None, quality: None }
+    }
+
+    #[test]
+    fn frame_rates_are_exact_fractions() {
+        assert_eq!(frame_rate(1.0 / 0.0166667), "60");
+        assert_eq!(frame_rate(30.0), "30");
+        assert_eq!(frame_rate(30000.0 / 1001.0), "30000/1001");
+        assert_eq!(frame_rate(24000.0 / 1001.0), "24000/1001");
+        assert_eq!(frame_rate(12.5), "12500/1000");
+    }
+
+    #[test]
+    fn containers_pick_their_codec_and_unknown_ones_are_refused() {
+        let args = |p: &str| settings(p).ffmpeg_args().map(|a| a.join(" "));
+        assert!(args("a.mp4").unwrap().contains("-c:v libx264 -pix_fmt yuv420p -crf 18"));
+        assert!(args("a.mkv").unwrap().contains("libx264"));
+        assert!(args("a.mov").unwrap().contains("-c:v prores_ks -profile:v 3"));
+        assert!(args("a.webm").unwrap().contains("libvpx-vp9"));
+        assert!(args("A.MP4").unwrap().ends_with("A.MP4"));
+        let e = args("a.gif").unwrap_err().to_string();
+        assert!(e.contains(".mp4, .mov, .webm or .mkv"), "{e}");
+    }
+
+    #[test]
+    fn quality_out_of_range_is_one_sentence() {
+        let mut s = settings("a.mp4");
+        s.quality = Some(60);
+        assert!(s.ffmpeg_args().unwrap_err().to_string().contains("past 51"));
+        let mut s = settings("a.mov");
+        s.quality = Some(7);
+        assert!(s.ffmpeg_args().unwrap_err().to_string().contains("no ProRes profile"));
+        s.fps = f64::NAN;
+        assert!(s.ffmpeg_args().is_err());
+    }
+}

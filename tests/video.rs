@@ -1,0 +1,165 @@
+//! `indra render --video` end to end: ffmpeg writes the frames the PNG path writes, at the
+//! scene's frame rate, and a missing ffmpeg is one sentence. Needs `ffmpeg` and `ffprobe`
+//! (tools/setup-system installs them).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn indra(args: &[&str]) -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_indra"));
+    command.args(args).args(["--backend", "vulkan"]).env("INDRA_ROOT", env!("CARGO_MANIFEST_DIR"));
+    command
+}
+
+fn text(o: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("indra-video-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs an ffmpeg tool; its absence is a set-up error worth saying plainly.
+fn tool(name: &str, args: &[&str]) -> Output {
+    let o = Command::new(name)
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("{name} is needed for this test ({e}): run tools/setup-system test"));
+    assert!(o.status.success(), "{name} {args:?}: {}", text(&o));
+    o
+}
+
+/// `ffprobe`'s stream fields as `key=value` pairs.
+fn probe(path: &Path) -> std::collections::HashMap<String, String> {
+    let o = tool(
+        "ffprobe",
+        &[
+            "-v",
+            "error",
+            "-count_frames",
+            "-select_streams",
+            "v:0",
+            "-show_entries",
+            "stream=nb_read_frames,width,height,r_frame_rate,codec_name",
+            "-of",
+            "default=nw=1",
+            path.to_str().unwrap(),
+        ],
+    );
+    String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .filter_map(|l| l.split_once('=').map(|(k, v)| (k.to_string(), v.to_string())))
+        .collect()
+}
+
+/// The first frame of a video as RGBA bytes, converted back with the BT.709 matrix it was
+/// written with.
+fn first_frame(path: &Path) -> Vec<u8> {
+    tool(
+        "ffmpeg",
+        &[
+            "-v",
+            "error",
+            "-i",
+            path.to_str().unwrap(),
+            "-frames:v",
+            "1",
+            "-vf",
+            "scale=in_color_matrix=bt709:in_range=tv",
+            "-f",
+            "rawvideo",
+            "-pix_fmt",
+            "rgba",
+            "-",
+        ],
+    )
+    .stdout
+}
+
+/// Mean absolute difference per colour channel (alpha left out), in 8-bit levels.
+fn mean_difference(a: &[u8], b: &[u8]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let pairs = a.chunks(4).zip(b.chunks(4)).flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c])));
+    pairs.map(f64::from).sum::<f64>() / (a.len() / 4 * 3) as f64
+}
+
+/// Renders `scene` from frame 5 as a video of `frames` frames and as PNGs of frames 5 and 6.
+fn video_and_pngs(dir: &Path, scene: &str, frames: &str) -> (PathBuf, Vec<u8>, Vec<u8>) {
+    let video = dir.join(format!("clip/{scene}.mp4"));
+    let base = ["render", scene, "--size", "96x64", "--start", "5"];
+    let o = indra(&base).args(["--frames", frames, "--video", video.to_str().unwrap()]).output().unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+    let o = indra(&base).args(["--frames", "2", "--out", dir.to_str().unwrap()]).output().unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+    let png = |n: u32| image::open(dir.join(format!("{scene}_0000{n}.png"))).unwrap().to_rgba8().into_raw();
+    (video, png(5), png(6))
+}
+
+#[test]
+fn a_video_holds_every_frame_at_the_scene_rate_in_bt709() {
+    let dir = temp_dir("mp4");
+    let (video, png, _) = video_and_pngs(&dir, "cloth", "30");
+    let info = probe(&video);
+    assert_eq!(info["codec_name"], "h264");
+    assert_eq!((info["width"].as_str(), info["height"].as_str()), ("96", "64"));
+    assert_eq!(info["nb_read_frames"], "30");
+    assert_eq!(info["r_frame_rate"], "50/1", "the cloth scene steps 0.02 s: 50 fps");
+    // H.264 at CRF 18 with 4:2:0 chroma: close, not equal (1.8 levels here). Written with the
+    // BT.601 matrix it would be 3.3 levels off when read as tagged.
+    let mean = mean_difference(&png, &first_frame(&video));
+    assert!(mean < 2.5, "mean difference {mean:.2} levels between the PNG and the video's first frame");
+}
+
+#[test]
+fn a_video_starts_at_the_frame_the_png_path_starts_at() {
+    // StarGlow's streaks turn fast: neighbouring frames differ by ~20 levels, the codec by ~4.
+    let dir = temp_dir("frame");
+    let (video, frame5, frame6) = video_and_pngs(&dir, "star_glow", "2");
+    let first = first_frame(&video);
+    let (same, next) = (mean_difference(&frame5, &first), mean_difference(&frame6, &first));
+    assert!(same < next / 3.0, "the video's first frame is {same:.2} from frame 5 and {next:.2} from frame 6");
+}
+
+#[test]
+fn odd_sizes_and_every_container_encode() {
+    let dir = temp_dir("containers");
+    for (file, codec) in [("a.mov", "prores"), ("a.webm", "vp9"), ("a.mkv", "h264")] {
+        let path = dir.join(file);
+        let o = indra(&["render", "star_glow", "--size", "33x17", "--frames", "3", "--video", path.to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{file}: {}", text(&o));
+        assert!(text(&o).contains("34x18"), "the padding is said: {}", text(&o));
+        let info = probe(&path);
+        assert_eq!(info["codec_name"], codec, "{file}");
+        assert_eq!(info["nb_read_frames"], "3", "{file}");
+        assert_eq!((info["width"].as_str(), info["height"].as_str()), ("34", "18"), "{file}");
+    }
+}
+
+#[test]
+fn a_missing_ffmpeg_or_encoder_is_one_sentence_before_any_frame() {
+    let dir = temp_dir("missing");
+    let video = dir.join("a.mp4");
+    let o = indra(&["render", "kleinian", "--video", video.to_str().unwrap()])
+        .env("PATH", dir.to_str().unwrap())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("ffmpeg was not found") && text(&o).contains("apt-get install ffmpeg"), "{}", text(&o));
+    assert!(!text(&o).contains("rendering"), "it fails before the GPU starts: {}", text(&o));
+
+    for (args, said) in
+        [(vec!["--codec", "no-such-encoder"], "no encoder 'no-such-encoder'"), (vec!["--quality", "99"], "past 51")]
+    {
+        let o = indra(&["render", "kleinian", "--video", video.to_str().unwrap()]).args(&args).output().unwrap();
+        assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+        assert!(text(&o).contains(said), "{}", text(&o));
+    }
+    let o = indra(&["render", "kleinian", "--video", dir.join("a.gif").to_str().unwrap()]).output().unwrap();
+    assert!(text(&o).contains(".mp4, .mov, .webm or .mkv"), "{}", text(&o));
+    assert!(!video.exists(), "no file is left behind by a refused render");
+}
