@@ -1,4 +1,5 @@
-//! CPU geometry algorithms of the book (chapters 1, 5 and 7). No wgpu, scenes or UI in here.
+//! CPU geometry algorithms of the book (chapters 1, 5 and 7) and of projection mapping. No wgpu,
+//! scenes or UI in here.
 
 pub mod outline;
 pub mod poisson;
@@ -6,5 +7,6 @@ mod rng;
 pub mod skinned;
 pub mod triangulate;
 pub mod volume;
+pub mod warp;
 
 pub use rng::SplitMix64;

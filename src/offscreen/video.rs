@@ -121,7 +121,7 @@ fn default_codec(path: &Path) -> Result<&'static str, VideoError> {
 /// n·1000/1001, anything else is kept to a thousandth. A dt of 0.0166667 is 60, not 59.99988.
 pub fn frame_rate(fps: f64) -> String {
     let whole = fps.round();
-    if (fps - whole).abs() < 1e-3 * fps.max(1.0) && whole >= 1.0 {
+    if (fps - whole).abs() < 1e-5 * fps && whole >= 1.0 {
         return format!("{whole}");
     }
     let ntsc = (fps * 1.001).round();

@@ -84,6 +84,11 @@ impl ParamSet {
         self.values.clone_from(&self.targets);
     }
 
+    /// Jumps parameter `i` to its target (a value loaded from a file: no glide).
+    pub fn snap_at(&mut self, i: usize) {
+        self.values[i] = self.targets[i];
+    }
+
     /// Clears triggers that fired: called after the fixed step that saw them, so a trigger fires
     /// for exactly one step whatever the number of steps a displayed frame runs.
     pub fn end_step(&mut self) {

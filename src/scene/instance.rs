@@ -147,8 +147,14 @@ impl SceneInstance {
         for params in &mut self.params {
             params.advance(time.dt);
         }
-        for (node, params) in self.nodes.iter_mut().zip(&self.params) {
+        for (node, params) in self.nodes.iter_mut().zip(&mut self.params) {
             node.step(params, time);
+            for (name, value) in node.take_loaded_values() {
+                if let Some(i) = params.index(name) {
+                    params.set_at(i, value);
+                    params.snap_at(i);
+                }
+            }
         }
         // A trigger fires for exactly one fixed step, however many steps a frame runs.
         for params in &mut self.params {

@@ -17,11 +17,12 @@ pub mod space_colonization;
 pub mod star_glow;
 pub mod tessellation;
 pub mod text_mesh;
+pub mod warp;
 
 use crate::assets::{AssetKind, Assets};
 use crate::gpu::{Gpu, ShaderError};
 use crate::graph::{FrameGraph, TextureHandle};
-use crate::params::{ParamDecl, ParamSet};
+use crate::params::{ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 
 /// Every technique indra knows, by scene name.
@@ -37,6 +38,7 @@ pub const REGISTRY: &[TechniqueInfo] = &[
     tessellation::INFO,
     height_image::INFO,
     space_colonization::INFO,
+    warp::INFO,
 ];
 
 /// Finds a technique by the name scenes use.
@@ -128,6 +130,13 @@ pub trait Technique {
     /// Figures for `indra bench` to print after measuring (e.g. triangles generated). May read
     /// back from the GPU: never called in the frame loop.
     fn bench_report(&mut self) -> Vec<String> {
+        Vec::new()
+    }
+
+    /// Parameter values the node read from a file since the last call (a warp file's corners):
+    /// the scene sets them after the step, as a preset recall would, so the panel, OSC feedback
+    /// and saves see them.
+    fn take_loaded_values(&mut self) -> Vec<(&'static str, ParamValue)> {
         Vec::new()
     }
 

@@ -1,0 +1,494 @@
+//! Projection mapping as a node: the corner pin, the mesh warp and soft edge blending of one
+//! output (see [`crate::geometry::warp`]), applied to any texture in the frame graph. Any scene
+//! can end in it, so `render` produces warped frames off-screen and goldens test them.
+//!
+//! The corners and blend settings are live parameters (panel, OSC, MIDI, presets, recordings).
+//! The `file` parameter names a warp file (RON): loading it — at start, when the path changes, or
+//! on `reload` — sets those parameters from the file and takes its mesh; `save` writes the live
+//! values and the mesh back. A file that cannot be read or parsed is one message, and the last
+//! good warp stays on the wall.
+
+use std::cell::RefCell;
+use std::path::PathBuf;
+
+use crate::geometry::warp::{Corners, EdgeBlend, Homography, MeshWarp, WarpFile};
+use crate::gpu::{BindGroupCache, GrowableBuffer, RasterDesc, ShaderError, uniform_buffer, uniform_entry};
+use crate::graph::{FrameGraph, PassContext, RasterTargets, TextureHandle};
+use crate::params::{ParamDecl, ParamSet, ParamValue};
+use crate::time::FrameTime;
+
+use super::{NodeSetup, Technique, TechniqueInfo};
+
+/// The registry entry.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "warp",
+    chapter: "stage output: projection mapping",
+    summary: "corner pin, mesh warp and soft edge blend of any texture, for projectors",
+    params,
+    inputs: &["source"],
+    shaders: &["warp.wgsl"],
+    create,
+};
+
+/// Output format: linear HDR like every node.
+pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The example warp `projection_mapping.ron` uses, by the path the scene gives.
+const BUNDLED: (&str, &str) = ("warps/wall-left.ron", include_str!("../../../warps/wall-left.ron"));
+
+/// Triangle rows and columns per mesh cell (a smooth mesh is curved inside a cell).
+const SUBDIVISIONS: u32 = 16;
+
+/// The corner parameters, in the order of the OSC aliases `/indra/output/<n>/corner/<i>`:
+/// clockwise from the top left.
+pub const CORNERS: [&str; 4] = ["corner_tl", "corner_tr", "corner_br", "corner_bl"];
+
+/// Parameters.
+pub fn params() -> Vec<ParamDecl> {
+    use ParamValue::*;
+    let corner = |name: &str, at: [f32; 2], doc: &str| ParamDecl::new(name, Vec2(at), Some((-1.0, 2.0)), doc);
+    let width = |name: &str, doc: &str| ParamDecl::new(name, Float(0.0), Some((0.0, 0.5)), doc);
+    vec![
+        corner(CORNERS[0], [0.0, 1.0], "where the image's top-left corner lands (view units, y up)"),
+        corner(CORNERS[1], [1.0, 1.0], "where the top-right corner lands"),
+        corner(CORNERS[2], [1.0, 0.0], "where the bottom-right corner lands"),
+        corner(CORNERS[3], [0.0, 0.0], "where the bottom-left corner lands"),
+        width("blend_left", "soft edge on the left, as a share of the image"),
+        width("blend_right", "soft edge on the right"),
+        width("blend_top", "soft edge at the top"),
+        width("blend_bottom", "soft edge at the bottom"),
+        ParamDecl::new("blend_curve", Float(2.0), Some((0.25, 8.0)), "blend ramp exponent: 1 linear, 2 S-curve"),
+        ParamDecl::new(
+            "blend_gamma",
+            Float(1.0),
+            Some((0.2, 4.0)),
+            "exponent on the blend weight (1: exact in linear light)",
+        ),
+        ParamDecl::new(
+            "black_lift",
+            Float(0.0),
+            Some((0.0, 0.25)),
+            "black raised outside the blend zones to match the overlap",
+        ),
+        ParamDecl::new("grid", Bool(false), None, "draw the mesh and its control points (for lining up)"),
+        ParamDecl::text("file", "", "warp file (RON) to load corners, blend and mesh from; empty: none"),
+        ParamDecl::trigger("reload", "read the warp file again"),
+        ParamDecl::trigger("save", "write the live corners, blend and mesh to the warp file"),
+    ]
+}
+
+/// The shader's uniform block.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct WarpUniforms {
+    /// Unit square → view units, as three padded columns.
+    pub homography: [[f32; 4]; 3],
+    /// Blend widths: left, right, top, bottom.
+    pub blend: [f32; 4],
+    /// Ramp exponent, gamma, black lift, grid on (1) or off (0).
+    pub shape: [f32; 4],
+    /// Mesh cells across and up.
+    pub grid: [f32; 4],
+}
+
+/// A mesh vertex: source coordinates and where the mesh warp moved them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+struct Vertex {
+    uv: [f32; 2],
+    warped: [f32; 2],
+}
+
+/// A warp node.
+pub struct Warp {
+    pipeline: wgpu::RenderPipeline,
+    uniform_buffer: wgpu::Buffer,
+    uniform_group: wgpu::BindGroup,
+    source_layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    source_groups: RefCell<BindGroupCache<u64>>,
+    samples: u32,
+    vertices: GrowableBuffer,
+    indices: GrowableBuffer,
+    index_count: u32,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    root: Option<PathBuf>,
+    /// The mesh in use (a regular 2×2 grid without one).
+    mesh: MeshWarp,
+    /// View units → unit square (the inverse corner pin of the last frame), for the pointer.
+    unpin: Option<Homography>,
+    /// The file path last loaded (or tried), so a bad path is reported once.
+    requested: Option<String>,
+    /// Values read from the file, for the scene to set (see [`Technique::take_loaded_values`]).
+    loaded: Vec<(&'static str, ParamValue)>,
+    messages: Vec<String>,
+}
+
+fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
+    Ok(Box::new(Warp::new(setup)?))
+}
+
+impl Warp {
+    /// Builds the pipeline from `warp.wgsl`.
+    pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
+        let device = &setup.gpu.device;
+        let (origin, source) = setup.shader_source("warp.wgsl", &[("u", 0)])?;
+        let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let uniform_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("warp_uniforms"),
+            entries: &[uniform_entry::<WarpUniforms>(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
+        });
+        let source_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("warp_source"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: fragment,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: fragment,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("warp"),
+            bind_group_layouts: &[Some(&uniform_layout), Some(&source_layout)],
+            immediate_size: 0,
+        });
+        let samples = setup.samples_for(&[FORMAT]);
+        let pipeline = crate::gpu::validated(device, &origin, || {
+            crate::gpu::raster_pipeline(
+                device,
+                &module,
+                &layout,
+                &RasterDesc {
+                    vertex: "vs_main",
+                    fragment: "fs_main",
+                    buffers: &[Some(wgpu::VertexBufferLayout {
+                        array_stride: size_of::<Vertex>() as u64,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &wgpu::vertex_attr_array![0 => Float32x2, 1 => Float32x2],
+                    })],
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    color: FORMAT,
+                    depth: None,
+                    additive: false,
+                    samples,
+                },
+            )
+        })?;
+        let uniform_buffer = uniform_buffer::<WarpUniforms>(device, "warp_uniforms");
+        let uniform_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("warp_uniforms"),
+            layout: &uniform_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniform_buffer.as_entire_binding() }],
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("warp_sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        use wgpu::BufferUsages as U;
+        let mut warp = Self {
+            pipeline,
+            uniform_buffer,
+            uniform_group,
+            source_layout,
+            sampler,
+            source_groups: RefCell::new(BindGroupCache::default()),
+            samples,
+            vertices: GrowableBuffer::new(device, "warp_vertices", U::VERTEX, 1024),
+            indices: GrowableBuffer::new(device, "warp_indices", U::INDEX, 1024),
+            index_count: 0,
+            device: device.clone(),
+            queue: setup.gpu.queue.clone(),
+            root: setup.assets.root().map(std::path::Path::to_path_buf),
+            mesh: MeshWarp::regular(2, 2),
+            unpin: None,
+            requested: None,
+            loaded: Vec::new(),
+            messages: Vec::new(),
+        };
+        warp.upload_mesh();
+        Ok(warp)
+    }
+
+    /// The mesh in use.
+    pub fn mesh(&self) -> &MeshWarp {
+        &self.mesh
+    }
+
+    /// Where a relative warp path lives: beside `scenes/` (the asset root) if that folder holds
+    /// it, else the current folder.
+    fn resolve(&self, path: &str) -> PathBuf {
+        let beside_scenes = self.root.as_ref().map(|r| r.join(path)).filter(|p| p.is_file());
+        beside_scenes.unwrap_or_else(|| PathBuf::from(path))
+    }
+
+    /// Reads the warp file; on success its values go to the parameters and its mesh is used.
+    /// The bundled example is built in, so its scene maps the same from any folder.
+    fn load(&mut self, path: &str) {
+        let file = self.resolve(path);
+        let text = match std::fs::read_to_string(&file) {
+            Err(_) if !file.exists() && BUNDLED.0 == path => Ok(BUNDLED.1.to_string()),
+            other => other.map_err(|e| format!("cannot read warp file {}: {e}", file.display())),
+        };
+        let read = text.and_then(|text| WarpFile::parse(&file.display().to_string(), &text));
+        match read {
+            Ok(warp) => {
+                self.mesh = warp.mesh.clone().unwrap_or_else(|| MeshWarp::regular(2, 2));
+                self.upload_mesh();
+                self.loaded = loaded_values(&warp);
+            }
+            Err(e) => self.messages.push(format!("{e}; keeping the last good warp")),
+        }
+    }
+
+    /// Writes the live values and the mesh to the warp file (atomically).
+    fn save(&mut self, path: &str, params: &ParamSet) {
+        if path.is_empty() {
+            self.messages.push("warp not saved: set the node's file parameter first".into());
+            return;
+        }
+        let warp = warp_from(params, Some(self.mesh.clone()));
+        let file = self.resolve(path);
+        match crate::atomic_file::write(&file, warp.to_ron().as_bytes()) {
+            Ok(()) => self.messages.push(format!("warp saved to {}", file.display())),
+            Err(e) => self.messages.push(format!("cannot save the warp to {}: {e}", file.display())),
+        }
+    }
+
+    /// Tessellates the mesh into the vertex and index buffers.
+    fn upload_mesh(&mut self) {
+        let (cols, rows) = ((self.mesh.columns - 1) * SUBDIVISIONS + 1, (self.mesh.rows - 1) * SUBDIVISIONS + 1);
+        let mut vertices = Vec::with_capacity((cols * rows) as usize);
+        for j in 0..rows {
+            for i in 0..cols {
+                let uv = [i as f32 / (cols - 1) as f32, j as f32 / (rows - 1) as f32];
+                vertices.push(Vertex { uv, warped: self.mesh.evaluate(uv[0], uv[1]) });
+            }
+        }
+        let mut indices = Vec::with_capacity(((cols - 1) * (rows - 1) * 6) as usize);
+        for j in 0..rows - 1 {
+            for i in 0..cols - 1 {
+                let a = j * cols + i;
+                indices.extend([a, a + 1, a + cols + 1, a, a + cols + 1, a + cols]);
+            }
+        }
+        self.vertices.write_all(&self.device, &self.queue, &vertices);
+        self.index_count = self.indices.write_all(&self.device, &self.queue, &indices);
+    }
+
+    fn source_group(&self, view: &wgpu::TextureView) -> wgpu::BindGroup {
+        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("warp_source"),
+            layout: &self.source_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(view) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+            ],
+        })
+    }
+
+    fn record(
+        &self,
+        ctx: &mut PassContext<'_>,
+        source: TextureHandle,
+        targets: &RasterTargets,
+        uniforms: &WarpUniforms,
+    ) {
+        ctx.queue.write_buffer(&self.uniform_buffer, 0, bytemuck::bytes_of(uniforms));
+        let group = self
+            .source_groups
+            .borrow_mut()
+            .get_or_create(ctx.texture_id(source), || self.source_group(ctx.view(source)))
+            .clone();
+        let mut pass = ctx.begin_draw(targets, wgpu::Color::BLACK);
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.uniform_group, &[]);
+        pass.set_bind_group(1, &group, &[]);
+        pass.set_vertex_buffer(0, self.vertices.buffer().slice(..));
+        pass.set_index_buffer(self.indices.buffer().slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..self.index_count, 0, 0..1);
+    }
+}
+
+/// The source point the mesh sends to `target` (Newton's method from the target itself, with a
+/// finite-difference Jacobian); None when it does not converge.
+fn invert_mesh(mesh: &MeshWarp, target: [f32; 2]) -> Option<[f32; 2]> {
+    let mut uv = target;
+    for _ in 0..20 {
+        let p = mesh.evaluate(uv[0], uv[1]);
+        let r = [p[0] - target[0], p[1] - target[1]];
+        if r[0].abs() < 1e-6 && r[1].abs() < 1e-6 {
+            return Some(uv);
+        }
+        let h = 1e-3;
+        let du = mesh.evaluate(uv[0] + h, uv[1]);
+        let dv = mesh.evaluate(uv[0], uv[1] + h);
+        let j = [[(du[0] - p[0]) / h, (dv[0] - p[0]) / h], [(du[1] - p[1]) / h, (dv[1] - p[1]) / h]];
+        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+        if det.abs() < 1e-9 {
+            return None;
+        }
+        uv[0] -= (j[1][1] * r[0] - j[0][1] * r[1]) / det;
+        uv[1] -= (-j[1][0] * r[0] + j[0][0] * r[1]) / det;
+    }
+    let p = mesh.evaluate(uv[0], uv[1]);
+    ((p[0] - target[0]).abs() < 1e-4 && (p[1] - target[1]).abs() < 1e-4).then_some(uv)
+}
+
+/// The parameter values a warp file sets.
+fn loaded_values(warp: &WarpFile) -> Vec<(&'static str, ParamValue)> {
+    let c = &warp.corners;
+    let b = &warp.blend;
+    let mut values: Vec<(&'static str, ParamValue)> = CORNERS
+        .iter()
+        .zip([c.top_left, c.top_right, c.bottom_right, c.bottom_left])
+        .map(|(n, p)| (*n, ParamValue::Vec2(p)))
+        .collect();
+    values.extend([
+        ("blend_left", ParamValue::Float(b.left)),
+        ("blend_right", ParamValue::Float(b.right)),
+        ("blend_top", ParamValue::Float(b.top)),
+        ("blend_bottom", ParamValue::Float(b.bottom)),
+        ("blend_curve", ParamValue::Float(b.curve)),
+        ("blend_gamma", ParamValue::Float(b.gamma)),
+        ("black_lift", ParamValue::Float(warp.black_lift)),
+    ]);
+    values
+}
+
+/// The warp the parameters describe, with `mesh`.
+pub fn warp_from(params: &ParamSet, mesh: Option<MeshWarp>) -> WarpFile {
+    let corner = |i: usize| params.vec2(CORNERS[i]);
+    WarpFile {
+        corners: Corners { top_left: corner(0), top_right: corner(1), bottom_right: corner(2), bottom_left: corner(3) },
+        blend: EdgeBlend {
+            left: params.float("blend_left"),
+            right: params.float("blend_right"),
+            top: params.float("blend_top"),
+            bottom: params.float("blend_bottom"),
+            curve: params.float("blend_curve"),
+            gamma: params.float("blend_gamma"),
+        },
+        black_lift: params.float("black_lift"),
+        mesh: mesh.filter(|m| *m != MeshWarp::regular(2, 2)),
+    }
+}
+
+/// The uniforms for `params` with `mesh`.
+pub fn uniforms(params: &ParamSet, mesh: &MeshWarp) -> WarpUniforms {
+    let warp = warp_from(params, None);
+    let b = warp.blend;
+    WarpUniforms {
+        homography: warp.corners.homography().to_wgsl_columns(),
+        blend: [b.left, b.right, b.top, b.bottom],
+        shape: [b.curve, b.gamma, warp.black_lift, if params.bool("grid") { 1.0 } else { 0.0 }],
+        grid: [(mesh.columns - 1) as f32, (mesh.rows - 1) as f32, 0.0, 0.0],
+    }
+}
+
+impl Technique for Warp {
+    fn step(&mut self, params: &ParamSet, _time: &FrameTime) {
+        let ParamValue::Text(path) = params.get("file") else { return };
+        let path = path.as_str().trim().to_string();
+        let changed = self.requested.as_deref() != Some(path.as_str());
+        if (changed || params.fired("reload")) && !path.is_empty() {
+            self.load(&path);
+        }
+        if changed && path.is_empty() && self.requested.is_some() {
+            self.mesh = MeshWarp::regular(2, 2);
+            self.upload_mesh();
+        }
+        self.requested = Some(path.clone());
+        if params.fired("save") {
+            self.save(&path, params);
+        }
+    }
+
+    fn take_loaded_values(&mut self) -> Vec<(&'static str, ParamValue)> {
+        std::mem::take(&mut self.loaded)
+    }
+
+    fn take_messages(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.messages)
+    }
+
+    fn map_pointer(&self, view: [f32; 2]) -> Option<[f32; 2]> {
+        // A pointer on the wall lands on the source point shown there (a fluid is stirred under
+        // it): undo the corner pin exactly, then the mesh by Newton steps.
+        let pinned = self.unpin?.apply([f64::from(view[0]), f64::from(view[1])])?;
+        let target = [pinned[0] as f32, pinned[1] as f32];
+        let uv = invert_mesh(&self.mesh, target)?;
+        uv.iter().all(|c| (0.0..=1.0).contains(c)).then_some(uv)
+    }
+
+    fn add_passes<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        params: &ParamSet,
+        _time: &FrameTime,
+        inputs: &[TextureHandle],
+    ) -> TextureHandle {
+        self.source_groups.get_mut().begin_frame();
+        let targets = graph.create_raster_targets("warp", FORMAT, None, self.samples);
+        let Some(&source) = inputs.first() else { return targets.color };
+        let uniforms = uniforms(params, &self.mesh);
+        self.unpin = warp_from(params, None).corners.homography().inverse();
+        let this = &*self;
+        graph.add_pass("warp/draw").read(source).draws_into(&targets).record(move |ctx| {
+            this.record(ctx, source, &targets, &uniforms);
+        });
+        targets.color
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uniform_layout_matches_the_wgsl_struct() {
+        let source = include_str!("../../../shaders/warp.wgsl");
+        assert_eq!(crate::gpu::wgsl_struct_size(source, "WarpUniforms"), Some(size_of::<WarpUniforms>() as u32));
+    }
+
+    #[test]
+    fn a_warp_file_round_trips_through_the_parameters() {
+        let mut params = ParamSet::new(super::params());
+        let warp = WarpFile {
+            corners: Corners { top_left: [0.1, 0.95], bottom_right: [0.9, 0.02], ..Default::default() },
+            blend: EdgeBlend { right: 0.2, curve: 3.0, gamma: 1.2, ..Default::default() },
+            black_lift: 0.03,
+            mesh: None,
+        };
+        for (name, value) in loaded_values(&warp) {
+            assert!(params.set_at(params.index(name).unwrap(), value), "{name}");
+        }
+        params.snap();
+        assert_eq!(warp_from(&params, None), warp);
+    }
+
+    #[test]
+    fn the_pointer_finds_the_source_point_through_pin_and_mesh() {
+        let mut mesh = MeshWarp::regular(3, 3);
+        mesh.points[4] = [0.56, 0.45];
+        for uv in [[0.5f32, 0.5], [0.2, 0.7], [0.9, 0.1]] {
+            let found = invert_mesh(&mesh, mesh.evaluate(uv[0], uv[1])).unwrap();
+            assert!((found[0] - uv[0]).abs() < 1e-4 && (found[1] - uv[1]).abs() < 1e-4, "{uv:?} → {found:?}");
+        }
+    }
+}
