@@ -71,6 +71,10 @@ pub struct RunArgs {
     /// Do not watch shaders/ and scenes/ for edits.
     #[arg(long)]
     pub no_watch: bool,
+    /// Record the output as shown to this video from the start (.mp4, .mov, .webm, .mkv);
+    /// later takes (panel button, OSC /indra/record/start) go beside it. Never overwrites.
+    #[arg(long, value_name = "FILE")]
+    pub record_video: Option<PathBuf>,
 }
 
 /// Where OSC listens unless told otherwise: loopback, so nothing on the network can reach it.
@@ -95,6 +99,7 @@ impl Default for RunArgs {
             presets: "presets".into(),
             midi_learn: "midi-learn.ron".into(),
             no_watch: false,
+            record_video: None,
         }
     }
 }
@@ -239,8 +244,12 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
             Err(_) => return Err(e),
         },
     };
-    let options =
-        indra::app::WindowOptions { fullscreen: args.fullscreen, monitor: args.monitor, watch: !args.no_watch };
+    let options = indra::app::WindowOptions {
+        fullscreen: args.fullscreen,
+        monitor: args.monitor,
+        watch: !args.no_watch,
+        record_video: args.record_video.clone(),
+    };
     let control = indra::control::ControlOptions {
         osc: (!args.no_osc).then(|| args.osc.clone()),
         osc_out: args.osc_out.clone(),

@@ -163,3 +163,118 @@ fn a_missing_ffmpeg_or_encoder_is_one_sentence_before_any_frame() {
     assert!(text(&o).contains(".mp4, .mov, .webm or .mkv"), "{}", text(&o));
     assert!(!video.exists(), "no file is left behind by a refused render");
 }
+
+/// A float texture of one colour, as a node's output would be.
+fn solid(gpu: &indra::gpu::Gpu, size: (u32, u32), level: f32) -> wgpu::Texture {
+    let texture = indra::graph::PersistentTexture::new(&gpu.device, "source", size, wgpu::TextureFormat::Rgba16Float);
+    let texel: Vec<u8> =
+        [level, level, level, 1.0].iter().flat_map(|&x| half::f16::from_f32(x).to_le_bytes()).collect();
+    let bytes = texel.repeat((size.0 * size.1) as usize);
+    gpu.queue.write_texture(
+        texture.texture.as_image_copy(),
+        &bytes,
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(size.0 * 8), rows_per_image: Some(size.1) },
+        texture.texture.size(),
+    );
+    texture.texture
+}
+
+fn live_settings(path: &Path, size: (u32, u32)) -> indra::offscreen::VideoSettings {
+    indra::offscreen::VideoSettings { path: path.into(), size, fps: 30.0, codec: None, quality: None }
+}
+
+#[test]
+fn a_live_recording_writes_each_shown_frame_for_every_step_it_advanced() {
+    let gpu = indra::gpu::Gpu::headless(&indra::gpu::GpuOptions {
+        backend: indra::gpu::BackendChoice::Vulkan,
+        adapter: None,
+    })
+    .unwrap();
+    let dir = temp_dir("live");
+    let path = dir.join("show.mp4");
+    let size = (64, 48);
+    let mut recorder = indra::offscreen::LiveRecorder::start(&gpu.device, live_settings(&path, size), 4).unwrap();
+    // Shown frames that advanced 1, 0, 2, 1, … steps: the video holds the sum, in show time.
+    let steps = [1u32, 0, 2, 1, 3, 1, 0, 1, 1, 2];
+    for (i, &n) in steps.iter().enumerate() {
+        let texture = solid(&gpu, size, i as f32 / 10.0);
+        let view = texture.create_view(&Default::default());
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        recorder.capture(&gpu.device, &gpu.queue, &mut encoder, &view, n);
+        gpu.queue.submit([encoder.finish()]);
+        recorder.after_submit();
+        // The show waits for its own frame, never for the recorder.
+        let _ = gpu.device.poll(wgpu::PollType::wait_indefinitely());
+        recorder.poll(&gpu.device);
+    }
+    let report = recorder.finish(&gpu.device).unwrap();
+    let total: u32 = steps.iter().sum();
+    assert_eq!(report.counts.offered, u64::from(total));
+    assert_eq!(report.counts.dropped(), 0, "{report}");
+    assert_eq!(report.written, u64::from(total));
+    let info = probe(&path);
+    assert_eq!(info["nb_read_frames"], total.to_string());
+    assert_eq!(info["r_frame_rate"], "30/1");
+    // Each shown frame appears as often as its steps, in order (levels 0.0, 0.2, 0.2, 0.3, …).
+    let decoded = tool(
+        "ffmpeg",
+        &[
+            "-v",
+            "error",
+            "-i",
+            path.to_str().unwrap(),
+            "-vf",
+            "scale=in_color_matrix=bt709:in_range=tv",
+            "-f",
+            "rawvideo",
+            "-pix_fmt",
+            "gray",
+            "-",
+        ],
+    )
+    .stdout;
+    let frame_bytes = (size.0 * size.1) as usize;
+    let means: Vec<f64> = decoded
+        .chunks(frame_bytes)
+        .map(|f| f.iter().map(|&b| f64::from(b)).sum::<f64>() / frame_bytes as f64)
+        .collect();
+    let srgb = |x: f64| if x <= 0.0031308 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
+    let expected: Vec<f64> = steps
+        .iter()
+        .enumerate()
+        .flat_map(|(i, &n)| std::iter::repeat_n(srgb(i as f64 / 10.0) * 255.0, n as usize))
+        .collect();
+    assert_eq!(means.len(), expected.len());
+    for (k, (got, want)) in means.iter().zip(&expected).enumerate() {
+        assert!((got - want).abs() < 3.0, "video frame {k}: mean {got:.1}, expected {want:.1}");
+    }
+}
+
+#[test]
+fn frames_a_busy_readback_cannot_take_are_counted_not_lost_silently() {
+    let gpu = indra::gpu::Gpu::headless(&indra::gpu::GpuOptions {
+        backend: indra::gpu::BackendChoice::Vulkan,
+        adapter: None,
+    })
+    .unwrap();
+    let dir = temp_dir("busy");
+    let path = dir.join("show.mkv");
+    let size = (32, 32);
+    // Two buffers and a show that never lets the recorder poll: from the third frame on, every
+    // frame finds both buffers in flight.
+    let mut recorder = indra::offscreen::LiveRecorder::start(&gpu.device, live_settings(&path, size), 2).unwrap();
+    let texture = solid(&gpu, size, 0.5);
+    let view = texture.create_view(&Default::default());
+    for _ in 0..10 {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        recorder.capture(&gpu.device, &gpu.queue, &mut encoder, &view, 1);
+        gpu.queue.submit([encoder.finish()]);
+        recorder.after_submit();
+    }
+    let counts = recorder.counts();
+    assert_eq!((counts.offered, counts.dropped_busy), (10, 8));
+    let report = recorder.finish(&gpu.device).unwrap();
+    assert_eq!(report.written, 2);
+    assert!(report.to_string().contains("8 frame(s) were not recorded"), "{report}");
+    assert_eq!(probe(&path)["nb_read_frames"], "2");
+}

@@ -13,7 +13,7 @@ use crate::gpu::GpuOptions;
 use crate::scene::Scene;
 
 /// How the window opens.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct WindowOptions {
     /// Start in borderless fullscreen.
     pub fullscreen: bool,
@@ -21,7 +21,12 @@ pub struct WindowOptions {
     pub monitor: Option<usize>,
     /// Watch `shaders/` and `scenes/` and reload edits.
     pub watch: bool,
+    /// Record the show to this video from the start; also where later takes go (panel, OSC).
+    pub record_video: Option<std::path::PathBuf>,
 }
+
+/// Where takes go when `--record-video` named no file.
+pub const DEFAULT_RECORDING: &str = "indra-recording.mp4";
 
 /// Opens `scene` in a window and runs until the window is closed.
 pub fn run(

@@ -26,6 +26,12 @@ pub struct Overlay {
     pub preset_name: String,
     /// Seconds a preset recall morphs over (0: instant).
     pub morph_seconds: f32,
+    /// The video recording's status line, while one runs.
+    pub recording: Option<String>,
+    /// The record button was clicked (the window starts or stops the recording).
+    pub record_clicked: bool,
+    /// How the last take ended.
+    pub last_take: Option<String>,
 }
 
 impl Default for Overlay {
@@ -39,6 +45,9 @@ impl Default for Overlay {
             errors_logged: 0,
             preset_name: "preset-1".into(),
             morph_seconds: 0.0,
+            recording: None,
+            record_clicked: false,
+            last_take: None,
         }
     }
 }
@@ -83,6 +92,22 @@ pub const MAX_LOGGED_ERRORS: u64 = 200;
 /// Longest error shown, in characters.
 pub const MAX_ERROR_CHARS: usize = 400;
 
+/// The record button and, while recording, the file, length and lost frames.
+fn record_panel(ui: &mut egui::Ui, overlay: &mut Overlay) {
+    ui.horizontal(|ui| {
+        let (label, hint) = match overlay.recording {
+            Some(_) => ("■ stop recording", "finish the video file"),
+            None => ("● record video", "record the output as shown (also OSC /indra/record/start, /stop)"),
+        };
+        if ui.button(label).on_hover_text(hint).clicked() {
+            overlay.record_clicked = true;
+        }
+    });
+    if let Some(status) = overlay.recording.as_ref().or(overlay.last_take.as_ref()) {
+        ui.small(status);
+    }
+}
+
 /// Draws the whole overlay for one frame; returns the control events the performer made.
 pub fn draw_ui(
     ui: &mut egui::Ui,
@@ -111,6 +136,8 @@ pub fn draw_ui(
                 events.extend(param_panel(ui, instance, hub).into_iter().map(ControlEvent::Write));
                 ui.separator();
                 events.extend(preset_panel(ui, instance, overlay, hub));
+                ui.separator();
+                record_panel(ui, overlay);
                 ui.separator();
                 timing_panel(ui, overlay);
                 ui.small("F1: hide panel · F2: resume tracks · 1–9: presets · F11: fullscreen · Esc: leave fullscreen");

@@ -14,10 +14,12 @@ use winit::window::{Fullscreen, Window, WindowId};
 use super::WindowOptions;
 use super::panel::{Overlay, draw_ui};
 use crate::assets::Assets;
-use crate::control::{ControlHub, ControlOptions};
+use crate::control::{ControlHub, ControlOptions, RecordRequest};
 use crate::gpu::{Blit, BlitTarget, DEFAULT_STALL_TIMEOUT, Gpu, GpuOptions};
 use crate::graph::GraphRuntime;
 use crate::live::{GpuGuard, GpuState, GpuTrouble, LiveReload};
+use crate::offscreen::LiveRecorder;
+use crate::offscreen::capture::{DEFAULT_IN_FLIGHT, take_path};
 use crate::params::ControlEvent;
 use crate::scene::{Player, Scene, SceneInstance};
 use crate::time::FixedClock;
@@ -52,6 +54,10 @@ struct Running {
     retry: Option<(GpuTrouble, Instant)>,
     /// Since when frames wait for a stalled one to finish.
     waiting_since: Option<Instant>,
+    /// The video recording in progress.
+    video: Option<LiveRecorder>,
+    /// Where takes go (`--record-video`, else [`super::DEFAULT_RECORDING`]).
+    video_base: std::path::PathBuf,
 }
 
 /// The winit handler; creates the window on `resumed`, as winit 0.30 asks.
@@ -164,6 +170,10 @@ impl WindowApp {
         let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
         let blit = Blit::new(&gpu.device);
         let (egui_state, egui_renderer) = egui_parts(&window, &gpu, format);
+        let mut hub = hub;
+        if self.options.record_video.is_some() {
+            hub.record_requests.push(RecordRequest::Start(None));
+        }
         Ok(Running {
             window,
             surface,
@@ -185,8 +195,21 @@ impl WindowApp {
             guard: GpuGuard::new(DEFAULT_STALL_TIMEOUT),
             retry: None,
             waiting_since: None,
+            video: None,
+            video_base: self.options.record_video.clone().unwrap_or_else(|| super::DEFAULT_RECORDING.into()),
         })
     }
+}
+
+/// The panel's line for a running take: file, length in show time, lost frames.
+fn recording_status(video: &LiveRecorder, dt: f32) -> String {
+    let counts = video.counts();
+    let seconds = counts.offered as f64 * f64::from(dt);
+    let lost = match counts.dropped() {
+        0 => String::new(),
+        n => format!(", {n} frame(s) not recorded"),
+    };
+    format!("● {}  {:.0}:{:04.1}{lost}", video.path().display(), (seconds / 60.0).floor(), seconds % 60.0)
 }
 
 /// egui's input state and renderer for `window` on `gpu` (made again on a new device).
@@ -213,6 +236,13 @@ fn fullscreen_on(event_loop: &ActiveEventLoop, window: &Window, monitor: Option<
 }
 
 impl ApplicationHandler for WindowApp {
+    fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
+        // The video is finished before the process ends, so the file is complete.
+        if let Some(r) = self.running.as_mut() {
+            r.stop_recording();
+        }
+    }
+
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
         if self.interrupted.load(Ordering::Relaxed) {
             log::info!("interrupted: closing the window (a recording in progress is finished)");
@@ -338,6 +368,7 @@ impl Running {
         events.extend(self.hub.poll(self.player.instance(), self.player.last_step().seconds));
         self.hub.record(self.player.now().frame, &events, self.player.instance().scene());
         self.player.apply(&events);
+        self.act_on_record_requests();
         for _ in 0..steps {
             self.player.step();
         }
@@ -365,6 +396,9 @@ impl Running {
                     &output.view,
                     BlitTarget { view: &target, format: self.config.format, size },
                 );
+                if let Some(video) = self.video.as_mut() {
+                    video.capture(&self.gpu.device, &self.gpu.queue, &mut encoder, &output.view, steps);
+                }
                 self.overlay.stats = Some(output.stats);
             }
             Err(e) => self.overlay.report(format!("frame graph: {e}")),
@@ -377,6 +411,11 @@ impl Running {
         let submitted = self.gpu.queue.submit(extra.into_iter().chain([encoder.finish()]));
         self.guard.submitted(submitted);
         self.runtime.after_submit();
+        if let Some(video) = self.video.as_mut() {
+            video.after_submit();
+            video.poll(&self.gpu.device);
+            self.overlay.recording = Some(recording_status(video, self.player.last_step().dt));
+        }
         // The frame must finish before it is shown: waiting here, within the watchdog's limit,
         // is what catches a stuck GPU on drivers whose present would otherwise block for good
         // (lavapipe). The unshown frame is dropped and the next one recovers.
@@ -438,6 +477,8 @@ impl Running {
         match crate::live::recover(&trouble, &self.gpu, Some(&self.surface), &mut self.player, live, &self.assets, size)
         {
             Ok((gpu, message)) => {
+                // The take's buffers lived on the old device: it ends here, with what it has.
+                self.stop_recording();
                 self.surface.configure(&gpu.device, &self.config);
                 self.runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
                 self.blit = Blit::new(&gpu.device);
@@ -456,6 +497,63 @@ impl Running {
                 self.retry = Some((trouble, Instant::now() + std::time::Duration::from_secs(1)));
                 false
             }
+        }
+    }
+
+    /// Starts or stops the recording as the panel and OSC asked, in order.
+    fn act_on_record_requests(&mut self) {
+        let mut requests = std::mem::take(&mut self.hub.record_requests);
+        if std::mem::take(&mut self.overlay.record_clicked) {
+            requests.push(if self.video.is_some() { RecordRequest::Stop } else { RecordRequest::Start(None) });
+        }
+        for request in requests {
+            match request {
+                RecordRequest::Start(name) => self.start_recording(name.as_deref()),
+                RecordRequest::Stop => self.stop_recording(),
+            }
+        }
+    }
+
+    /// Starts a take at the window's size and the scene's frame rate; problems go to the overlay.
+    fn start_recording(&mut self, name: Option<&str>) {
+        if let Some(video) = &self.video {
+            self.overlay.report(format!("already recording to {}", video.path().display()));
+            return;
+        }
+        let started = take_path(&self.video_base, name).and_then(|path| {
+            let settings = crate::offscreen::VideoSettings {
+                path,
+                size: (self.config.width, self.config.height),
+                fps: 1.0 / f64::from(self.player.last_step().dt),
+                codec: None,
+                quality: None,
+            };
+            LiveRecorder::start(&self.gpu.device, settings, DEFAULT_IN_FLIGHT).map_err(|e| e.to_string())
+        });
+        match started {
+            Ok(video) => {
+                log::info!("recording to {}", video.path().display());
+                self.overlay.recording = Some(recording_status(&video, self.player.last_step().dt));
+                self.video = Some(video);
+            }
+            Err(e) => self.overlay.report(format!("cannot record: {e}")),
+        }
+    }
+
+    /// Finishes the take (waits for the frames in flight and for ffmpeg) and says how it went.
+    fn stop_recording(&mut self) {
+        let Some(video) = self.video.take() else { return };
+        self.overlay.recording = None;
+        match video.finish(&self.gpu.device) {
+            Ok(report) => {
+                log::info!("{report}");
+                // Lost frames are worth a warning; a clean take is just the panel's last line.
+                if report.counts.dropped() > 0 {
+                    self.overlay.report(report.to_string());
+                }
+                self.overlay.last_take = Some(report.to_string());
+            }
+            Err(e) => self.overlay.report(format!("the recording failed: {e}")),
         }
     }
 

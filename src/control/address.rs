@@ -17,6 +17,10 @@ pub enum Command {
     PresetSave,
     /// `/indra/resume`: give taken-over parameters back to their tracks.
     Resume,
+    /// `/indra/record/start [s]`: record the show to a video (optionally named `s`).
+    RecordStart,
+    /// `/indra/record/stop`: finish the recording.
+    RecordStop,
 }
 
 /// What an address resolves to.
@@ -61,6 +65,8 @@ impl AddressMap {
         routes.insert("/indra/preset/recall".into(), Route::Command(Command::PresetRecall));
         routes.insert("/indra/preset/save".into(), Route::Command(Command::PresetSave));
         routes.insert("/indra/resume".into(), Route::Command(Command::Resume));
+        routes.insert("/indra/record/start".into(), Route::Command(Command::RecordStart));
+        routes.insert("/indra/record/stop".into(), Route::Command(Command::RecordStop));
         Self { routes }
     }
 

@@ -7,7 +7,7 @@ use std::time::SystemTime;
 
 use super::feedback::OscFeedback;
 use super::midi::{LearnStore, MidiInput, MidiMapper, MidiParser};
-use super::osc::{OscReceiver, OscRouter, Routed};
+use super::osc::{OscReceiver, OscRouter, RecordRequest, Routed};
 use super::oscquery::OscQueryServer;
 use super::presets::PresetStore;
 use super::record::Recorder;
@@ -68,6 +68,8 @@ pub struct ControlHub {
     recorder: Option<Recorder>,
     /// Things to tell the performer (shown in the overlay, logged once there).
     pub notices: Vec<String>,
+    /// Video recording starts and stops asked for over OSC, for the window to act on.
+    pub record_requests: Vec<RecordRequest>,
     frame_count: u64,
     /// Preset names, re-read on save and every [`PRESET_RESCAN_FRAMES`] frames (not per frame:
     /// the panel shows them every frame).
@@ -117,6 +119,7 @@ impl ControlHub {
             presets,
             recorder,
             notices,
+            record_requests: Vec::new(),
             frame_count: 0,
             preset_names,
         }
@@ -151,6 +154,7 @@ impl ControlHub {
                     Some(Routed::Event(e)) => events.push(e),
                     Some(Routed::SavePreset(name)) => self.save_preset(&name, instance),
                     Some(Routed::RecallPreset(name, s)) => events.extend(self.recall(&name, s, scene)),
+                    Some(Routed::Record(request)) => self.record_requests.push(request),
                     None => {}
                 }
             }

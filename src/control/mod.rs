@@ -17,3 +17,4 @@ pub mod record;
 
 pub use address::{AddressMap, Route};
 pub use hub::{ControlHub, ControlOptions};
+pub use osc::RecordRequest;

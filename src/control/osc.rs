@@ -304,6 +304,17 @@ pub enum Routed {
     SavePreset(String),
     /// Recall a preset, morphing over `seconds`.
     RecallPreset(String, f64),
+    /// Start or stop the video recording.
+    Record(RecordRequest),
+}
+
+/// Start or stop recording the show to a video file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum RecordRequest {
+    /// Start, into a file of this name (a bare file name) or the default one.
+    Start(Option<String>),
+    /// Finish the recording.
+    Stop,
 }
 
 /// Translates messages into control events against one scene's address map.
@@ -367,6 +378,8 @@ fn route_command(command: Command, args: &[OscType]) -> Option<Routed> {
         Command::Resume => Some(Routed::Event(ControlEvent::ResumeTracks)),
         Command::PresetSave => name.map(Routed::SavePreset),
         Command::PresetRecall => name.map(|n| Routed::RecallPreset(n, seconds.max(0.0))),
+        Command::RecordStart => Some(Routed::Record(RecordRequest::Start(name))),
+        Command::RecordStop => Some(Routed::Record(RecordRequest::Stop)),
     }
 }
 

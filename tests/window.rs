@@ -1,0 +1,163 @@
+//! The live show in a real window, on a virtual X display (Xvfb, installed by
+//! tools/setup-system test): recording to video from the command line, stopping and starting
+//! takes over OSC, and a complete file after SIGTERM.
+
+use std::io::Read;
+use std::net::UdpSocket;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// An Xvfb server on a free display number, killed when dropped.
+struct VirtualDisplay {
+    server: Child,
+    display: String,
+}
+
+impl VirtualDisplay {
+    fn start() -> Self {
+        for attempt in 0..20 {
+            let number = 150 + (std::process::id() % 300) + attempt * 7;
+            let socket = format!("/tmp/.X11-unix/X{number}");
+            if Path::new(&socket).exists() {
+                continue;
+            }
+            let mut server = Command::new("Xvfb")
+                .args([&format!(":{number}"), "-screen", "0", "1280x800x24", "-nolisten", "tcp"])
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+                .expect("Xvfb runs (tools/setup-system test installs xvfb)");
+            let deadline = Instant::now() + Duration::from_secs(10);
+            while Instant::now() < deadline {
+                if Path::new(&socket).exists() {
+                    return Self { server, display: format!(":{number}") };
+                }
+                if let Ok(Some(_)) = server.try_wait() {
+                    break;
+                }
+                std::thread::sleep(Duration::from_millis(50));
+            }
+            let _ = server.kill();
+            let _ = server.wait();
+        }
+        panic!("no virtual display could be started");
+    }
+}
+
+impl Drop for VirtualDisplay {
+    fn drop(&mut self) {
+        let _ = self.server.kill();
+        let _ = self.server.wait();
+    }
+}
+
+/// `indra run` in the virtual display, its log going to a file the test reads.
+struct Show {
+    child: Child,
+    log: PathBuf,
+}
+
+impl Show {
+    /// Waits (at most 90 s: debug build on lavapipe) until the log holds `text`; returns the log.
+    fn wait_for(&mut self, text: &str) -> String {
+        let deadline = Instant::now() + Duration::from_secs(90);
+        loop {
+            let mut log = String::new();
+            if let Ok(mut f) = std::fs::File::open(&self.log) {
+                let _ = f.read_to_string(&mut log);
+            }
+            if log.contains(text) {
+                return log;
+            }
+            if let Ok(Some(status)) = self.child.try_wait() {
+                panic!("the show ended ({status}) before saying '{text}':\n{log}");
+            }
+            assert!(Instant::now() < deadline, "no '{text}' after 90 s:\n{log}");
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    }
+}
+
+impl Drop for Show {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn send(socket: &UdpSocket, port: u16, addr: &str, args: Vec<rosc::OscType>) {
+    let packet = rosc::OscPacket::Message(rosc::OscMessage { addr: addr.into(), args });
+    socket.send_to(&rosc::encoder::encode(&packet).unwrap(), ("127.0.0.1", port)).unwrap();
+}
+
+fn frames(path: &Path) -> u64 {
+    let o = Command::new("ffprobe")
+        .args(["-v", "error", "-count_frames", "-show_entries", "stream=nb_read_frames", "-of", "csv=p=0"])
+        .arg(path)
+        .output()
+        .expect("ffprobe runs (tools/setup-system test installs ffmpeg)");
+    String::from_utf8_lossy(&o.stdout).trim().parse().unwrap_or_else(|_| panic!("{} is no video", path.display()))
+}
+
+#[test]
+fn the_show_records_takes_started_and_stopped_over_osc_and_finishes_on_sigterm() {
+    let display = VirtualDisplay::start();
+    let dir = std::env::temp_dir().join(format!("indra-window-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let port = UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let log = dir.join("show.log");
+    let child = Command::new(env!("CARGO_BIN_EXE_indra"))
+        .args(["--backend", "vulkan", "run", "star_glow", "--no-midi", "--no-watch"])
+        .args(["--osc", &format!("127.0.0.1:{port}"), "--record-video"])
+        .arg(dir.join("show.mp4"))
+        .arg("--presets")
+        .arg(dir.join("presets"))
+        .arg("--midi-learn")
+        .arg(dir.join("learn.ron"))
+        .env("INDRA_ROOT", env!("CARGO_MANIFEST_DIR"))
+        .env("DISPLAY", &display.display)
+        .env_remove("WAYLAND_DISPLAY")
+        .env("RUST_LOG", "info")
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .unwrap();
+    let mut show = Show { child, log };
+    let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
+
+    show.wait_for("recording to");
+    std::thread::sleep(Duration::from_secs(2));
+    send(&socket, port, "/indra/record/stop", vec![]);
+    let log = show.wait_for("recorded ");
+    let first: u64 = log
+        .split("recorded ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no frame count in:\n{log}"));
+    assert!(first > 0, "{log}");
+    assert_eq!(frames(&dir.join("show.mp4")), first, "the file holds what the show reported");
+
+    // A take named over the network lands beside the first; a path is refused.
+    send(&socket, port, "/indra/record/start", vec![rosc::OscType::String("../escape.mp4".into())]);
+    send(&socket, port, "/indra/record/start", vec![rosc::OscType::String("encore".into())]);
+    show.wait_for("encore.mp4");
+    std::thread::sleep(Duration::from_secs(2));
+    let terminated = Command::new("kill").args(["-TERM", &show.child.id().to_string()]).status().unwrap();
+    assert!(terminated.success());
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let status = loop {
+        if let Some(status) = show.child.try_wait().unwrap() {
+            break status;
+        }
+        assert!(Instant::now() < deadline, "the show did not end after SIGTERM");
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    let log = std::fs::read_to_string(&show.log).unwrap();
+    assert!(status.success(), "{status}:\n{log}");
+    assert!(log.contains("is not a plain file name"), "{log}");
+    assert!(!dir.parent().unwrap().join("escape.mp4").exists());
+    assert!(frames(&dir.join("encore.mp4")) > 0, "the take stopped by SIGTERM is a complete file:\n{log}");
+}
