@@ -2,7 +2,8 @@
 // the mesh warp (on the CPU), then the corner pin (here, as a homography in clip space so the
 // GPU's perspective-correct interpolation makes the pin exact inside every triangle). Soft edges
 // and the black-level lift are applied in linear light, in the source's own coordinates, so the
-// ramps of two overlapping projectors sum to one on the wall.
+// ramps of two overlapping projectors sum to one on the wall. `uv` runs over the part of the
+// source this output shows (its region), so blends and the grid belong to the projector.
 
 struct WarpUniforms {
     // Unit square (after the mesh) → output view units (0–1, y up).
@@ -13,6 +14,8 @@ struct WarpUniforms {
     shape: vec4<f32>,
     // x, y: mesh cells across and up; z, w: unused.
     grid: vec4<f32>,
+    // The part of the source shown: min x, min y, max x, max y (v up).
+    region: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> u: WarpUniforms;
@@ -62,7 +65,8 @@ fn grid_distances(uv: vec2<f32>) -> vec2<f32> {
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let uv = in.uv;
-    var color = textureSample(source, source_sampler, vec2<f32>(uv.x, 1.0 - uv.y)).rgb;
+    let at = mix(u.region.xy, u.region.zw, uv);
+    var color = textureSample(source, source_sampler, vec2<f32>(at.x, 1.0 - at.y)).rgb;
     let w = side(uv.x, u.blend.x) * side(1.0 - uv.x, u.blend.y) * side(1.0 - uv.y, u.blend.z) * side(uv.y, u.blend.w);
     color = color * pow(w, u.shape.y);
     // The lift raises black where only this projector shines (outside every blend zone).

@@ -150,6 +150,10 @@ pub struct RenderArgs {
     /// Replay a control stream recorded with `run --record-controls`, frame-exactly.
     #[arg(long)]
     pub replay: Option<PathBuf>,
+    /// Which output to render: 0 the scene's output (default), 1… its `outputs` as their
+    /// windows show them (warped).
+    #[arg(long, default_value_t = 0)]
+    pub output: usize,
 }
 
 /// `indra bench`.
@@ -295,6 +299,7 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     eprintln!("rendering '{}' on {}", scene.name, device.adapter_label());
     let mut renderer =
         OffscreenRenderer::new(device, assets, scene, args.size, args.dt, args.seed).map_err(|e| e.to_string())?;
+    renderer.show_output(args.output)?;
     // Replayed events apply at their own frames, also those a seek passes over.
     for (frame, events) in script {
         renderer.schedule(frame, events);

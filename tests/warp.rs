@@ -259,3 +259,41 @@ fn projection_mapping_matches_its_golden_with_and_without_the_grid() {
     let frame = common::render_scene(scene, (192, 108), 30);
     golden().check("projection_mapping_grid", frame.size, &frame.rgba).unwrap();
 }
+
+#[test]
+fn scene_outputs_get_a_warp_node_each_and_corner_addresses() {
+    let scene = indra::scene::load_scene(&assets(), "two_projectors").unwrap();
+    assert_eq!(scene.outputs.len(), 2);
+    let map = indra::control::AddressMap::new(&scene);
+    for (n, file) in [(1, "warps/wall-left-half.ron"), (2, "warps/wall-right.ron")] {
+        let output = &scene.outputs[n - 1];
+        let node = &scene.nodes[output.node];
+        assert_eq!((node.id.as_str(), node.technique.name), (format!("output{n}").as_str(), "warp"));
+        assert_eq!(node.params.get("file"), ParamValue::Text(Text::new(file)));
+        assert_eq!((output.monitor, output.fullscreen), (Some(n), true));
+        for (c, name) in warp::CORNERS.iter().enumerate() {
+            let route = map.route(&format!("/indra/output/{n}/corner/{c}"));
+            let target =
+                indra::params::Target { node: output.node, param: node.params.index(name).unwrap(), component: None };
+            assert_eq!(route, Some(indra::control::Route::Param(target)), "output {n} corner {c}");
+        }
+    }
+    let broken = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/two_projectors.ron"))
+        .unwrap()
+        .replace("(warp: \"warps/wall-right.ron\"", "(source: \"nowhere\", warp: \"warps/wall-right.ron\"");
+    let e = indra::scene::parse_scene("two.ron", &broken).err().unwrap().to_string();
+    assert!(e.contains("'nowhere'"), "{e}");
+}
+
+#[test]
+fn each_projector_output_matches_its_golden() {
+    for n in [1, 2] {
+        let scene = indra::scene::load_scene(&assets(), "two_projectors").unwrap();
+        let mut r =
+            indra::offscreen::OffscreenRenderer::new(gpu(), &assets(), scene, Some((192, 108)), None, None).unwrap();
+        r.show_output(n).unwrap();
+        r.seek(30).unwrap();
+        let frame = r.render_next().unwrap();
+        golden().check(&format!("two_projectors_output{n}"), frame.size, &frame.rgba).unwrap();
+    }
+}

@@ -260,10 +260,29 @@ impl Corners {
     }
 }
 
+/// The part of the source an output shows (source units, v up): two projectors side by side
+/// show overlapping halves, e.g. left 0–0.6 and 0.4–1.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Region {
+    /// Lower-left corner.
+    pub min: [f32; 2],
+    /// Upper-right corner.
+    pub max: [f32; 2],
+}
+
+impl Default for Region {
+    fn default() -> Self {
+        Self { min: [0.0, 0.0], max: [1.0, 1.0] }
+    }
+}
+
 /// One output's warp as stored on disk (RON).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct WarpFile {
+    /// The part of the source shown (default: all of it).
+    pub region: Region,
     /// The corner pin.
     pub corners: Corners,
     /// Soft edges.
@@ -291,6 +310,11 @@ impl WarpFile {
         let corners = [c.top_left, c.top_right, c.bottom_right, c.bottom_left];
         if corners.iter().flatten().any(|v| !v.is_finite()) {
             return Some("a corner is not a finite number".into());
+        }
+        let r = &self.region;
+        let inside = |v: f32| (0.0..=1.0).contains(&v);
+        if !(r.min.iter().chain(&r.max).all(|&v| inside(v)) && r.min[0] < r.max[0] && r.min[1] < r.max[1]) {
+            return Some("region must have 0 ≤ min < max ≤ 1 on both axes".into());
         }
         let b = &self.blend;
         if [b.left, b.right, b.top, b.bottom].iter().any(|w| !(0.0..=0.5).contains(w)) {
@@ -399,6 +423,7 @@ mod tests {
     #[test]
     fn warp_files_round_trip_and_bad_ones_say_where() {
         let warp = WarpFile {
+            region: Region { min: [0.4, 0.0], max: [1.0, 1.0] },
             corners: Corners { top_left: [0.05, 0.9], ..Default::default() },
             blend: EdgeBlend { right: 0.2, curve: 3.0, ..Default::default() },
             black_lift: 0.02,
@@ -419,6 +444,8 @@ mod tests {
         assert!(e.contains("between 0 and 0.5"), "{e}");
         let e = WarpFile::parse("w.ron", "(mesh: (columns: 3, rows: 2, points: [(0.0, 0.0)]))").unwrap_err();
         assert!(e.contains("needs 6 points"), "{e}");
+        let e = WarpFile::parse("w.ron", "(region: (min: (0.6, 0.0), max: (0.4, 1.0)))").unwrap_err();
+        assert!(e.contains("region"), "{e}");
         let e = WarpFile::parse("w.ron", "(colour: 1)").unwrap_err();
         assert!(e.contains("colour"), "{e}");
     }

@@ -57,6 +57,8 @@ pub struct FrameGraph<'r> {
     pub(crate) buffers: Vec<VirtualBuffer>,
     pub(crate) passes: Vec<PassDecl<'r>>,
     pub(crate) output: Option<TextureHandle>,
+    /// More textures the frame shows (other windows), kept like the output.
+    pub(crate) extra_outputs: Vec<TextureHandle>,
     /// A frame that only advances simulations (a seek): it has no output, and only passes that
     /// write persistent state (imports) or have side effects, with what they depend on, run.
     pub(crate) simulation_only: bool,
@@ -71,6 +73,7 @@ impl<'r> FrameGraph<'r> {
             buffers: Vec::new(),
             passes: Vec::new(),
             output: None,
+            extra_outputs: Vec::new(),
             simulation_only: false,
         }
     }
@@ -141,6 +144,14 @@ impl<'r> FrameGraph<'r> {
             return;
         }
         self.output = Some(texture);
+    }
+
+    /// Marks one more texture the frame shows (another window): it and the passes it needs
+    /// are kept, and it comes back in [`super::FrameOutput::extras`], in the order added.
+    pub fn add_extra_output(&mut self, texture: TextureHandle) {
+        if !self.simulation_only {
+            self.extra_outputs.push(texture);
+        }
     }
 
     /// The texture set as output, if any.

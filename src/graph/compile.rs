@@ -74,7 +74,8 @@ pub fn compile(graph: &FrameGraph<'_>) -> Result<CompiledGraph, GraphError> {
         }
     }
 
-    let live = live_passes(graph, output, &deps);
+    let shown: Vec<super::TextureHandle> = output.into_iter().chain(graph.extra_outputs.iter().copied()).collect();
+    let live = live_passes(graph, &shown, &deps);
     let order = topological_order(graph, &deps, &live)?;
     check_reads(graph, &order)?;
 
@@ -92,17 +93,17 @@ pub fn compile(graph: &FrameGraph<'_>) -> Result<CompiledGraph, GraphError> {
             });
         }
     }
-    // The output is read after the last pass (display encode / readback).
-    if let Some(output) = output
-        && let Some((first, _)) = texture_lifetimes[output.0 as usize]
-    {
-        texture_lifetimes[output.0 as usize] = Some((first, usize::MAX));
+    // The outputs are read after the last pass (display encode / readback).
+    for shown in &shown {
+        if let Some((first, _)) = texture_lifetimes[shown.0 as usize] {
+            texture_lifetimes[shown.0 as usize] = Some((first, usize::MAX));
+        }
     }
     Ok(CompiledGraph { order, texture_lifetimes, buffer_lifetimes })
 }
 
 /// Passes whose work reaches the output, an imported resource, or that have side effects.
-fn live_passes(graph: &FrameGraph<'_>, output: Option<super::TextureHandle>, deps: &[BTreeSet<usize>]) -> Vec<bool> {
+fn live_passes(graph: &FrameGraph<'_>, shown: &[super::TextureHandle], deps: &[BTreeSet<usize>]) -> Vec<bool> {
     let is_root = |p: usize| {
         let pass = &graph.passes[p];
         pass.side_effect
@@ -110,7 +111,7 @@ fn live_passes(graph: &FrameGraph<'_>, output: Option<super::TextureHandle>, dep
                 a != Access::Read
                     && match res {
                         Resource::Texture(t) => {
-                            output.is_some_and(|o| o.0 == t)
+                            shown.iter().any(|o| o.0 == t)
                                 || matches!(graph.textures[t as usize].origin, TextureOrigin::Imported(..))
                         }
                         Resource::Buffer(b) => {

@@ -33,6 +33,9 @@ pub struct FrameOutput {
     pub texture: wgpu::Texture,
     /// Its view.
     pub view: wgpu::TextureView,
+    /// The textures added with [`super::FrameGraph::add_extra_output`], in order (None: never
+    /// written this frame).
+    pub extras: Vec<Option<(wgpu::Texture, wgpu::TextureView)>>,
     /// Stats of this frame.
     pub stats: FrameStats,
 }
@@ -73,11 +76,16 @@ impl GraphRuntime {
     ) -> Result<FrameOutput, GraphError> {
         let output = graph.output.ok_or(GraphError::NoOutput)?;
         let output_name = graph.textures[output.0 as usize].name.clone();
-        let (mut textures, stats) = self.record(device, queue, graph, encoder)?;
+        let extra_outputs = graph.extra_outputs.clone();
+        let (textures, stats) = self.record(device, queue, graph, encoder)?;
         let out = textures[output.0 as usize]
-            .take()
+            .clone()
             .ok_or(GraphError::ReadOfUnwritten { pass: "<output>".into(), resource: output_name })?;
-        Ok(FrameOutput { texture: out.texture, view: out.view, stats })
+        let extras = extra_outputs
+            .iter()
+            .map(|t| textures[t.0 as usize].as_ref().map(|r| (r.texture.clone(), r.view.clone())))
+            .collect();
+        Ok(FrameOutput { texture: out.texture, view: out.view, extras, stats })
     }
 
     /// Compiles and records a [`FrameGraph::simulation_only`] frame: only the passes that write
@@ -104,7 +112,7 @@ impl GraphRuntime {
         let started = Instant::now();
         let compiled = compile(&graph)?;
         let compile_time = started.elapsed();
-        let usages = texture_usages(&graph, graph.output.map(|o| o.0));
+        let usages = texture_usages(&graph);
 
         let mut textures: Vec<Option<ResolvedTexture>> = vec![None; graph.textures.len()];
         let mut pool_index: Vec<Option<usize>> = vec![None; graph.textures.len()];
@@ -280,7 +288,7 @@ fn size_of(t: &ResolvedTexture) -> (u32, u32) {
 }
 
 /// Usage flags of each texture, inferred from how passes access it.
-fn texture_usages(graph: &FrameGraph<'_>, output: Option<u32>) -> Vec<wgpu::TextureUsages> {
+fn texture_usages(graph: &FrameGraph<'_>) -> Vec<wgpu::TextureUsages> {
     let mut usages = vec![wgpu::TextureUsages::empty(); graph.textures.len()];
     for pass in &graph.passes {
         for &(res, access) in &pass.accesses {
@@ -293,9 +301,9 @@ fn texture_usages(graph: &FrameGraph<'_>, output: Option<u32>) -> Vec<wgpu::Text
             }
         }
     }
-    // The output is encoded for display (sampled) or copied for readback.
-    if let Some(output) = output {
-        usages[output as usize] |= wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    // Outputs are encoded for display (sampled) or copied for readback.
+    for shown in graph.output.iter().chain(&graph.extra_outputs) {
+        usages[shown.0 as usize] |= wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
     }
     usages
 }

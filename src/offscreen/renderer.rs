@@ -33,6 +33,8 @@ pub struct OffscreenRenderer {
     size: (u32, u32),
     target: wgpu::Texture,
     guard: GpuGuard,
+    /// Which output is read back: 0 the scene's output, n its n-th extra output.
+    shown: usize,
 }
 
 impl OffscreenRenderer {
@@ -52,7 +54,7 @@ impl OffscreenRenderer {
         let blit = Blit::new(&gpu.device);
         let target = display_target(&gpu, size);
         let guard = GpuGuard::new(DEFAULT_STALL_TIMEOUT);
-        Ok(Self { gpu, player: Player::new(instance, clock), runtime, blit, size, target, guard })
+        Ok(Self { gpu, player: Player::new(instance, clock), runtime, blit, size, target, guard, shown: 0 })
     }
 
     /// Waits (within the watchdog's limit) for the last frame; reports a lost or stuck device,
@@ -89,6 +91,18 @@ impl OffscreenRenderer {
         self.guard.reset();
         self.gpu = gpu;
         Ok(message)
+    }
+
+    /// Reads back output `n` from now on: 0 is the scene's output (the first window), 1… its
+    /// `outputs` (the other windows, warped as they are shown).
+    pub fn show_output(&mut self, n: usize) -> Result<(), String> {
+        let count = self.player.instance().scene().outputs.len();
+        if n > count {
+            let name = &self.player.instance().scene().name;
+            return Err(format!("'{name}' has outputs 0 to {count}; there is no output {n}"));
+        }
+        self.shown = n;
+        Ok(())
     }
 
     /// The live scene (to change parameters between frames).
@@ -130,12 +144,18 @@ impl OffscreenRenderer {
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("offscreen_frame") });
         let output = self.player.encode(&self.gpu, &mut self.runtime, &mut encoder, self.size)?;
+        let shown = match self.shown {
+            0 => output.view.clone(),
+            n => output.extras.get(n - 1).cloned().flatten().map(|(_, view)| view).ok_or_else(|| {
+                crate::graph::GraphError::ReadOfUnwritten { pass: "<output>".into(), resource: format!("output {n}") }
+            })?,
+        };
         let target_view = self.target.create_view(&Default::default());
         self.blit.record(
             &self.gpu.device,
             &self.gpu.queue,
             &mut encoder,
-            &output.view,
+            &shown,
             BlitTarget { view: &target_view, format: DISPLAY_FORMAT, size: self.size },
         );
         let index = self.gpu.queue.submit([encoder.finish()]);

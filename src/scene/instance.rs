@@ -367,6 +367,9 @@ impl SceneInstance {
             outputs.push(node.add_passes(&mut graph, &self.params[i], time, &inputs));
         }
         graph.set_output(outputs[self.scene.output]);
+        for extra in &self.scene.outputs {
+            graph.add_extra_output(outputs[extra.node]);
+        }
         graph
     }
 

@@ -31,10 +31,23 @@ pub struct Scene {
     pub output: usize,
     /// Tracks bound to node parameters.
     pub tracks: Vec<BoundTrack>,
+    /// More outputs (windows; `render --output N`), numbered from 1.
+    pub outputs: Vec<SceneOutput>,
     /// OSC addresses declared in the scene's `controls`, besides `/indra/<node>/<param>`.
     pub osc_aliases: Vec<(String, Target)>,
     /// MIDI mappings declared in the scene's `controls`.
     pub midi: Vec<(MidiMapping, Target)>,
+}
+
+/// One more output of a scene, resolved.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SceneOutput {
+    /// Index of the node it shows.
+    pub node: usize,
+    /// Monitor for its window.
+    pub monitor: Option<usize>,
+    /// Borderless fullscreen on that monitor.
+    pub fullscreen: bool,
 }
 
 /// A scene's OSC aliases and MIDI mappings, resolved.
@@ -235,6 +248,46 @@ pub fn parse_scene(origin: &str, source: &str) -> Result<Scene, SceneErrors> {
     Validator { origin, source, errors: Vec::new(), more: 0 }.validate(file)
 }
 
+/// Puts a `warp` node `output<n>` between each warped output and its source (the scene's output
+/// when it names none), and points the output at it.
+fn add_output_warps(file: &mut SceneFile) {
+    for (i, output) in file.outputs.iter_mut().enumerate() {
+        let Some(warp) = output.warp.take() else { continue };
+        let id = format!("output{}", i + 1);
+        let source = output.source.clone().unwrap_or_else(|| file.output.clone());
+        file.nodes.push(super::schema::NodeFile {
+            id: id.clone(),
+            technique: techniques::warp::INFO.name.into(),
+            params: [("file".to_string(), RawValue::Text(warp))].into(),
+            ranges: Default::default(),
+            smoothing: Default::default(),
+            inputs: [("source".to_string(), source)].into(),
+        });
+        output.source = Some(id);
+    }
+}
+
+/// `/indra/output/<n>/corner/<i>` for every output that shows a warp node: a controller can
+/// drag corner i (clockwise from the top left) of output n without knowing node ids.
+fn corner_aliases(outputs: &[SceneOutput], nodes: &[SceneNode]) -> Vec<(String, Target)> {
+    let mut aliases = Vec::new();
+    for (i, output) in outputs.iter().enumerate() {
+        let node = &nodes[output.node];
+        if node.technique.name != techniques::warp::INFO.name {
+            continue;
+        }
+        for (c, name) in techniques::warp::CORNERS.iter().enumerate() {
+            if let Some(param) = node.params.index(name) {
+                aliases.push((
+                    format!("/indra/output/{}/corner/{c}", i + 1),
+                    Target { node: output.node, param, component: None },
+                ));
+            }
+        }
+    }
+    aliases
+}
+
 /// Errors located and reported per file; the rest are counted. Locating scans the source, so a
 /// file with tens of thousands of mistakes would otherwise take quadratic time to check.
 const MAX_REPORTED_ERRORS: usize = 50;
@@ -273,7 +326,8 @@ impl Validator<'_> {
         SceneErrors(self.errors)
     }
 
-    fn validate(mut self, file: SceneFile) -> Result<Scene, SceneErrors> {
+    fn validate(mut self, mut file: SceneFile) -> Result<Scene, SceneErrors> {
+        add_output_warps(&mut file);
         if file.size.0 == 0 || file.size.1 == 0 || file.size.0 > 16384 || file.size.1 > 16384 {
             self.error(&["size"], format!("size {:?} must be between 1 and 16384 on each axis", file.size));
         }
@@ -316,7 +370,9 @@ impl Validator<'_> {
         }
         let output = position[&output.expect("checked above")];
         let tracks = self.tracks(&file, &ordered);
-        let (osc_aliases, midi) = self.controls(&file, &ordered);
+        let (mut osc_aliases, midi) = self.controls(&file, &ordered);
+        let outputs = self.outputs(&file, &ordered, output);
+        osc_aliases.extend(corner_aliases(&outputs, &ordered));
         if !self.errors.is_empty() {
             return Err(self.failure());
         }
@@ -330,6 +386,7 @@ impl Validator<'_> {
             msaa: file.msaa,
             nodes: ordered,
             output,
+            outputs,
             tracks,
             osc_aliases,
             midi,
@@ -339,6 +396,26 @@ impl Validator<'_> {
             return Err(self.failure());
         }
         Ok(scene)
+    }
+
+    /// Resolves the extra outputs' sources (after [`add_output_warps`]).
+    fn outputs(&mut self, file: &SceneFile, nodes: &[SceneNode], main: usize) -> Vec<SceneOutput> {
+        let mut outputs = Vec::new();
+        for (i, o) in file.outputs.iter().enumerate() {
+            let node = match &o.source {
+                None => Some(main),
+                Some(id) => nodes.iter().position(|n| &n.id == id),
+            };
+            match node {
+                Some(node) => outputs.push(SceneOutput { node, monitor: o.monitor, fullscreen: o.fullscreen }),
+                None => {
+                    let id = o.source.clone().unwrap_or_default();
+                    let anchor = format!("\"{id}\"");
+                    self.error(&["outputs", &anchor], format!("output {}: '{id}' is not a node of this scene", i + 1));
+                }
+            }
+        }
+        outputs
     }
 
     /// Resolves OSC aliases and MIDI mappings to parameters.

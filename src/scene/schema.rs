@@ -49,14 +49,37 @@ pub struct SceneFile {
     pub msaa: u32,
     /// Technique instances and their wiring.
     pub nodes: Vec<NodeFile>,
-    /// The node whose texture is shown.
+    /// The node whose texture is shown (in the first window, with the panel).
     pub output: String,
+    /// More outputs for the stage: each a window of its own (`run`) or a target of
+    /// `render --output N`, numbered from 1.
+    #[serde(default)]
+    pub outputs: Vec<OutputFile>,
     /// OSC aliases and MIDI mappings.
     #[serde(default)]
     pub controls: ControlsFile,
     /// Animation tracks.
     #[serde(default)]
     pub tracks: Vec<TrackFile>,
+}
+
+/// One more output: a node's texture, optionally through a warp (projection mapping).
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputFile {
+    /// The node whose texture it shows (default: the scene's output).
+    #[serde(default)]
+    pub source: Option<String>,
+    /// A warp file: a `warp` node `output<n>` is added between the source and this output, its
+    /// corners also at `/indra/output/<n>/corner/<0–3>` (clockwise from the top left).
+    #[serde(default)]
+    pub warp: Option<String>,
+    /// Monitor index for its window (see the log for the list).
+    #[serde(default)]
+    pub monitor: Option<usize>,
+    /// Open borderless fullscreen on that monitor.
+    #[serde(default)]
+    pub fullscreen: bool,
 }
 
 /// How controllers reach parameters, besides the default `/indra/<node>/<param>` addresses.

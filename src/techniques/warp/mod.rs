@@ -11,7 +11,7 @@
 use std::cell::RefCell;
 use std::path::PathBuf;
 
-use crate::geometry::warp::{Corners, EdgeBlend, Homography, MeshWarp, WarpFile};
+use crate::geometry::warp::{Corners, EdgeBlend, Homography, MeshWarp, Region, WarpFile};
 use crate::gpu::{BindGroupCache, GrowableBuffer, RasterDesc, ShaderError, uniform_buffer, uniform_entry};
 use crate::graph::{FrameGraph, PassContext, RasterTargets, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue};
@@ -33,8 +33,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 /// Output format: linear HDR like every node.
 pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
-/// The example warp `projection_mapping.ron` uses, by the path the scene gives.
-const BUNDLED: (&str, &str) = ("warps/wall-left.ron", include_str!("../../../warps/wall-left.ron"));
+/// The example warps the bundled scenes use, by the path they give.
+const BUNDLED: [(&str, &str); 3] = [
+    ("warps/wall-left.ron", include_str!("../../../warps/wall-left.ron")),
+    ("warps/wall-left-half.ron", include_str!("../../../warps/wall-left-half.ron")),
+    ("warps/wall-right.ron", include_str!("../../../warps/wall-right.ron")),
+];
 
 /// Triangle rows and columns per mesh cell (a smooth mesh is curved inside a cell).
 const SUBDIVISIONS: u32 = 16;
@@ -53,6 +57,8 @@ pub fn params() -> Vec<ParamDecl> {
         corner(CORNERS[1], [1.0, 1.0], "where the top-right corner lands"),
         corner(CORNERS[2], [1.0, 0.0], "where the bottom-right corner lands"),
         corner(CORNERS[3], [0.0, 0.0], "where the bottom-left corner lands"),
+        ParamDecl::new("region_min", Vec2([0.0, 0.0]), Some((0.0, 1.0)), "lower-left of the part of the source shown"),
+        ParamDecl::new("region_max", Vec2([1.0, 1.0]), Some((0.0, 1.0)), "upper-right of the part of the source shown"),
         width("blend_left", "soft edge on the left, as a share of the image"),
         width("blend_right", "soft edge on the right"),
         width("blend_top", "soft edge at the top"),
@@ -89,6 +95,8 @@ pub struct WarpUniforms {
     pub shape: [f32; 4],
     /// Mesh cells across and up.
     pub grid: [f32; 4],
+    /// The part of the source shown: min x, min y, max x, max y (v up).
+    pub region: [f32; 4],
 }
 
 /// A mesh vertex: source coordinates and where the mesh warp moved them.
@@ -118,6 +126,8 @@ pub struct Warp {
     mesh: MeshWarp,
     /// View units → unit square (the inverse corner pin of the last frame), for the pointer.
     unpin: Option<Homography>,
+    /// The part of the source shown in the last frame, for the pointer.
+    region: Region,
     /// The file path last loaded (or tried), so a bad path is reported once.
     requested: Option<String>,
     /// Values read from the file, for the scene to set (see [`Technique::take_loaded_values`]).
@@ -217,6 +227,7 @@ impl Warp {
             root: setup.assets.root().map(std::path::Path::to_path_buf),
             mesh: MeshWarp::regular(2, 2),
             unpin: None,
+            region: Region::default(),
             requested: None,
             loaded: Vec::new(),
             messages: Vec::new(),
@@ -241,9 +252,10 @@ impl Warp {
     /// The bundled example is built in, so its scene maps the same from any folder.
     fn load(&mut self, path: &str) {
         let file = self.resolve(path);
-        let text = match std::fs::read_to_string(&file) {
-            Err(_) if !file.exists() && BUNDLED.0 == path => Ok(BUNDLED.1.to_string()),
-            other => other.map_err(|e| format!("cannot read warp file {}: {e}", file.display())),
+        let bundled = BUNDLED.iter().find(|(name, _)| *name == path).map(|(_, text)| *text);
+        let text = match (std::fs::read_to_string(&file), bundled) {
+            (Err(_), Some(text)) if !file.exists() => Ok(text.to_string()),
+            (read, _) => read.map_err(|e| format!("cannot read warp file {}: {e}", file.display())),
         };
         let read = text.and_then(|text| WarpFile::parse(&file.display().to_string(), &text));
         match read {
@@ -360,6 +372,8 @@ fn loaded_values(warp: &WarpFile) -> Vec<(&'static str, ParamValue)> {
         .map(|(n, p)| (*n, ParamValue::Vec2(p)))
         .collect();
     values.extend([
+        ("region_min", ParamValue::Vec2(warp.region.min)),
+        ("region_max", ParamValue::Vec2(warp.region.max)),
         ("blend_left", ParamValue::Float(b.left)),
         ("blend_right", ParamValue::Float(b.right)),
         ("blend_top", ParamValue::Float(b.top)),
@@ -375,6 +389,7 @@ fn loaded_values(warp: &WarpFile) -> Vec<(&'static str, ParamValue)> {
 pub fn warp_from(params: &ParamSet, mesh: Option<MeshWarp>) -> WarpFile {
     let corner = |i: usize| params.vec2(CORNERS[i]);
     WarpFile {
+        region: Region { min: params.vec2("region_min"), max: params.vec2("region_max") },
         corners: Corners { top_left: corner(0), top_right: corner(1), bottom_right: corner(2), bottom_left: corner(3) },
         blend: EdgeBlend {
             left: params.float("blend_left"),
@@ -398,6 +413,7 @@ pub fn uniforms(params: &ParamSet, mesh: &MeshWarp) -> WarpUniforms {
         blend: [b.left, b.right, b.top, b.bottom],
         shape: [b.curve, b.gamma, warp.black_lift, if params.bool("grid") { 1.0 } else { 0.0 }],
         grid: [(mesh.columns - 1) as f32, (mesh.rows - 1) as f32, 0.0, 0.0],
+        region: [warp.region.min[0], warp.region.min[1], warp.region.max[0], warp.region.max[1]],
     }
 }
 
@@ -433,7 +449,10 @@ impl Technique for Warp {
         let pinned = self.unpin?.apply([f64::from(view[0]), f64::from(view[1])])?;
         let target = [pinned[0] as f32, pinned[1] as f32];
         let uv = invert_mesh(&self.mesh, target)?;
-        uv.iter().all(|c| (0.0..=1.0).contains(c)).then_some(uv)
+        let (lo, hi) = (self.region.min, self.region.max);
+        uv.iter()
+            .all(|c| (0.0..=1.0).contains(c))
+            .then(|| [lo[0] + uv[0] * (hi[0] - lo[0]), lo[1] + uv[1] * (hi[1] - lo[1])])
     }
 
     fn add_passes<'r>(
@@ -447,7 +466,9 @@ impl Technique for Warp {
         let targets = graph.create_raster_targets("warp", FORMAT, None, self.samples);
         let Some(&source) = inputs.first() else { return targets.color };
         let uniforms = uniforms(params, &self.mesh);
-        self.unpin = warp_from(params, None).corners.homography().inverse();
+        let warp = warp_from(params, None);
+        self.unpin = warp.corners.homography().inverse();
+        self.region = warp.region;
         let this = &*self;
         graph.add_pass("warp/draw").read(source).draws_into(&targets).record(move |ctx| {
             this.record(ctx, source, &targets, &uniforms);
@@ -470,6 +491,7 @@ mod tests {
     fn a_warp_file_round_trips_through_the_parameters() {
         let mut params = ParamSet::new(super::params());
         let warp = WarpFile {
+            region: Region { min: [0.0, 0.1], max: [0.6, 1.0] },
             corners: Corners { top_left: [0.1, 0.95], bottom_right: [0.9, 0.02], ..Default::default() },
             blend: EdgeBlend { right: 0.2, curve: 3.0, gamma: 1.2, ..Default::default() },
             black_lift: 0.03,
