@@ -161,3 +161,60 @@ fn the_show_records_takes_started_and_stopped_over_osc_and_finishes_on_sigterm()
     assert!(!dir.parent().unwrap().join("escape.mp4").exists());
     assert!(frames(&dir.join("encore.mp4")) > 0, "the take stopped by SIGTERM is a complete file:\n{log}");
 }
+
+/// The virtual screen as RGB bytes (ffmpeg's X11 grabber), `size` pixels from the top left.
+fn grab(display: &str, size: (u32, u32)) -> Vec<u8> {
+    let o = Command::new("ffmpeg")
+        .args(["-v", "error", "-f", "x11grab", "-video_size", &format!("{}x{}", size.0, size.1), "-i", display])
+        .args(["-frames:v", "1", "-f", "rawvideo", "-pix_fmt", "rgb24", "-"])
+        .output()
+        .expect("ffmpeg runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    o.stdout
+}
+
+#[test]
+fn projector_outputs_open_their_windows_and_follow_corner_addresses() {
+    let display = VirtualDisplay::start();
+    let dir = std::env::temp_dir().join(format!("indra-outputs-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let port = UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let log = dir.join("show.log");
+    let child = Command::new(env!("CARGO_BIN_EXE_indra"))
+        .args(["--backend", "vulkan", "run", "two_projectors", "--no-midi", "--no-watch"])
+        .args(["--osc", &format!("127.0.0.1:{port}")])
+        .arg("--presets")
+        .arg(dir.join("presets"))
+        .arg("--midi-learn")
+        .arg(dir.join("learn.ron"))
+        .env("INDRA_ROOT", env!("CARGO_MANIFEST_DIR"))
+        .env("DISPLAY", &display.display)
+        .env_remove("WAYLAND_DISPLAY")
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(&log).unwrap())
+        .spawn()
+        .unwrap();
+    let mut show = Show { child, log };
+    show.wait_for("output 1: window");
+    show.wait_for("output 2: window");
+    // Without a window manager every window sits at the top left, the last opened (output 2)
+    // on top. Its warp puts image in the top-left 40×40 pixels; moving corner 0 (top left)
+    // inwards over OSC must leave them black.
+    let lit = |screen: &[u8]| -> u32 {
+        (0..40).flat_map(|y| screen[y * 1280 * 3..(y * 1280 + 40) * 3].iter()).map(|&b| u32::from(b)).sum()
+    };
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while lit(&grab(&display.display, (1280, 720))) == 0 {
+        assert!(Instant::now() < deadline, "output 2 never showed its image");
+        std::thread::sleep(Duration::from_millis(250));
+    }
+    let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let corner = vec![rosc::OscType::Float(0.3), rosc::OscType::Float(0.7)];
+    send(&socket, port, "/indra/output/2/corner/0", corner);
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while lit(&grab(&display.display, (1280, 720))) != 0 {
+        assert!(Instant::now() < deadline, "the corner did not move:\n{}", std::fs::read_to_string(&show.log).unwrap());
+        std::thread::sleep(Duration::from_millis(250));
+    }
+}

@@ -9,9 +9,10 @@ use winit::application::ApplicationHandler;
 use winit::event::{ElementState, KeyEvent, WindowEvent};
 use winit::event_loop::ActiveEventLoop;
 use winit::keyboard::{Key, NamedKey};
-use winit::window::{Fullscreen, Window, WindowId};
+use winit::window::{Window, WindowId};
 
 use super::WindowOptions;
+use super::outputs::{OutputWindow, fullscreen_on};
 use super::panel::{Overlay, draw_ui};
 use crate::assets::Assets;
 use crate::control::{ControlHub, ControlOptions, RecordRequest};
@@ -58,6 +59,8 @@ struct Running {
     video: Option<LiveRecorder>,
     /// Where takes go (`--record-video`, else [`super::DEFAULT_RECORDING`]).
     video_base: std::path::PathBuf,
+    /// The windows of the scene's other outputs (projectors).
+    outputs: Vec<OutputWindow>,
 }
 
 /// The winit handler; creates the window on `resumed`, as winit 0.30 asks.
@@ -167,6 +170,13 @@ impl WindowApp {
             }
         };
         let hub = ControlHub::start(&self.control, instance.scene());
+        let mut outputs = Vec::new();
+        for (i, spec) in instance.scene().outputs.iter().enumerate() {
+            match OutputWindow::open(event_loop, &gpu, &instance.scene().name, i + 1, spec, instance.scene().size) {
+                Ok(output) => outputs.push(output),
+                Err(e) => overlay.report(e),
+            }
+        }
         let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
         let blit = Blit::new(&gpu.device);
         let (egui_state, egui_renderer) = egui_parts(&window, &gpu, format);
@@ -196,6 +206,7 @@ impl WindowApp {
             retry: None,
             waiting_since: None,
             video: None,
+            outputs,
             video_base: self.options.record_video.clone().unwrap_or_else(|| super::DEFAULT_RECORDING.into()),
         })
     }
@@ -225,14 +236,6 @@ fn egui_parts(window: &Window, gpu: &Gpu, format: wgpu::TextureFormat) -> (egui_
     );
     let renderer = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
     (state, renderer)
-}
-
-fn fullscreen_on(event_loop: &ActiveEventLoop, window: &Window, monitor: Option<usize>) -> Fullscreen {
-    let chosen = monitor.and_then(|i| event_loop.available_monitors().nth(i));
-    if monitor.is_some() && chosen.is_none() {
-        log::warn!("no monitor {}; using the window's own", monitor.unwrap_or_default());
-    }
-    Fullscreen::Borderless(chosen.or_else(|| window.current_monitor()))
 }
 
 impl ApplicationHandler for WindowApp {
@@ -266,10 +269,14 @@ impl ApplicationHandler for WindowApp {
         }
     }
 
-    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, id: WindowId, event: WindowEvent) {
         let Some(r) = self.running.as_mut() else {
             return;
         };
+        if id != r.window.id() {
+            r.output_event(event_loop, id, &event);
+            return;
+        }
         let consumed = r.egui_state.on_window_event(&r.window, &event).consumed;
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
@@ -385,6 +392,7 @@ impl Running {
         };
         let target = frame.texture.create_view(&Default::default());
         let size = (self.config.width, self.config.height);
+        let mut projected = Vec::new();
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("window_frame") });
         match self.player.encode(&self.gpu, &mut self.runtime, &mut encoder, size) {
@@ -398,6 +406,12 @@ impl Running {
                 );
                 if let Some(video) = self.video.as_mut() {
                     video.capture(&self.gpu.device, &self.gpu.queue, &mut encoder, &output.view, steps);
+                }
+                for (i, window) in self.outputs.iter_mut().enumerate() {
+                    let Some(Some((_, view))) = output.extras.get(window.number - 1) else { continue };
+                    if let Some(shown) = window.draw(&self.gpu, &mut encoder, view) {
+                        projected.push((i, shown));
+                    }
                 }
                 self.overlay.stats = Some(output.stats);
             }
@@ -426,6 +440,9 @@ impl Running {
         }
         self.window.pre_present_notify();
         self.gpu.queue.present(frame);
+        for (i, shown) in projected {
+            self.outputs[i].present(shown, &self.gpu.queue);
+        }
         self.hub.after_frame(self.player.instance());
         for m in self.player.instance_mut().take_messages() {
             self.overlay.report(m);
@@ -480,6 +497,9 @@ impl Running {
                 // The take's buffers lived on the old device: it ends here, with what it has.
                 self.stop_recording();
                 self.surface.configure(&gpu.device, &self.config);
+                for output in &mut self.outputs {
+                    output.reconfigure(&gpu);
+                }
                 self.runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
                 self.blit = Blit::new(&gpu.device);
                 (self.egui_state, self.egui_renderer) = egui_parts(&self.window, &gpu, self.config.format);
@@ -497,6 +517,22 @@ impl Running {
                 self.retry = Some((trouble, Instant::now() + std::time::Duration::from_secs(1)));
                 false
             }
+        }
+    }
+
+    /// An event of an output window: edit-mode writes go with the panel's; closing one closes
+    /// that output only (the show goes on).
+    fn output_event(&mut self, event_loop: &ActiveEventLoop, id: WindowId, event: &WindowEvent) {
+        let Some(i) = self.outputs.iter().position(|o| o.id() == id) else { return };
+        if matches!(event, WindowEvent::CloseRequested) {
+            let output = self.outputs.remove(i);
+            log::info!("output {} closed; the show goes on", output.number);
+            return;
+        }
+        let node = self.player.instance().scene().outputs.get(self.outputs[i].number - 1).map(|o| o.node);
+        if let Some(node) = node {
+            let events = self.outputs[i].event(event_loop, event, &self.gpu, self.player.instance(), node);
+            self.ui_events.extend(events);
         }
     }
 

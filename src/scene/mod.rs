@@ -9,7 +9,9 @@ mod schema;
 
 pub use error::{SceneError, SceneErrors};
 pub use instance::SceneInstance;
-pub use load::{BoundTrack, Scene, SceneNode, load_scene, parse_scene, parse_value_override, resolve_target};
+pub use load::{
+    BoundTrack, Scene, SceneNode, SceneOutput, load_scene, parse_scene, parse_value_override, resolve_target,
+};
 pub use player::{Player, SeekError};
 pub use schema::{ControlsFile, MidiCurve, MidiMapping, NodeFile, SceneFile, TrackFile, ron_options};
 // The address space lives in `params/`; re-exported for code that reaches it through scenes.
