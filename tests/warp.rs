@@ -297,3 +297,53 @@ fn each_projector_output_matches_its_golden() {
         golden().check(&format!("two_projectors_output{n}"), frame.size, &frame.rgba).unwrap();
     }
 }
+
+#[test]
+fn mesh_points_move_where_the_pointer_puts_them_and_save_with_the_warp() {
+    let gpu = gpu();
+    let dir = common::sandbox("warp-edit");
+    let file = dir.join("wall.ron");
+    let mut node = Node::new(&gpu);
+    let corners =
+        Corners { top_left: [0.1, 0.9], top_right: [0.9, 0.95], bottom_right: [0.95, 0.1], bottom_left: [0.05, 0.0] };
+    set_corners(&mut node, &corners);
+    node.set("file", ParamValue::Text(Text::new(file.to_str().unwrap())));
+    node.step();
+    assert_eq!(node.node.handles().len(), 4, "no mesh: the four corners of the unit square");
+
+    node.set("mesh_size", ParamValue::Vec2([3.0, 3.0]));
+    node.step();
+    let handles = node.node.handles();
+    let warp = WarpFile { corners, ..Default::default() };
+    assert_eq!(handles.len(), 9);
+    let centre = warp.map(0.5, 0.5).unwrap();
+    assert!((handles[4][0] - centre[0] as f32).abs() < 1e-5 && (handles[4][1] - centre[1] as f32).abs() < 1e-5);
+
+    // Drag the centre point to a view position: it lands exactly there, through the pin.
+    node.set("mesh_point", ParamValue::Vec3([4.0, 0.55, 0.42]));
+    node.step();
+    let moved = node.node.handles()[4];
+    assert!((moved[0] - 0.55).abs() < 1e-5 && (moved[1] - 0.42).abs() < 1e-5, "{moved:?}");
+    let image = node.draw(&gpu, &spots());
+    let at = centroid(&image, [0.55 * 256.0, (1.0 - 0.42) * 256.0]);
+    assert!(
+        (at[0] - 0.55 * 256.0).abs() < 0.5 && (at[1] - 0.58 * 256.0).abs() < 0.5,
+        "the source centre shows at {at:?}"
+    );
+
+    node.set("save", ParamValue::Trigger(true));
+    node.step();
+    let saved = WarpFile::parse("wall.ron", &std::fs::read_to_string(&file).unwrap()).unwrap();
+    let mesh = saved.mesh.expect("the edited mesh is saved");
+    assert_eq!((mesh.columns, mesh.rows), (3, 3));
+
+    // A fresh node loading the file shows the same handles and takes the mesh's size.
+    let mut again = Node::new(&gpu);
+    again.set("file", ParamValue::Text(Text::new(file.to_str().unwrap())));
+    again.step();
+    again.step();
+    assert_eq!(again.params.vec2("mesh_size"), [3.0, 3.0]);
+    for (a, b) in again.node.handles().iter().zip(node.node.handles()) {
+        assert!((a[0] - b[0]).abs() < 1e-5 && (a[1] - b[1]).abs() < 1e-5);
+    }
+}

@@ -4,8 +4,9 @@
 //! and saved like any other.
 //!
 //! Keys in an output window: E edit mode on/off (shows the warp's grid), Tab next corner, arrows
-//! nudge the corner by a pixel (Shift: ten), S saves the warp file, F11 fullscreen. In edit mode
-//! a click near a corner picks it and dragging moves it.
+//! nudge the picked corner or mesh point by a pixel (Shift: ten), S saves the warp file, F11
+//! fullscreen. In edit mode a click near a corner or a mesh control point picks it and dragging
+//! moves it; the mesh's density is the warp node's `mesh_size` parameter.
 
 use std::sync::Arc;
 
@@ -19,7 +20,14 @@ use crate::params::{ControlEvent, ParamValue, ParamWrite, Source};
 use crate::scene::{SceneInstance, SceneOutput};
 use crate::techniques::warp::CORNERS;
 
-/// How close (in pixels) a click must be to a corner to pick it.
+/// What edit mode moves: a corner of the pin, or a control point of the mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Pick {
+    Corner(usize),
+    MeshPoint(usize),
+}
+
+/// How close (in pixels) a click must be to a corner or mesh point to pick it.
 const PICK_RADIUS: f32 = 40.0;
 
 /// One output window.
@@ -33,7 +41,7 @@ pub struct OutputWindow {
     blit: Blit,
     /// Edit mode, the picked corner, and whether it is being dragged.
     editing: bool,
-    corner: usize,
+    picked: Pick,
     dragging: bool,
     pointer: [f32; 2],
     modifiers: ModifiersState,
@@ -85,7 +93,7 @@ impl OutputWindow {
             config,
             blit: Blit::new(&gpu.device),
             editing: false,
-            corner: 0,
+            picked: Pick::Corner(0),
             dragging: false,
             pointer: [0.0, 0.0],
             modifiers: ModifiersState::empty(),
@@ -158,15 +166,15 @@ impl OutputWindow {
             WindowEvent::CursorMoved { position, .. } => {
                 self.pointer = [position.x as f32, position.y as f32];
                 if let (true, Some(warp)) = (self.dragging, &warp) {
-                    return vec![warp.write(self.corner, self.view_position())];
+                    return vec![warp.write(self.picked, self.view_position())];
                 }
             }
             WindowEvent::MouseInput { state, button: MouseButton::Left, .. } => {
                 self.dragging = false;
                 if let (ElementState::Pressed, true, Some(warp)) = (state, self.editing, &warp)
-                    && let Some(corner) = self.nearest_corner(instance, warp)
+                    && let Some(picked) = self.nearest(instance, warp)
                 {
-                    self.corner = corner;
+                    self.picked = picked;
                     self.dragging = true;
                 }
             }
@@ -194,8 +202,12 @@ impl OutputWindow {
                 return Vec::new();
             }
             Key::Named(NamedKey::Tab) => {
-                self.corner = (self.corner + 1) % CORNERS.len();
-                log::info!("output {}: corner {} ({}) picked", self.number, self.corner, CORNERS[self.corner]);
+                let next = match self.picked {
+                    Pick::Corner(c) => (c + 1) % CORNERS.len(),
+                    Pick::MeshPoint(_) => 0,
+                };
+                self.picked = Pick::Corner(next);
+                log::info!("output {}: corner {next} ({}) picked", self.number, CORNERS[next]);
                 return Vec::new();
             }
             Key::Named(NamedKey::ArrowLeft) => [-step / w, 0.0],
@@ -212,10 +224,10 @@ impl OutputWindow {
             _ => return Vec::new(),
         };
         match (self.editing, warp) {
-            (true, Some(warp)) => {
-                let at = warp.position(instance, self.corner);
-                vec![warp.write(self.corner, [at[0] + nudge[0], at[1] + nudge[1]])]
-            }
+            (true, Some(warp)) => match warp.position(instance, self.picked) {
+                Some(at) => vec![warp.write(self.picked, [at[0] + nudge[0], at[1] + nudge[1]])],
+                None => Vec::new(),
+            },
             _ => Vec::new(),
         }
     }
@@ -226,19 +238,22 @@ impl OutputWindow {
         [self.pointer[0] / w, 1.0 - self.pointer[1] / h]
     }
 
-    /// The corner within [`PICK_RADIUS`] pixels of the pointer, nearest first.
-    fn nearest_corner(&self, instance: &SceneInstance, warp: &WarpControls) -> Option<usize> {
+    /// The corner or mesh point within [`PICK_RADIUS`] pixels of the pointer, nearest first
+    /// (a corner wins a tie: the pin is what one lines up first).
+    fn nearest(&self, instance: &SceneInstance, warp: &WarpControls) -> Option<Pick> {
         let (w, h) = (self.config.width as f32, self.config.height as f32);
         let pointer = self.view_position();
-        (0..CORNERS.len())
-            .map(|c| {
-                let at = warp.position(instance, c);
+        let mesh_points = instance.handles(warp.node).len();
+        let picks = (0..CORNERS.len()).map(Pick::Corner).chain((0..mesh_points).map(Pick::MeshPoint));
+        picks
+            .filter_map(|pick| {
+                let at = warp.position(instance, pick)?;
                 let (dx, dy) = ((at[0] - pointer[0]) * w, (at[1] - pointer[1]) * h);
-                (c, (dx * dx + dy * dy).sqrt())
+                Some((pick, (dx * dx + dy * dy).sqrt()))
             })
             .filter(|&(_, d)| d <= PICK_RADIUS)
             .min_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(c, _)| c)
+            .map(|(pick, _)| pick)
     }
 }
 
@@ -246,6 +261,7 @@ impl OutputWindow {
 struct WarpControls {
     node: usize,
     corners: [usize; 4],
+    mesh_point: usize,
     grid: usize,
     save: usize,
 }
@@ -259,13 +275,23 @@ impl WarpControls {
         }
         let index = |name: &str| scene_node.params.index(name);
         let [a, b, c, d] = CORNERS.map(index);
-        Some(Self { node, corners: [a?, b?, c?, d?], grid: index("grid")?, save: index("save")? })
+        Some(Self {
+            node,
+            corners: [a?, b?, c?, d?],
+            mesh_point: index("mesh_point")?,
+            grid: index("grid")?,
+            save: index("save")?,
+        })
     }
 
-    fn position(&self, instance: &SceneInstance, corner: usize) -> [f32; 2] {
-        match instance.params(self.node).value_at(self.corners[corner]) {
-            ParamValue::Vec2(v) => v,
-            _ => [0.0, 0.0],
+    /// Where `pick` is now, in view units.
+    fn position(&self, instance: &SceneInstance, pick: Pick) -> Option<[f32; 2]> {
+        match pick {
+            Pick::Corner(c) => match instance.params(self.node).value_at(self.corners[c]) {
+                ParamValue::Vec2(v) => Some(v),
+                _ => None,
+            },
+            Pick::MeshPoint(i) => instance.handles(self.node).get(i).copied(),
         }
     }
 
@@ -273,8 +299,12 @@ impl WarpControls {
         ControlEvent::Write(ParamWrite { node: self.node, param, component: None, value, source: Source::Ui })
     }
 
-    fn write(&self, corner: usize, at: [f32; 2]) -> ControlEvent {
-        self.set(self.corners[corner], ParamValue::Vec2(at))
+    /// Moves `pick` to `at` (view units).
+    fn write(&self, pick: Pick, at: [f32; 2]) -> ControlEvent {
+        match pick {
+            Pick::Corner(c) => self.set(self.corners[c], ParamValue::Vec2(at)),
+            Pick::MeshPoint(i) => self.set(self.mesh_point, ParamValue::Vec3([i as f32, at[0], at[1]])),
+        }
     }
 }
 

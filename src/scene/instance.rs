@@ -79,6 +79,11 @@ impl SceneInstance {
         self.scene.tracks.iter().any(|t| t.node == node && t.param == param)
     }
 
+    /// Points of node `node` a performer may drag (see [`Technique::handles`]).
+    pub fn handles(&self, node: usize) -> Vec<[f32; 2]> {
+        self.nodes.get(node).map_or_else(Vec::new, |n| n.handles())
+    }
+
     /// Applies control events in order; they take effect from the next step.
     pub fn apply(&mut self, events: &[ControlEvent]) {
         for event in events {

@@ -140,6 +140,12 @@ pub trait Technique {
         Vec::new()
     }
 
+    /// Points of this node a performer may drag in an output window (a warp's mesh control
+    /// points), in view units; their order is the index the node's edit parameters take.
+    fn handles(&self) -> Vec<[f32; 2]> {
+        Vec::new()
+    }
+
     /// Things to tell the performer since the last call (e.g. "the cloth blew up and was reset").
     fn take_messages(&mut self) -> Vec<String> {
         Vec::new()

@@ -11,7 +11,7 @@
 use std::cell::RefCell;
 use std::path::PathBuf;
 
-use crate::geometry::warp::{Corners, EdgeBlend, Homography, MeshWarp, Region, WarpFile};
+use crate::geometry::warp::{Corners, EdgeBlend, Homography, MAX_MESH_SIDE, MeshWarp, Region, WarpFile};
 use crate::gpu::{BindGroupCache, GrowableBuffer, RasterDesc, ShaderError, uniform_buffer, uniform_entry};
 use crate::graph::{FrameGraph, PassContext, RasterTargets, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue};
@@ -77,6 +77,18 @@ pub fn params() -> Vec<ParamDecl> {
             "black raised outside the blend zones to match the overlap",
         ),
         ParamDecl::new("grid", Bool(false), None, "draw the mesh and its control points (for lining up)"),
+        ParamDecl::new(
+            "mesh_size",
+            Vec2([2.0, 2.0]),
+            Some((2.0, MAX_MESH_SIDE as f32)),
+            "mesh control points across and up; a change resamples the mesh's shape",
+        ),
+        ParamDecl::new(
+            "mesh_point",
+            Vec3([-1.0, 0.0, 0.0]),
+            Some((-1.0, 1024.0)),
+            "move mesh point (index, x, y): x, y in view units (an output window's edit mode writes it)",
+        ),
         ParamDecl::text("file", "", "warp file (RON) to load corners, blend and mesh from; empty: none"),
         ParamDecl::trigger("reload", "read the warp file again"),
         ParamDecl::trigger("save", "write the live corners, blend and mesh to the warp file"),
@@ -128,6 +140,12 @@ pub struct Warp {
     unpin: Option<Homography>,
     /// The part of the source shown in the last frame, for the pointer.
     region: Region,
+    /// The `mesh_size` last applied (the loaded mesh's after a file load).
+    applied_size: [u32; 2],
+    /// The `mesh_point` last applied, so each write moves its point once.
+    applied_point: [f32; 3],
+    /// The corner pin of the last step (mesh handles and `mesh_point` are in view units).
+    pin: Homography,
     /// The file path last loaded (or tried), so a bad path is reported once.
     requested: Option<String>,
     /// Values read from the file, for the scene to set (see [`Technique::take_loaded_values`]).
@@ -227,6 +245,9 @@ impl Warp {
             root: setup.assets.root().map(std::path::Path::to_path_buf),
             mesh: MeshWarp::regular(2, 2),
             unpin: None,
+            applied_size: [2, 2],
+            applied_point: [-1.0, 0.0, 0.0],
+            pin: Corners::default().homography(),
             region: Region::default(),
             requested: None,
             loaded: Vec::new(),
@@ -261,8 +282,11 @@ impl Warp {
         match read {
             Ok(warp) => {
                 self.mesh = warp.mesh.clone().unwrap_or_else(|| MeshWarp::regular(2, 2));
+                self.applied_size = [self.mesh.columns, self.mesh.rows];
                 self.upload_mesh();
                 self.loaded = loaded_values(&warp);
+                let size = [self.mesh.columns as f32, self.mesh.rows as f32];
+                self.loaded.push(("mesh_size", ParamValue::Vec2(size)));
             }
             Err(e) => self.messages.push(format!("{e}; keeping the last good warp")),
         }
@@ -279,6 +303,35 @@ impl Warp {
         match crate::atomic_file::write(&file, warp.to_ron().as_bytes()) {
             Ok(()) => self.messages.push(format!("warp saved to {}", file.display())),
             Err(e) => self.messages.push(format!("cannot save the warp to {}: {e}", file.display())),
+        }
+    }
+
+    /// Applies `mesh_size` (resampling the mesh's shape to the new grid) and `mesh_point` (one
+    /// control point moved to a view position, through the inverse corner pin) when they change.
+    fn edit_mesh(&mut self, params: &ParamSet) {
+        let size = params.vec2("mesh_size").map(|v| (v.round() as u32).clamp(2, MAX_MESH_SIDE));
+        let mut changed = false;
+        if size != self.applied_size {
+            let regular = MeshWarp::regular(size[0], size[1]);
+            let points = regular.points.iter().map(|p| self.mesh.evaluate(p[0], p[1])).collect();
+            self.mesh = MeshWarp { points, interpolation: self.mesh.interpolation, ..regular };
+            self.applied_size = size;
+            changed = true;
+        }
+        let ParamValue::Vec3(point) = params.get("mesh_point") else { return };
+        if point != self.applied_point {
+            self.applied_point = point;
+            let index = point[0].round();
+            let target = self.pin.inverse().and_then(|h| h.apply([f64::from(point[1]), f64::from(point[2])]));
+            if let (Some(slot), Some(at)) = (self.mesh.points.get_mut(index.max(0.0) as usize), target)
+                && index >= 0.0
+            {
+                *slot = [at[0] as f32, at[1] as f32];
+                changed = true;
+            }
+        }
+        if changed {
+            self.upload_mesh();
         }
     }
 
@@ -419,6 +472,10 @@ pub fn uniforms(params: &ParamSet, mesh: &MeshWarp) -> WarpUniforms {
 
 impl Technique for Warp {
     fn step(&mut self, params: &ParamSet, _time: &FrameTime) {
+        // Edits first: a file loaded in this step replaces the mesh, and its size reaches the
+        // parameters only after the step.
+        self.pin = warp_from(params, None).corners.homography();
+        self.edit_mesh(params);
         let ParamValue::Text(path) = params.get("file") else { return };
         let path = path.as_str().trim().to_string();
         let changed = self.requested.as_deref() != Some(path.as_str());
@@ -427,12 +484,19 @@ impl Technique for Warp {
         }
         if changed && path.is_empty() && self.requested.is_some() {
             self.mesh = MeshWarp::regular(2, 2);
+            self.applied_size = [2, 2];
+            self.loaded.push(("mesh_size", ParamValue::Vec2([2.0, 2.0])));
             self.upload_mesh();
         }
         self.requested = Some(path.clone());
         if params.fired("save") {
             self.save(&path, params);
         }
+    }
+
+    fn handles(&self) -> Vec<[f32; 2]> {
+        let view = |p: &[f32; 2]| self.pin.apply([f64::from(p[0]), f64::from(p[1])]);
+        self.mesh.points.iter().filter_map(view).map(|v| [v[0] as f32, v[1] as f32]).collect()
     }
 
     fn take_loaded_values(&mut self) -> Vec<(&'static str, ParamValue)> {
