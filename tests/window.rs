@@ -16,8 +16,11 @@ struct VirtualDisplay {
 
 impl VirtualDisplay {
     fn start() -> Self {
+        // Tests run in parallel in one process: each call takes its own range of numbers.
+        static CALLS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+        let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
         for attempt in 0..20 {
-            let number = 150 + (std::process::id() % 300) + attempt * 7;
+            let number = 1000 + (std::process::id() % 30_000) + call * 50 + attempt;
             let socket = format!("/tmp/.X11-unix/X{number}");
             if Path::new(&socket).exists() {
                 continue;
@@ -30,8 +33,13 @@ impl VirtualDisplay {
                 .expect("Xvfb runs (tools/setup-system test installs xvfb)");
             let deadline = Instant::now() + Duration::from_secs(10);
             while Instant::now() < deadline {
+                // The socket is ours only if our server is still running (a lost race exits).
                 if Path::new(&socket).exists() {
-                    return Self { server, display: format!(":{number}") };
+                    std::thread::sleep(Duration::from_millis(200));
+                    if let Ok(None) = server.try_wait() {
+                        return Self { server, display: format!(":{number}") };
+                    }
+                    break;
                 }
                 if let Ok(Some(_)) = server.try_wait() {
                     break;
