@@ -4,9 +4,8 @@
 mod common;
 
 use common::{assets, golden, gpu, render_scene};
-use half::f16;
-use indra::gpu::{Gpu, read_texture_bytes};
-use indra::graph::{FrameGraph, GraphRuntime, PersistentTexture};
+use indra::gpu::Gpu;
+use indra::graph::{FrameGraph, GraphRuntime};
 use indra::params::ParamSet;
 use indra::scene::load_scene;
 use indra::techniques::{NodeSetup, star_glow};
@@ -24,14 +23,7 @@ fn glow(gpu: &Gpu, source: &[[f32; 4]], settings: &[(&str, &str)]) -> Vec<[f32; 
         let i = params.index(name).unwrap();
         params.set_at(i, indra::scene::parse_value_override(value, &params.decls()[i]).unwrap());
     }
-    let texture = PersistentTexture::new(&gpu.device, "test_source", SIZE, star_glow::FORMAT);
-    let bytes: Vec<u8> = source.iter().flatten().flat_map(|&x| f16::from_f32(x).to_le_bytes()).collect();
-    gpu.queue.write_texture(
-        texture.texture.as_image_copy(),
-        &bytes,
-        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(SIZE.0 * 8), rows_per_image: Some(SIZE.1) },
-        texture.texture.size(),
-    );
+    let texture = common::float_texture(gpu, SIZE, source);
     let mut runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
     let mut graph = FrameGraph::new(SIZE);
     let input = graph.import_texture("source", &texture);
@@ -41,11 +33,7 @@ fn glow(gpu: &Gpu, source: &[[f32; 4]], settings: &[(&str, &str)]) -> Vec<[f32; 
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let frame = runtime.execute(&gpu.device, &gpu.queue, graph, &mut encoder).unwrap();
     gpu.queue.submit([encoder.finish()]);
-    read_texture_bytes(&gpu.device, &gpu.queue, &frame.texture)
-        .unwrap()
-        .chunks_exact(8)
-        .map(|t| std::array::from_fn(|c| f16::from_le_bytes([t[2 * c], t[2 * c + 1]]).to_f32()))
-        .collect()
+    common::read_float_texture(gpu, &frame.texture)
 }
 
 fn single_texel(at: (u32, u32), value: f32) -> Vec<[f32; 4]> {

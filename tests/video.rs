@@ -2,6 +2,8 @@
 //! scene's frame rate, and a missing ffmpeg is one sentence. Needs `ffmpeg` and `ffprobe`
 //! (tools/setup-system installs them).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -166,17 +168,7 @@ fn a_missing_ffmpeg_or_encoder_is_one_sentence_before_any_frame() {
 
 /// A float texture of one colour, as a node's output would be.
 fn solid(gpu: &indra::gpu::Gpu, size: (u32, u32), level: f32) -> wgpu::Texture {
-    let texture = indra::graph::PersistentTexture::new(&gpu.device, "source", size, wgpu::TextureFormat::Rgba16Float);
-    let texel: Vec<u8> =
-        [level, level, level, 1.0].iter().flat_map(|&x| half::f16::from_f32(x).to_le_bytes()).collect();
-    let bytes = texel.repeat((size.0 * size.1) as usize);
-    gpu.queue.write_texture(
-        texture.texture.as_image_copy(),
-        &bytes,
-        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(size.0 * 8), rows_per_image: Some(size.1) },
-        texture.texture.size(),
-    );
-    texture.texture
+    common::float_texture(gpu, size, &vec![[level, level, level, 1.0]; (size.0 * size.1) as usize]).texture
 }
 
 fn live_settings(path: &Path, size: (u32, u32)) -> indra::offscreen::VideoSettings {
@@ -185,11 +177,7 @@ fn live_settings(path: &Path, size: (u32, u32)) -> indra::offscreen::VideoSettin
 
 #[test]
 fn a_live_recording_writes_each_shown_frame_for_every_step_it_advanced() {
-    let gpu = indra::gpu::Gpu::headless(&indra::gpu::GpuOptions {
-        backend: indra::gpu::BackendChoice::Vulkan,
-        adapter: None,
-    })
-    .unwrap();
+    let gpu = common::gpu();
     let dir = temp_dir("live");
     let path = dir.join("show.mp4");
     let size = (64, 48);
@@ -252,11 +240,7 @@ fn a_live_recording_writes_each_shown_frame_for_every_step_it_advanced() {
 
 #[test]
 fn frames_a_busy_readback_cannot_take_are_counted_not_lost_silently() {
-    let gpu = indra::gpu::Gpu::headless(&indra::gpu::GpuOptions {
-        backend: indra::gpu::BackendChoice::Vulkan,
-        adapter: None,
-    })
-    .unwrap();
+    let gpu = common::gpu();
     let dir = temp_dir("busy");
     let path = dir.join("show.mkv");
     let size = (32, 32);

@@ -5,10 +5,9 @@
 mod common;
 
 use common::{assets, golden, gpu, render_named};
-use half::f16;
 use indra::geometry::warp::{Corners, MeshWarp, WarpFile};
-use indra::gpu::{Gpu, read_texture_bytes};
-use indra::graph::{FrameGraph, GraphRuntime, PersistentTexture};
+use indra::gpu::Gpu;
+use indra::graph::{FrameGraph, GraphRuntime};
 use indra::params::{ParamSet, ParamValue, Text};
 use indra::techniques::{NodeSetup, Technique, warp};
 use indra::time::FrameTime;
@@ -47,14 +46,7 @@ impl Node {
 
     /// Warps `source` (RGBA, linear, SIZE) and returns the output's RGBA in linear light.
     fn draw(&mut self, gpu: &Gpu, source: &[[f32; 4]]) -> Vec<[f32; 4]> {
-        let texture = PersistentTexture::new(&gpu.device, "test_source", SIZE, warp::FORMAT);
-        let bytes: Vec<u8> = source.iter().flatten().flat_map(|&x| f16::from_f32(x).to_le_bytes()).collect();
-        gpu.queue.write_texture(
-            texture.texture.as_image_copy(),
-            &bytes,
-            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(SIZE.0 * 8), rows_per_image: Some(SIZE.1) },
-            texture.texture.size(),
-        );
+        let texture = common::float_texture(gpu, SIZE, source);
         let mut runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
         let mut graph = FrameGraph::new(SIZE);
         let input = graph.import_texture("source", &texture);
@@ -63,11 +55,7 @@ impl Node {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let frame = runtime.execute(&gpu.device, &gpu.queue, graph, &mut encoder).unwrap();
         gpu.queue.submit([encoder.finish()]);
-        read_texture_bytes(&gpu.device, &gpu.queue, &frame.texture)
-            .unwrap()
-            .chunks_exact(8)
-            .map(|t| std::array::from_fn(|c| f16::from_le_bytes([t[2 * c], t[2 * c + 1]]).to_f32()))
-            .collect()
+        common::read_float_texture(gpu, &frame.texture)
     }
 }
 

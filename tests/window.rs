@@ -67,6 +67,30 @@ struct Show {
 }
 
 impl Show {
+    /// Starts `indra run <scene> <args>` on `display`, with OSC on a free loopback port and its
+    /// presets, learn file and log in `dir`. Returns the show and its OSC port.
+    fn start(display: &VirtualDisplay, dir: &Path, scene: &str, args: &[&std::ffi::OsStr]) -> (Self, u16) {
+        let port = UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+        let log = dir.join("show.log");
+        let child = Command::new(env!("CARGO_BIN_EXE_indra"))
+            .args(["--backend", "vulkan", "run", scene, "--no-midi", "--no-watch"])
+            .args(["--osc", &format!("127.0.0.1:{port}")])
+            .args(args)
+            .arg("--presets")
+            .arg(dir.join("presets"))
+            .arg("--midi-learn")
+            .arg(dir.join("learn.ron"))
+            .env("INDRA_ROOT", env!("CARGO_MANIFEST_DIR"))
+            .env("DISPLAY", &display.display)
+            .env_remove("WAYLAND_DISPLAY")
+            .env("RUST_LOG", "info")
+            .stdout(Stdio::null())
+            .stderr(std::fs::File::create(&log).unwrap())
+            .spawn()
+            .unwrap();
+        (Self { child, log }, port)
+    }
+
     /// Waits (at most 90 s: debug build on lavapipe) until the log holds `text`; returns the log.
     fn wait_for(&mut self, text: &str) -> String {
         let deadline = Instant::now() + Duration::from_secs(90);
@@ -114,25 +138,8 @@ fn the_show_records_takes_started_and_stopped_over_osc_and_finishes_on_sigterm()
     let dir = std::env::temp_dir().join(format!("indra-window-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let port = UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
-    let log = dir.join("show.log");
-    let child = Command::new(env!("CARGO_BIN_EXE_indra"))
-        .args(["--backend", "vulkan", "run", "star_glow", "--no-midi", "--no-watch"])
-        .args(["--osc", &format!("127.0.0.1:{port}"), "--record-video"])
-        .arg(dir.join("show.mp4"))
-        .arg("--presets")
-        .arg(dir.join("presets"))
-        .arg("--midi-learn")
-        .arg(dir.join("learn.ron"))
-        .env("INDRA_ROOT", env!("CARGO_MANIFEST_DIR"))
-        .env("DISPLAY", &display.display)
-        .env_remove("WAYLAND_DISPLAY")
-        .env("RUST_LOG", "info")
-        .stdout(Stdio::null())
-        .stderr(std::fs::File::create(&log).unwrap())
-        .spawn()
-        .unwrap();
-    let mut show = Show { child, log };
+    let video = dir.join("show.mp4");
+    let (mut show, port) = Show::start(&display, &dir, "star_glow", &["--record-video".as_ref(), video.as_os_str()]);
     let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
 
     show.wait_for("recording to");
@@ -187,23 +194,7 @@ fn projector_outputs_open_their_windows_and_follow_corner_addresses() {
     let dir = std::env::temp_dir().join(format!("indra-outputs-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let port = UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
-    let log = dir.join("show.log");
-    let child = Command::new(env!("CARGO_BIN_EXE_indra"))
-        .args(["--backend", "vulkan", "run", "two_projectors", "--no-midi", "--no-watch"])
-        .args(["--osc", &format!("127.0.0.1:{port}")])
-        .arg("--presets")
-        .arg(dir.join("presets"))
-        .arg("--midi-learn")
-        .arg(dir.join("learn.ron"))
-        .env("INDRA_ROOT", env!("CARGO_MANIFEST_DIR"))
-        .env("DISPLAY", &display.display)
-        .env_remove("WAYLAND_DISPLAY")
-        .stdout(Stdio::null())
-        .stderr(std::fs::File::create(&log).unwrap())
-        .spawn()
-        .unwrap();
-    let mut show = Show { child, log };
+    let (mut show, port) = Show::start(&display, &dir, "two_projectors", &[]);
     show.wait_for("output 1: window");
     show.wait_for("output 2: window");
     // Without a window manager every window sits at the top left, the last opened (output 2)

@@ -34,6 +34,29 @@ pub fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bo
     }
 }
 
+/// The two layout entries of a filtered 2-D float texture at `binding` and its sampler at
+/// `binding + 1` (how a node samples an upstream node's image).
+pub fn sampled_texture_entries(binding: u32, visibility: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 2] {
+    [
+        wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        },
+        wgpu::BindGroupLayoutEntry {
+            binding: binding + 1,
+            visibility,
+            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            count: None,
+        },
+    ]
+}
+
 /// A buffer for one uniform block of `T`, written with `queue.write_buffer`.
 pub fn uniform_buffer<T>(device: &wgpu::Device, label: &str) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {

@@ -7,6 +7,21 @@ pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 const SOURCE: &str = include_str!("../../shaders/display.wgsl");
 
+/// A texture of [`DISPLAY_FORMAT`] that a blit draws into and that can be copied out (the
+/// image a render or a recording reads back).
+pub fn display_target(device: &wgpu::Device, label: &str, size: (u32, u32)) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: DISPLAY_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
 /// Where a blit draws: a render-target view of `format` and `size`.
 pub struct BlitTarget<'a> {
     /// The view to draw into.

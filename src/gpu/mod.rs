@@ -13,8 +13,10 @@ mod readback;
 mod shader;
 mod watchdog;
 
-pub use binding::{check_bindings, storage_entry, uniform_buffer, uniform_entry, wgsl_struct_size};
-pub use blit::{Blit, BlitTarget, DISPLAY_FORMAT};
+pub use binding::{
+    check_bindings, sampled_texture_entries, storage_entry, uniform_buffer, uniform_entry, wgsl_struct_size,
+};
+pub use blit::{Blit, BlitTarget, DISPLAY_FORMAT, display_target};
 pub use cache::{BindGroupCache, DEFAULT_MAX_AGE};
 pub use compute::ComputeKernel;
 pub use context::{BackendChoice, Gpu, GpuError, GpuOptions, instance_descriptor};

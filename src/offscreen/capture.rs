@@ -116,16 +116,7 @@ impl LiveRecorder {
             .name("indra-video".into())
             .spawn(move || encode(writer, receiver))
             .map_err(|e| VideoError::Settings(format!("cannot start the encoder thread: {e}")))?;
-        let target = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("capture_target"),
-            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DISPLAY_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let target = crate::gpu::display_target(device, "capture_target", size);
         let target_view = target.create_view(&Default::default());
         let padded_row = (size.0 * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let slots = (0..in_flight.max(1))

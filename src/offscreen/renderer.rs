@@ -191,16 +191,7 @@ impl OffscreenRenderer {
 
 /// The texture a frame is encoded into for readback.
 fn display_target(gpu: &Gpu, size: (u32, u32)) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("offscreen_target"),
-        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: DISPLAY_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    })
+    crate::gpu::display_target(&gpu.device, "offscreen_target", size)
 }
 
 /// Why an off-screen frame could not be produced; each is one sentence for the user.

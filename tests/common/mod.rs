@@ -61,3 +61,27 @@ pub fn sandbox(name: &str) -> std::path::PathBuf {
     }
     root
 }
+
+/// A `Rgba16Float` texture of `size` holding `texels` (linear RGBA, row by row from the top), as
+/// an upstream node's output would be.
+pub fn float_texture(gpu: &Gpu, size: (u32, u32), texels: &[[f32; 4]]) -> indra::graph::PersistentTexture {
+    let texture =
+        indra::graph::PersistentTexture::new(&gpu.device, "test_source", size, wgpu::TextureFormat::Rgba16Float);
+    let bytes: Vec<u8> = texels.iter().flatten().flat_map(|&x| half::f16::from_f32(x).to_le_bytes()).collect();
+    gpu.queue.write_texture(
+        texture.texture.as_image_copy(),
+        &bytes,
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(size.0 * 8), rows_per_image: Some(size.1) },
+        texture.texture.size(),
+    );
+    texture
+}
+
+/// Reads a `Rgba16Float` texture back as linear RGBA texels.
+pub fn read_float_texture(gpu: &Gpu, texture: &wgpu::Texture) -> Vec<[f32; 4]> {
+    indra::gpu::read_texture_bytes(&gpu.device, &gpu.queue, texture)
+        .unwrap()
+        .chunks_exact(8)
+        .map(|t| std::array::from_fn(|c| half::f16::from_le_bytes([t[2 * c], t[2 * c + 1]]).to_f32()))
+        .collect()
+}

@@ -111,29 +111,10 @@ impl Tessellation {
             entries: &[crate::gpu::uniform_entry::<TessUniforms>(0, all)],
         });
         let read = wgpu::ShaderStages::VERTEX | compute;
+        let [texture, sampler] = crate::gpu::sampled_texture_entries(0, read);
         let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("tessellation_draw_layout"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: read,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: read,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-                storage(2, read, true),
-                storage(3, read, true),
-                storage(4, read, true),
-            ],
+            entries: &[texture, sampler, storage(2, read, true), storage(3, read, true), storage(4, read, true)],
         });
         let boundary_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("tessellation_boundary_layout"),

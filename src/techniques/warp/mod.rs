@@ -163,31 +163,13 @@ impl Warp {
         let device = &setup.gpu.device;
         let (origin, source) = setup.shader_source("warp.wgsl", &[("u", 0)])?;
         let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
-        let fragment = wgpu::ShaderStages::FRAGMENT;
         let uniform_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("warp_uniforms"),
             entries: &[uniform_entry::<WarpUniforms>(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
         });
         let source_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("warp_source"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: fragment,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: fragment,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
+            entries: &crate::gpu::sampled_texture_entries(0, wgpu::ShaderStages::FRAGMENT),
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("warp"),
