@@ -40,9 +40,10 @@ fn send_and_route(scene: &Scene, packets: &[Vec<u8>]) -> (Vec<Routed>, OscReceiv
     for p in packets {
         tx.send_to(p, rx.local_addr()).unwrap();
     }
-    let router = OscRouter::new(scene);
+    let mut router = OscRouter::new(scene);
     let batches = receive(&mut rx, packets.len() as u64);
-    let routed = batches.iter().flat_map(|b| &b.messages).filter_map(|m| router.route(m, scene, &rx)).collect();
+    router.begin_frame();
+    let routed = batches.iter().flat_map(|b| &b.messages).flat_map(|m| router.route_all(m, scene, &rx)).collect();
     (routed, rx)
 }
 
@@ -442,4 +443,68 @@ fn stats_are_answered_over_osc() {
     // packets, messages, malformed, unknown address, bad arguments, applied
     assert_eq!(m.args[..3], [OscType::Long(2), OscType::Long(1), OscType::Long(1)]);
     let _ = receive(&mut rx, 2);
+}
+
+/// The (node id, parameter name) each routed write goes to.
+fn written(scene: &Scene, routed: &[Routed]) -> Vec<(String, String)> {
+    routed
+        .iter()
+        .map(|r| match r {
+            Routed::Event(ControlEvent::Write(w)) => {
+                let node = &scene.nodes[w.node];
+                (node.id.clone(), node.params.decls()[w.param].name.clone())
+            }
+            other => panic!("not a write: {other:?}"),
+        })
+        .collect()
+}
+
+#[test]
+fn address_patterns_reach_every_parameter_they_match_and_no_command() {
+    let s = scene("two_projectors");
+    let pairs = |list: &[(&str, &str)]| list.iter().map(|(n, p)| (n.to_string(), p.to_string())).collect::<Vec<_>>();
+    let (routed, rx) = send_and_route(&s, &[packet("/indra/output{1,2}/blend_curve", vec![OscType::Float(3.0)])]);
+    assert_eq!(written(&s, &routed), pairs(&[("output1", "blend_curve"), ("output2", "blend_curve")]));
+    assert!(routed.iter().all(|r| write_value(r) == ParamValue::Float(3.0)));
+    assert_eq!(rx.counters().applied.load(std::sync::atomic::Ordering::Relaxed), 1);
+
+    let (routed, _) =
+        send_and_route(&s, &[packet("/indra/output?/corner_t[lr]", vec![OscType::Float(0.5), OscType::Float(0.5)])]);
+    assert_eq!(
+        written(&s, &routed),
+        pairs(&[
+            ("output1", "corner_tl"),
+            ("output1", "corner_tr"),
+            ("output2", "corner_tl"),
+            ("output2", "corner_tr")
+        ])
+    );
+    // An alias and a default address of one parameter are one write.
+    let (routed, _) =
+        send_and_route(&s, &[packet("/indra/output/*/corner/0", vec![OscType::Float(0.1), OscType::Float(0.9)])]);
+    assert_eq!(written(&s, &routed), pairs(&[("output1", "corner_tl"), ("output2", "corner_tl")]));
+
+    let (routed, rx) = send_and_route(
+        &s,
+        &[
+            packet("/indra/record/*", vec![]),
+            packet("/indra/preset/*", vec![OscType::String("a".into())]),
+            packet("/indra/[", vec![OscType::Float(1.0)]),
+            packet("/indra/*/blend_curve", vec![OscType::String("steep".into())]),
+        ],
+    );
+    assert!(routed.is_empty(), "patterns never reach commands: {routed:?}");
+    let counters = rx.counters().snapshot();
+    assert_eq!((counters[3], counters[4]), (3, 1), "3 unknown, 1 with bad arguments: {counters:?}");
+}
+
+#[test]
+fn a_flood_of_new_patterns_costs_a_bounded_amount_per_frame() {
+    let s = scene("two_projectors");
+    let packets: Vec<Vec<u8>> =
+        (0..100).map(|i| packet(&format!("/indra/output{{1,x{i}}}/blend_curve"), vec![OscType::Float(2.5)])).collect();
+    let (routed, rx) = send_and_route(&s, &packets);
+    let new_patterns = indra::control::osc::NEW_PATTERNS_PER_FRAME;
+    assert_eq!(routed.len(), new_patterns, "each routed pattern reaches output1 once");
+    assert_eq!(rx.counters().snapshot()[3], (100 - new_patterns) as u64, "the rest are counted");
 }

@@ -1,6 +1,9 @@
 //! Where an OSC address leads: a parameter (or one component of it) or an engine command.
 //! Every parameter answers at `/indra/<node>/<param>`, vector components at
 //! `/indra/<node>/<param>/<x|y|z|w>` (colours also `r g b a`), plus the scene's aliases.
+//! An incoming address may be an OSC address pattern (`*`, `?`, `[a-z]`, `{a,b}`): it reaches
+//! every parameter address it matches (rosc's matcher), never a command — `/indra/record/*` must
+//! not start and stop a recording at once.
 
 use std::collections::HashMap;
 
@@ -75,6 +78,29 @@ impl AddressMap {
         self.routes.get(address).copied()
     }
 
+    /// Every parameter (or component) whose address matches OSC address pattern `pattern`, in
+    /// address order (so the writes, and a recording of them, are the same every time).
+    pub fn route_pattern(&self, pattern: &str) -> Result<Vec<Target>, String> {
+        let matcher = rosc::address::Matcher::new(pattern).map_err(|e| format!("{pattern}: {e}"))?;
+        let mut matched: Vec<(&String, Target)> = self
+            .routes
+            .iter()
+            .filter_map(|(address, route)| match route {
+                Route::Param(t) => Some((address, *t)),
+                Route::Command(_) => None,
+            })
+            .filter(|(address, _)| {
+                rosc::address::OscAddress::new((*address).clone()).is_ok_and(|a| matcher.match_address(&a))
+            })
+            .collect();
+        matched.sort_by(|a, b| a.0.cmp(b.0));
+        let mut targets: Vec<Target> = matched.into_iter().map(|(_, t)| t).collect();
+        // An alias and the default address of one parameter are one write.
+        let mut seen = std::collections::HashSet::new();
+        targets.retain(|t| seen.insert(*t));
+        Ok(targets)
+    }
+
     /// Number of addresses.
     pub fn len(&self) -> usize {
         self.routes.len()
@@ -84,6 +110,11 @@ impl AddressMap {
     pub fn is_empty(&self) -> bool {
         self.routes.is_empty()
     }
+}
+
+/// Whether `address` is an OSC address pattern rather than a plain address.
+pub fn is_pattern(address: &str) -> bool {
+    address.contains(['*', '?', '[', ']', '{', '}'])
 }
 
 /// `/indra/<node>/<param>`.

@@ -147,15 +147,17 @@ impl ControlHub {
         let mut events = Vec::new();
         let scene = instance.scene();
         let batches = self.osc.as_mut().map(|o| o.drain(SystemTime::now())).unwrap_or_default();
+        self.router.begin_frame();
         for batch in batches {
             for msg in &batch.messages {
                 let Some(osc) = self.osc.as_ref() else { break };
-                match self.router.route(msg, scene, osc) {
-                    Some(Routed::Event(e)) => events.push(e),
-                    Some(Routed::SavePreset(name)) => self.save_preset(&name, instance),
-                    Some(Routed::RecallPreset(name, s)) => events.extend(self.recall(&name, s, scene)),
-                    Some(Routed::Record(request)) => self.record_requests.push(request),
-                    None => {}
+                for routed in self.router.route_all(msg, scene, osc) {
+                    match routed {
+                        Routed::Event(e) => events.push(e),
+                        Routed::SavePreset(name) => self.save_preset(&name, instance),
+                        Routed::RecallPreset(name, s) => events.extend(self.recall(&name, s, scene)),
+                        Routed::Record(request) => self.record_requests.push(request),
+                    }
                 }
             }
         }

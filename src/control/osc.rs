@@ -13,8 +13,8 @@ use std::time::{Duration, SystemTime};
 
 use rosc::{OscMessage, OscPacket, OscType};
 
-use super::address::{AddressMap, Command, Route};
-use crate::params::{ControlEvent, ParamDecl, ParamType, ParamValue, ParamWrite, Source};
+use super::address::{AddressMap, Command, Route, is_pattern};
+use crate::params::{ControlEvent, ParamDecl, ParamType, ParamValue, ParamWrite, Source, Target};
 use crate::scene::Scene;
 
 /// What went in and what was rejected, shared between the receiver thread and the render loop.
@@ -317,18 +317,68 @@ pub enum RecordRequest {
     Stop,
 }
 
+/// Distinct address patterns whose matches are remembered (a controller repeats its patterns;
+/// a flood of new ones only ever costs this much memory).
+const PATTERN_CACHE: usize = 256;
+
+/// New address patterns matched per frame: each is compared with every address of the scene,
+/// so a flood of distinct patterns must not stall the render loop. The rest are counted unknown.
+pub const NEW_PATTERNS_PER_FRAME: usize = 64;
+
 /// Translates messages into control events against one scene's address map.
 pub struct OscRouter {
     map: AddressMap,
+    /// Pattern → the parameters it matched (None: not a valid pattern).
+    patterns: std::collections::HashMap<String, Option<Vec<Target>>>,
+    /// New patterns matched since [`OscRouter::begin_frame`].
+    new_patterns: usize,
 }
 
 impl OscRouter {
     /// A router for `scene`.
     pub fn new(scene: &Scene) -> Self {
-        Self { map: AddressMap::new(scene) }
+        Self { map: AddressMap::new(scene), patterns: Default::default(), new_patterns: 0 }
     }
 
-    /// Routes one message; rejected ones bump a counter and are logged once per kind.
+    /// Starts a frame's routing (resets the budget of new patterns).
+    pub fn begin_frame(&mut self) {
+        self.new_patterns = 0;
+    }
+
+    /// Routes one message — to every parameter it matches when its address is a pattern;
+    /// rejected ones bump a counter and are logged once per kind.
+    pub fn route_all(&mut self, msg: &OscMessage, scene: &Scene, rx: &OscReceiver) -> Vec<Routed> {
+        if !is_pattern(&msg.addr) {
+            return self.route(msg, scene, rx).into_iter().collect();
+        }
+        let counters = rx.counters();
+        if !self.patterns.contains_key(&msg.addr) {
+            if self.new_patterns >= NEW_PATTERNS_PER_FRAME {
+                counters.unknown_address.fetch_add(1, Ordering::Relaxed);
+                rx.log_once("pattern budget", "too many new OSC address patterns in one frame; the rest were dropped");
+                return Vec::new();
+            }
+            self.new_patterns += 1;
+            if self.patterns.len() >= PATTERN_CACHE {
+                self.patterns.clear();
+            }
+            self.patterns.insert(msg.addr.clone(), self.map.route_pattern(&msg.addr).ok());
+        }
+        let targets = match self.patterns.get(&msg.addr) {
+            Some(Some(targets)) if !targets.is_empty() => targets.clone(),
+            _ => {
+                counters.unknown_address.fetch_add(1, Ordering::Relaxed);
+                rx.log_once(&format!("unknown {}", msg.addr), &format!("no parameter matches {}", msg.addr));
+                return Vec::new();
+            }
+        };
+        let routed: Vec<Routed> = targets.iter().filter_map(|t| write_for(*t, &msg.args, scene)).collect();
+        self.count(&routed.first().cloned(), msg, rx);
+        routed
+    }
+
+    /// Routes one message to a plain address; rejected ones bump a counter and are logged once
+    /// per kind.
     pub fn route(&self, msg: &OscMessage, scene: &Scene, rx: &OscReceiver) -> Option<Routed> {
         let counters = rx.counters();
         if msg.addr == "/indra/stats" {
@@ -341,20 +391,16 @@ impl OscRouter {
         };
         let routed = match route {
             Route::Command(command) => route_command(command, &msg.args),
-            Route::Param(t) => {
-                let decl = &scene.nodes[t.node].params.decls()[t.param];
-                let value = match t.component {
-                    Some(_) => numbers(&msg.args).filter(|n| n.len() == 1).map(|n| ParamValue::Float(n[0] as f32)),
-                    None => coerce_args(&msg.args, decl),
-                };
-                value.map(|value| {
-                    let write =
-                        ParamWrite { node: t.node, param: t.param, component: t.component, value, source: Source::Osc };
-                    Routed::Event(ControlEvent::Write(write))
-                })
-            }
+            Route::Param(t) => write_for(t, &msg.args, scene),
         };
-        match &routed {
+        self.count(&routed, msg, rx);
+        routed
+    }
+
+    /// Counts a routed message as applied, or as having bad arguments (logged once).
+    fn count(&self, routed: &Option<Routed>, msg: &OscMessage, rx: &OscReceiver) {
+        let counters = rx.counters();
+        match routed {
             Some(_) => counters.applied.fetch_add(1, Ordering::Relaxed),
             None => {
                 rx.log_once(
@@ -364,8 +410,20 @@ impl OscRouter {
                 counters.bad_arguments.fetch_add(1, Ordering::Relaxed)
             }
         };
-        routed
     }
+}
+
+/// The write of `args` to target `t`, if they fit its type.
+fn write_for(t: Target, args: &[OscType], scene: &Scene) -> Option<Routed> {
+    let decl = &scene.nodes[t.node].params.decls()[t.param];
+    let value = match t.component {
+        Some(_) => numbers(args).filter(|n| n.len() == 1).map(|n| ParamValue::Float(n[0] as f32)),
+        None => coerce_args(args, decl),
+    };
+    value.map(|value| {
+        let write = ParamWrite { node: t.node, param: t.param, component: t.component, value, source: Source::Osc };
+        Routed::Event(ControlEvent::Write(write))
+    })
 }
 
 fn route_command(command: Command, args: &[OscType]) -> Option<Routed> {
