@@ -237,6 +237,7 @@ fn script(s: &Scene, dir: &std::path::Path) -> Vec<(u64, Vec<ControlEvent>)> {
     vec![
         (2, vec![write(scale, ParamValue::Float(3.3), Source::Osc)]),
         (3, h.midi_bytes(&[0xB0, 7, 100, 0x90, 60, 90], s, 0.3)),
+        (4, vec![ControlEvent::Tempo { bpm: 90.0, resync: true }]),
         (5, vec![h.recall("zoomed", 0.2, s).unwrap()]),
         (7, vec![ControlEvent::ResumeTracks, write(scale, ParamValue::Float(1.5), Source::Ui)]),
     ]
@@ -300,4 +301,67 @@ fn a_hub_starts_without_midi_hardware_or_ports() {
     let taken = h.osc.as_ref().unwrap().local_addr().to_string();
     let second = ControlHub::start(&ControlOptions { osc: Some(taken), midi: false, ..options }, &s);
     assert!(second.osc.is_none() && second.notices.iter().any(|n| n.contains("cannot listen for OSC")));
+}
+
+const LFO_SCENE: &str = r#"(
+    name: "lfo test",
+    size: (64, 64),
+    bpm: 150,
+    nodes: [(id: "k", technique: "kleinian")],
+    output: "k",
+    controls: (lfo: [
+        (target: "k.scale", shape: Saw, rate: Hz(0.5), range: (1.0, 3.0)),
+        (target: "k.offset.y", shape: Square, rate: Beats(1.0), range: (0.0, 2.0), phase: 0.25),
+    ]),
+)"#;
+
+fn float(inst: &SceneInstance, name: &str) -> f32 {
+    inst.params(0).float(name)
+}
+
+#[test]
+fn lfos_move_parameters_in_hertz_and_in_beats_of_the_tempo() {
+    let gpu = common::gpu();
+    let s = parse_scene("lfo.ron", LFO_SCENE).unwrap_or_else(|e| panic!("{e}"));
+    let mut inst = instance(&gpu, &s);
+    for f in 0..12 {
+        inst.advance(&at(f));
+        // Saw at 0.5 Hz over (1, 3): 1 + 2·frac(0.05 f).
+        let saw = 1.0 + 2.0 * (0.05 * f as f64).fract() as f32;
+        assert!((float(&inst, "scale") - saw).abs() < 1e-5, "frame {f}: {}", float(&inst, "scale"));
+        // 150 bpm at dt 0.1 is 0.25 beats a step; the square is high for the first half beat.
+        let cycles = 0.25 * f as f64 + 0.25;
+        let high = cycles.fract() < 0.5;
+        assert_eq!(inst.params(0).vec2("offset")[1], if high { 2.0 } else { 0.0 }, "frame {f}");
+    }
+    assert!((inst.tempo().beats - 3.0).abs() < 1e-6, "{}", inst.tempo().beats);
+    // A tap lands the beat: 3.0 stays 3.0; a slower tempo slows the beat LFO.
+    inst.apply(&[ControlEvent::Tempo { bpm: 60.0, resync: true }]);
+    inst.advance(&at(12));
+    assert_eq!(inst.tempo().bpm, 60.0);
+    assert!((inst.tempo().beats - 3.1).abs() < 1e-6, "{}", inst.tempo().beats);
+    // A live write takes the parameter from its LFO until tracks resume.
+    let scale = s.nodes[0].params.index("scale").unwrap();
+    inst.apply(&[write(scale, ParamValue::Float(7.0), Source::Osc)]);
+    inst.advance(&at(13));
+    assert_eq!(float(&inst, "scale"), 7.0);
+    inst.apply(&[ControlEvent::ResumeTracks]);
+    inst.advance(&at(14));
+    assert!((float(&inst, "scale") - (1.0 + 2.0 * 0.7)).abs() < 1e-5);
+}
+
+#[test]
+fn bad_lfos_and_tempos_are_located_errors() {
+    for (bad, said) in [
+        ("(target: \"k.circle_inversion\", rate: Hz(1.0), range: (0.0, 1.0))", "is a bool"),
+        ("(target: \"k.scale\", rate: Hz(0.0), range: (0.0, 1.0))", "positive rate"),
+        ("(target: \"k.zoom\", rate: Beats(1.0), range: (0.0, 1.0))", "no parameter 'zoom'"),
+        ("(target: \"k.scale\", shape: Wobble, rate: Hz(1.0), range: (0.0, 1.0))", "Wobble"),
+    ] {
+        let text = LFO_SCENE.replace("(target: \"k.scale\", shape: Saw, rate: Hz(0.5), range: (1.0, 3.0))", bad);
+        let e = parse_scene("lfo.ron", &text).err().unwrap_or_else(|| panic!("{bad} was accepted")).to_string();
+        assert!(e.contains(said) && e.contains("lfo.ron:"), "{bad}: {e}");
+    }
+    let e = parse_scene("lfo.ron", &LFO_SCENE.replace("bpm: 150", "bpm: 1000")).err().unwrap().to_string();
+    assert!(e.contains("bpm 1000"), "{e}");
 }

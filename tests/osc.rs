@@ -508,3 +508,18 @@ fn a_flood_of_new_patterns_costs_a_bounded_amount_per_frame() {
     assert_eq!(routed.len(), new_patterns, "each routed pattern reaches output1 once");
     assert_eq!(rx.counters().snapshot()[3], (100 - new_patterns) as u64, "the rest are counted");
 }
+
+#[test]
+fn tempo_is_set_and_tapped_over_osc() {
+    let k = scene("kleinian");
+    let (routed, rx) = send_and_route(
+        &k,
+        &[
+            packet("/indra/tempo/bpm", vec![OscType::Float(128.0)]),
+            packet("/indra/tempo/tap", vec![]),
+            packet("/indra/tempo/bpm", vec![OscType::String("fast".into())]),
+        ],
+    );
+    assert_eq!(routed, [Routed::Event(ControlEvent::Tempo { bpm: 128.0, resync: false }), Routed::TapTempo]);
+    assert_eq!(rx.counters().snapshot()[4], 1, "the word is a bad argument");
+}

@@ -132,6 +132,15 @@ pub fn draw_ui(
                         events.push(ControlEvent::ResumeTracks);
                     }
                 });
+                let tempo = instance.tempo();
+                ui.horizontal(|ui| {
+                    // The beat within the bar of four, so the performer sees the phase.
+                    let beat = tempo.beats.rem_euclid(4.0).floor() as u32 + 1;
+                    ui.label(format!("♩ {:.1} BPM  beat {beat}/4", tempo.bpm));
+                    if ui.button("tap").on_hover_text("tap tempo (key T, OSC /indra/tempo/tap)").clicked() {
+                        events.extend(hub.tap_tempo());
+                    }
+                });
                 ui.small(hub.status());
                 events.extend(param_panel(ui, instance, hub).into_iter().map(ControlEvent::Write));
                 ui.separator();

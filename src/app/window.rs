@@ -308,6 +308,9 @@ impl ApplicationHandler for WindowApp {
                 event: KeyEvent { logical_key: Key::Character(c), state: ElementState::Pressed, repeat: false, .. },
                 ..
             } if !consumed => {
+                if c.eq_ignore_ascii_case("t") {
+                    r.ui_events.extend(r.hub.tap_tempo());
+                }
                 // Keys the scene's techniques declared (R reset, U undo, C clear, …).
                 if let Some(key) = c.chars().next().filter(char::is_ascii_alphabetic) {
                     r.ui_events.extend(r.player.instance().key(key, crate::params::Source::Ui));

@@ -24,6 +24,10 @@ pub enum Command {
     RecordStart,
     /// `/indra/record/stop`: finish the recording.
     RecordStop,
+    /// `/indra/tempo/bpm f`: set the tempo.
+    TempoBpm,
+    /// `/indra/tempo/tap`: a tap of tap tempo.
+    TempoTap,
 }
 
 /// What an address resolves to.
@@ -70,6 +74,8 @@ impl AddressMap {
         routes.insert("/indra/resume".into(), Route::Command(Command::Resume));
         routes.insert("/indra/record/start".into(), Route::Command(Command::RecordStart));
         routes.insert("/indra/record/stop".into(), Route::Command(Command::RecordStop));
+        routes.insert("/indra/tempo/bpm".into(), Route::Command(Command::TempoBpm));
+        routes.insert("/indra/tempo/tap".into(), Route::Command(Command::TempoTap));
         Self { routes }
     }
 

@@ -11,6 +11,7 @@ use super::osc::{OscReceiver, OscRouter, RecordRequest, Routed};
 use super::oscquery::OscQueryServer;
 use super::presets::PresetStore;
 use super::record::Recorder;
+use super::tempo::TempoInput;
 use crate::params::{ControlEvent, Remap, Target};
 use crate::scene::{Scene, SceneInstance};
 
@@ -70,6 +71,8 @@ pub struct ControlHub {
     pub notices: Vec<String>,
     /// Video recording starts and stops asked for over OSC, for the window to act on.
     pub record_requests: Vec<RecordRequest>,
+    /// Tap tempo and the MIDI clock follower.
+    tempo: TempoInput,
     frame_count: u64,
     /// Preset names, re-read on save and every [`PRESET_RESCAN_FRAMES`] frames (not per frame:
     /// the panel shows them every frame).
@@ -120,6 +123,7 @@ impl ControlHub {
             recorder,
             notices,
             record_requests: Vec::new(),
+            tempo: TempoInput::default(),
             frame_count: 0,
             preset_names,
         }
@@ -157,6 +161,7 @@ impl ControlHub {
                         Routed::SavePreset(name) => self.save_preset(&name, instance),
                         Routed::RecallPreset(name, s) => events.extend(self.recall(&name, s, scene)),
                         Routed::Record(request) => self.record_requests.push(request),
+                        Routed::TapTempo => events.extend(self.tempo.tap()),
                     }
                 }
             }
@@ -165,7 +170,17 @@ impl ControlHub {
         for bytes in messages {
             events.extend(self.midi_bytes(&bytes, scene, seconds));
         }
+        // A running MIDI clock sets the show's tempo.
+        if self.mapper.clock.playing {
+            events.extend(self.tempo.follow_clock(self.mapper.clock.bpm()));
+        }
         events
+    }
+
+    /// A tap of tap tempo now (key T, the panel's button): the event that sets the tempo, from
+    /// the second tap on.
+    pub fn tap_tempo(&mut self) -> Option<ControlEvent> {
+        self.tempo.tap()
     }
 
     /// Feeds raw MIDI bytes (from a port, or a test) through the parser and mappings.

@@ -14,6 +14,7 @@ mod osc_guard;
 pub mod oscquery;
 pub mod presets;
 pub mod record;
+pub mod tempo;
 
 pub use address::{AddressMap, Route};
 pub use hub::{ControlHub, ControlOptions};

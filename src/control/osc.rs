@@ -306,6 +306,8 @@ pub enum Routed {
     RecallPreset(String, f64),
     /// Start or stop the video recording.
     Record(RecordRequest),
+    /// A tap of tap tempo (timed where it is received).
+    TapTempo,
 }
 
 /// Start or stop recording the show to a video file.
@@ -438,6 +440,10 @@ fn route_command(command: Command, args: &[OscType]) -> Option<Routed> {
         Command::PresetRecall => name.map(|n| Routed::RecallPreset(n, seconds.max(0.0))),
         Command::RecordStart => Some(Routed::Record(RecordRequest::Start(name))),
         Command::RecordStop => Some(Routed::Record(RecordRequest::Stop)),
+        Command::TempoBpm => numbers(args)
+            .filter(|n| n.len() == 1 && n[0].is_finite())
+            .map(|n| Routed::Event(ControlEvent::Tempo { bpm: n[0], resync: false })),
+        Command::TempoTap => Some(Routed::TapTempo),
     }
 }
 

@@ -47,6 +47,13 @@ pub enum RecordedEvent {
     },
     /// Tracks resumed.
     ResumeTracks,
+    /// The tempo set (tap, OSC, MIDI clock).
+    Tempo {
+        /// Beats per minute.
+        bpm: f64,
+        /// Whether the beat snapped to this step.
+        resync: bool,
+    },
 }
 
 /// Writes events as they are applied — into a temporary file beside the target, renamed over it
@@ -134,6 +141,7 @@ fn to_recorded(event: &ControlEvent, scene: &Scene) -> Option<RecordedEvent> {
             seconds: *seconds,
         },
         ControlEvent::ResumeTracks => RecordedEvent::ResumeTracks,
+        ControlEvent::Tempo { bpm, resync } => RecordedEvent::Tempo { bpm: *bpm, resync: *resync },
     })
 }
 
@@ -182,5 +190,6 @@ fn from_recorded(event: &RecordedEvent, scene: &Scene) -> Result<ControlEvent, S
             seconds: *seconds,
         },
         RecordedEvent::ResumeTracks => ControlEvent::ResumeTracks,
+        RecordedEvent::Tempo { bpm, resync } => ControlEvent::Tempo { bpm: *bpm, resync: *resync },
     })
 }

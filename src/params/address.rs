@@ -34,6 +34,13 @@ pub enum ControlEvent {
     },
     /// Give every parameter a live source took over back to its track.
     ResumeTracks,
+    /// Set the show's tempo (tap, OSC, MIDI clock); `resync` puts the beat on this step.
+    Tempo {
+        /// Beats per minute.
+        bpm: f64,
+        /// Snap the beat position to the nearest whole beat.
+        resync: bool,
+    },
 }
 
 impl ControlEvent {
@@ -51,6 +58,7 @@ impl ControlEvent {
                 seconds: *seconds,
             }),
             ControlEvent::ResumeTracks => Some(ControlEvent::ResumeTracks),
+            ControlEvent::Tempo { .. } => Some(self.clone()),
         }
     }
 }

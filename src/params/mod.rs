@@ -4,6 +4,7 @@
 //! (UI, files, OSC).
 
 mod address;
+pub mod lfo;
 mod morph;
 mod raw;
 mod set;
@@ -12,6 +13,7 @@ mod value;
 mod write;
 
 pub use address::{ControlEvent, NodeValues, Remap, Target};
+pub use lfo::{Lfo, LfoRate, LfoShape, TempoClock};
 pub use morph::Morph;
 pub use raw::{RawValue, coerce, raw_from_value, value_from_raw};
 pub use set::ParamSet;

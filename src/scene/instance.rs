@@ -13,7 +13,9 @@ use super::load::Scene;
 use crate::assets::Assets;
 use crate::gpu::{Gpu, ShaderError};
 use crate::graph::{FrameGraph, FrameOutput, GraphError, GraphRuntime};
-use crate::params::{ControlEvent, InputRole, Morph, NodeValues, ParamSet, ParamValue, ParamWrite, Remap, Source};
+use crate::params::{
+    ControlEvent, InputRole, Morph, NodeValues, ParamSet, ParamValue, ParamWrite, Remap, Source, TempoClock,
+};
 use crate::techniques::{NodeSetup, Technique};
 use crate::time::FrameTime;
 
@@ -27,6 +29,8 @@ pub struct SceneInstance {
     overridden: BTreeSet<(usize, usize)>,
     morph: Option<Morph>,
     pending_morph: Option<(NodeValues, f64)>,
+    /// The show's tempo and beat position (what `Beats` LFOs follow).
+    tempo: TempoClock,
     /// Parameters a non-finite value was refused for (each told once), and the messages.
     refused: BTreeSet<(usize, usize)>,
     messages: Vec<String>,
@@ -37,7 +41,9 @@ impl SceneInstance {
     pub fn new(gpu: &Gpu, assets: &Assets, scene: Scene, output_size: (u32, u32)) -> Result<Self, ShaderError> {
         let nodes = create_nodes(&scene, gpu, assets, output_size)?;
         let params = scene.nodes.iter().map(|n| n.params.clone()).collect();
+        let tempo = TempoClock::new(scene.bpm);
         Ok(Self {
+            tempo,
             scene,
             params,
             nodes,
@@ -75,8 +81,15 @@ impl SceneInstance {
         self.overridden.contains(&(node, param))
     }
 
+    /// Whether a track or an LFO drives the parameter (a live write then takes it over).
     fn has_track(&self, node: usize, param: usize) -> bool {
         self.scene.tracks.iter().any(|t| t.node == node && t.param == param)
+            || self.scene.lfos.iter().any(|l| l.target.node == node && l.target.param == param)
+    }
+
+    /// The show's tempo and beat position.
+    pub fn tempo(&self) -> TempoClock {
+        self.tempo
     }
 
     /// Points of node `node` a performer may drag (see [`Technique::handles`]).
@@ -91,6 +104,7 @@ impl SceneInstance {
                 ControlEvent::Write(w) => self.write(w),
                 ControlEvent::Morph { values, seconds } => self.pending_morph = Some((values.clone(), *seconds)),
                 ControlEvent::ResumeTracks => self.overridden.clear(),
+                ControlEvent::Tempo { bpm, resync } => self.tempo.set(*bpm, *resync),
             }
         }
     }
@@ -134,6 +148,21 @@ impl SceneInstance {
                 };
             }
         }
+        // LFOs after tracks: a modulated parameter follows its LFO unless a live source took it.
+        for (i, lfo) in self.scene.lfos.iter().enumerate() {
+            let (node, param) = (lfo.target.node, lfo.target.param);
+            if self.overridden.contains(&(node, param)) {
+                continue;
+            }
+            let key = time.seed ^ (i as u64 + 1).wrapping_mul(0xA24B_AED4_963E_E407);
+            let value = lfo.value(time.seconds, self.tempo.beats, key);
+            let params = &mut self.params[node];
+            // LFO values come from validated, finite ranges.
+            let _ = match lfo.target.component {
+                Some(c) => params.set_component(param, c, value),
+                None => params.set_at(param, ParamValue::Float(value)),
+            };
+        }
         if let Some((values, seconds)) = self.pending_morph.take() {
             let entries = values.iter().map(|&(n, p, to)| (n, p, self.params[n].target_at(p), to)).collect();
             self.morph = Some(Morph { entries, start: time.seconds, duration: seconds });
@@ -165,6 +194,7 @@ impl SceneInstance {
         for params in &mut self.params {
             params.end_step();
         }
+        self.tempo.step(f64::from(time.dt));
     }
 
     /// Whether any node records simulation work in its passes that every fixed step needs

@@ -5,7 +5,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use super::error::{SceneError, SceneErrors, locate};
 use super::schema::{MidiMapping, SceneFile};
 use crate::assets::{AssetKind, Assets};
-use crate::params::{Key, ParamDecl, ParamSet, ParamType, ParamValue, RawValue, Target, Track, coerce};
+use crate::params::{Key, Lfo, ParamDecl, ParamSet, ParamType, ParamValue, RawValue, Target, Track, coerce};
 use crate::techniques::{self, TechniqueInfo};
 
 /// A validated scene: every name resolved, every value typed.
@@ -23,6 +23,10 @@ pub struct Scene {
     pub seed: u64,
     /// Fixed step, seconds.
     pub dt: f32,
+    /// Tempo at start, beats per minute.
+    pub bpm: f64,
+    /// LFOs bound to parameters.
+    pub lfos: Vec<Lfo>,
     /// Samples per pixel wanted for rasterising nodes (1, 2, 4 or 8; the adapter may allow fewer).
     pub msaa: u32,
     /// Nodes in dependency order (inputs before their consumers).
@@ -337,6 +341,10 @@ impl Validator<'_> {
         if !(file.dt > 0.0 && file.dt <= 1.0) {
             self.error(&["dt"], format!("dt {} must be in (0, 1] seconds", file.dt));
         }
+        let (lo, hi) = crate::params::lfo::BPM_RANGE;
+        if !(file.bpm >= lo && file.bpm <= hi) {
+            self.error(&["bpm"], format!("bpm {} must be between {lo} and {hi}", file.bpm));
+        }
         if file.nodes.len() > MAX_NODES {
             let message = format!("{} nodes; a scene may have at most {MAX_NODES}", file.nodes.len());
             self.error(&["nodes"], message);
@@ -372,6 +380,7 @@ impl Validator<'_> {
         let tracks = self.tracks(&file, &ordered);
         let (mut osc_aliases, midi) = self.controls(&file, &ordered);
         let outputs = self.outputs(&file, &ordered, output);
+        let lfos = self.lfos(&file, &ordered);
         osc_aliases.extend(corner_aliases(&outputs, &ordered));
         if !self.errors.is_empty() {
             return Err(self.failure());
@@ -383,6 +392,8 @@ impl Validator<'_> {
             size: file.size,
             seed: file.seed,
             dt: file.dt,
+            bpm: file.bpm,
+            lfos,
             msaa: file.msaa,
             nodes: ordered,
             output,
@@ -396,6 +407,36 @@ impl Validator<'_> {
             return Err(self.failure());
         }
         Ok(scene)
+    }
+
+    /// Binds the LFOs to numeric parameters (or components) with finite ranges and rates.
+    fn lfos(&mut self, file: &SceneFile, nodes: &[SceneNode]) -> Vec<Lfo> {
+        let mut lfos = Vec::new();
+        for l in &file.controls.lfo {
+            let anchor = format!("\"{}\"", l.target);
+            let anchors = ["lfo", anchor.as_str()];
+            let target = match resolve_target(nodes, &l.target) {
+                Ok(t) => t,
+                Err(e) => {
+                    self.error(&anchors, format!("LFO target {e}"));
+                    continue;
+                }
+            };
+            let ty = nodes[target.node].params.decls()[target.param].ty();
+            if target.component.is_none() && !matches!(ty, ParamType::Float | ParamType::Int) {
+                self.error(&anchors, format!("LFO target '{}' is a {ty}: name a number or one component", l.target));
+                continue;
+            }
+            if !(l.range.0.is_finite() && l.range.1.is_finite() && l.phase.is_finite() && l.rate.is_valid()) {
+                self.error(
+                    &anchors,
+                    format!("LFO on '{}' needs a finite range and phase and a positive rate", l.target),
+                );
+                continue;
+            }
+            lfos.push(Lfo { target, shape: l.shape, rate: l.rate, range: l.range, phase: l.phase });
+        }
+        lfos
     }
 
     /// Resolves the extra outputs' sources (after [`add_output_warps`]).

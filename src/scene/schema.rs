@@ -24,7 +24,7 @@ use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
-use crate::params::{Interpolation, LoopMode, RawValue};
+use crate::params::{Interpolation, LfoRate, LfoShape, LoopMode, RawValue};
 
 /// A whole scene file.
 #[derive(Clone, Debug, Deserialize)]
@@ -43,6 +43,10 @@ pub struct SceneFile {
     /// Fixed simulation step in seconds (default 1/60).
     #[serde(default = "default_dt")]
     pub dt: f32,
+    /// The show's tempo at start, in beats per minute (default 120): what `Beats` LFOs follow
+    /// until a tap, OSC or MIDI clock sets it.
+    #[serde(default = "default_bpm")]
+    pub bpm: f64,
     /// Samples per pixel of the rasterising nodes (1, 2, 4 or 8; default 4), resolved before
     /// any post effect sees the image. `run`, `render` and `bench` override it with `--msaa`.
     #[serde(default = "default_msaa")]
@@ -92,6 +96,27 @@ pub struct ControlsFile {
     /// MIDI controls bound to parameters.
     #[serde(default)]
     pub midi: Vec<MidiMapping>,
+    /// LFOs moving parameters on the fixed clock.
+    #[serde(default)]
+    pub lfo: Vec<LfoFile>,
+}
+
+/// An LFO: `(target: "glow.angle", shape: Sine, rate: Beats(1.0), range: (0, 90), phase: 0.0)`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LfoFile {
+    /// `node.param` or `node.param.<component>` (a number, or one component of a vector).
+    pub target: String,
+    /// Sine (default), Triangle, Saw, Square or Random (sample and hold).
+    #[serde(default)]
+    pub shape: LfoShape,
+    /// `Beats(n)`: one cycle every n beats of the show's tempo; `Hz(f)`: f cycles a second.
+    pub rate: LfoRate,
+    /// The values at the bottom and the top of the wave.
+    pub range: (f32, f32),
+    /// Offset in cycles.
+    #[serde(default)]
+    pub phase: f64,
 }
 
 /// How every hand-editable RON file (scenes, MIDI learn files) is read: `implicit_some`, so
@@ -160,6 +185,10 @@ pub enum MidiCurve {
 
 fn default_msaa() -> u32 {
     4
+}
+
+fn default_bpm() -> f64 {
+    crate::params::lfo::DEFAULT_BPM
 }
 
 fn default_dt() -> f32 {
