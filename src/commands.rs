@@ -59,6 +59,16 @@ pub struct RunArgs {
     /// No MIDI input.
     #[arg(long)]
     pub no_midi: bool,
+    /// Audio input device: the first whose name contains this (default: the default device,
+    /// opened when the scene maps audio).
+    #[arg(long, value_name = "NAME")]
+    pub audio_in: Option<String>,
+    /// No audio input.
+    #[arg(long)]
+    pub no_audio: bool,
+    /// List the audio input devices and exit.
+    #[arg(long)]
+    pub list_audio: bool,
     /// Record every control event with its frame to this file (replay with `render --replay`).
     #[arg(long)]
     pub record_controls: Option<PathBuf>,
@@ -95,6 +105,9 @@ impl Default for RunArgs {
             oscquery: None,
             midi: None,
             no_midi: false,
+            audio_in: None,
+            no_audio: false,
+            list_audio: false,
             record_controls: None,
             presets: "presets".into(),
             midi_learn: "midi-learn.ron".into(),
@@ -154,6 +167,10 @@ pub struct RenderArgs {
     /// windows show them (warped).
     #[arg(long, default_value_t = 0)]
     pub output: usize,
+    /// A WAV file the scene's audio mappings hear (frame n hears it up to (n + 1) × dt, so
+    /// renders are exact); with --video it is also the video's sound track.
+    #[arg(long, value_name = "FILE.wav")]
+    pub audio: Option<PathBuf>,
 }
 
 /// `indra bench`.
@@ -237,6 +254,9 @@ fn scene_with_sets(assets: &Assets, name: &str, sets: &[String], msaa: Option<u3
 /// Opens the scene in a window. A scene file that is broken on disk falls back to its built-in
 /// copy (with the error shown) so the show starts; the fix is picked up on save.
 pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), String> {
+    if args.list_audio {
+        return list_audio();
+    }
     let mut notices = Vec::new();
     let scene = match scene_with_sets(assets, &args.scene, &args.sets, args.msaa) {
         Ok(scene) => scene,
@@ -259,6 +279,7 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         osc_out: args.osc_out.clone(),
         oscquery: args.oscquery.clone(),
         midi: !args.no_midi,
+        audio_in: (!args.no_audio).then(|| args.audio_in.clone()),
         midi_filter: args.midi.clone(),
         record: args.record_controls.clone(),
         presets_dir: args.presets.clone(),
@@ -267,23 +288,57 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
     indra::app::run(assets.clone(), gpu.clone(), scene, options, control, notices)
 }
 
+/// Prints the audio input devices, one per line.
+fn list_audio() -> Result<(), String> {
+    #[cfg(feature = "audio")]
+    {
+        let devices = indra::control::audio::live::list_devices()?;
+        if devices.is_empty() {
+            say!("no audio input devices");
+        }
+        for d in devices {
+            say!("{d}");
+        }
+        Ok(())
+    }
+    #[cfg(not(feature = "audio"))]
+    Err("this build has no live audio input (built without the `audio` feature)".into())
+}
+
 /// Renders a PNG sequence.
 pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<(), String> {
     check_timing(args.start, args.frames, args.dt)?;
     let scene = scene_with_sets(assets, &args.scene, &args.sets, args.msaa)?;
-    let script = match &args.replay {
+    let mut script = match &args.replay {
         Some(path) => indra::control::record::read_replay(path, &scene)?,
         None => Default::default(),
     };
+    let dt = f64::from(args.dt.unwrap_or(scene.dt));
+    if let Some(path) = &args.audio {
+        let file = indra::control::audio::AudioFile::open(path)?;
+        if scene.audio.is_empty() {
+            eprintln!("'{}' maps no audio (controls.audio): the file is only the sound track", scene.name);
+        }
+        let frames = args.start.saturating_add(args.frames);
+        for (frame, events) in indra::control::audio::file_script(&file, &scene, frames, dt) {
+            script.entry(frame).or_default().extend(events);
+        }
+    }
     scene.check_texture_budget(args.size.unwrap_or(scene.size))?;
     let stem = Path::new(&args.scene).file_stem().map_or("frame".into(), |s| s.to_string_lossy().into_owned());
     let size = args.size.unwrap_or(scene.size);
-    let fps = 1.0 / f64::from(args.dt.unwrap_or(scene.dt));
+    let fps = 1.0 / dt;
     // ffmpeg starts before the GPU and the seek, so a missing one or a bad codec fails at once.
     let mut sink = match &args.video {
         Some(path) => {
-            let settings =
-                VideoSettings { path: path.clone(), size, fps, codec: args.codec.clone(), quality: args.quality };
+            let settings = VideoSettings {
+                path: path.clone(),
+                size,
+                fps,
+                codec: args.codec.clone(),
+                quality: args.quality,
+                audio: args.audio.clone().map(|file| (file, args.start as f64 * dt)),
+            };
             if settings.encoded_size() != size {
                 let (w, h) = settings.encoded_size();
                 eprintln!("the video is {w}x{h}: odd sides are padded by one black pixel (4:2:0 chroma)");

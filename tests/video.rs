@@ -172,7 +172,7 @@ fn solid(gpu: &indra::gpu::Gpu, size: (u32, u32), level: f32) -> wgpu::Texture {
 }
 
 fn live_settings(path: &Path, size: (u32, u32)) -> indra::offscreen::VideoSettings {
-    indra::offscreen::VideoSettings { path: path.into(), size, fps: 30.0, codec: None, quality: None }
+    indra::offscreen::VideoSettings { path: path.into(), size, fps: 30.0, codec: None, quality: None, audio: None }
 }
 
 #[test]

@@ -92,6 +92,29 @@ pub const MAX_LOGGED_ERRORS: u64 = 200;
 /// Longest error shown, in characters.
 pub const MAX_ERROR_CHARS: usize = 400;
 
+/// The live input's level meter and spectrum, and its tempo estimate with a button to take it.
+fn audio_panel(ui: &mut egui::Ui, frame: &crate::control::audio::AudioFrame) -> Option<ControlEvent> {
+    ui.add(egui::ProgressBar::new(frame.level.clamp(0.0, 1.0)).desired_height(6.0).text("level"));
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(ui.available_width().min(240.0), 36.0), egui::Sense::hover());
+    let painter = ui.painter_at(rect);
+    let width = rect.width() / frame.bands.len().max(1) as f32;
+    for (i, band) in frame.bands.iter().enumerate() {
+        let x = rect.left() + i as f32 * width;
+        let top = rect.bottom() - band.clamp(0.0, 1.0) * rect.height();
+        let bar = egui::Rect::from_min_max(egui::pos2(x + 1.0, top), egui::pos2(x + width - 1.0, rect.bottom()));
+        painter.rect_filled(bar, 0.0, if frame.onset { egui::Color32::WHITE } else { egui::Color32::LIGHT_BLUE });
+    }
+    let bpm = frame.bpm?;
+    let mut take = None;
+    ui.horizontal(|ui| {
+        ui.small(format!("the audio suggests {bpm:.1} BPM"));
+        if ui.small_button("use").clicked() {
+            take = Some(ControlEvent::Tempo { bpm, resync: false });
+        }
+    });
+    take
+}
+
 /// The record button and, while recording, the file, length and lost frames.
 fn record_panel(ui: &mut egui::Ui, overlay: &mut Overlay) {
     ui.horizontal(|ui| {
@@ -141,6 +164,9 @@ pub fn draw_ui(
                         events.extend(hub.tap_tempo());
                     }
                 });
+                if let Some(frame) = hub.audio_frame.clone() {
+                    events.extend(audio_panel(ui, &frame));
+                }
                 ui.small(hub.status());
                 events.extend(param_panel(ui, instance, hub).into_iter().map(ControlEvent::Write));
                 ui.separator();

@@ -566,6 +566,7 @@ impl Running {
                 fps: 1.0 / f64::from(self.player.last_step().dt),
                 codec: None,
                 quality: None,
+                audio: None,
             };
             LiveRecorder::start(&self.gpu.device, settings, DEFAULT_IN_FLIGHT).map_err(|e| e.to_string())
         });

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 use std::time::SystemTime;
 
+use super::audio::{AudioFrame, AudioMapper};
 use super::feedback::OscFeedback;
 use super::midi::{LearnStore, MidiInput, MidiMapper, MidiParser};
 use super::osc::{OscReceiver, OscRouter, RecordRequest, Routed};
@@ -34,6 +35,9 @@ pub struct ControlOptions {
     pub presets_dir: PathBuf,
     /// File of learned MIDI mappings.
     pub learn_file: PathBuf,
+    /// Audio input: `None` none; `Some(None)` the default device when the scene maps audio;
+    /// `Some(Some(name))` the first device whose name contains `name`, always.
+    pub audio_in: Option<Option<String>>,
 }
 
 impl Default for ControlOptions {
@@ -47,6 +51,7 @@ impl Default for ControlOptions {
             record: None,
             presets_dir: "presets".into(),
             learn_file: "midi-learn.ron".into(),
+            audio_in: Some(None),
         }
     }
 }
@@ -73,6 +78,12 @@ pub struct ControlHub {
     pub record_requests: Vec<RecordRequest>,
     /// Tap tempo and the MIDI clock follower.
     tempo: TempoInput,
+    /// Live audio and its analysis, when an input is open.
+    audio: Option<LiveSound>,
+    /// The scene's audio mappings.
+    audio_mapper: AudioMapper,
+    /// The last analysed audio frame (the panel's meter and spectrum).
+    pub audio_frame: Option<AudioFrame>,
     frame_count: u64,
     /// Preset names, re-read on save and every [`PRESET_RESCAN_FRAMES`] frames (not per frame:
     /// the panel shows them every frame).
@@ -110,6 +121,7 @@ impl ControlHub {
         let mapper = MidiMapper::new(scene, &learn.load());
         let presets = PresetStore { dir: options.presets_dir.clone() };
         let preset_names = presets.names();
+        let audio = open_audio(options.audio_in.as_ref(), scene, &mut notices);
         Self {
             osc,
             router: OscRouter::new(scene),
@@ -124,6 +136,9 @@ impl ControlHub {
             notices,
             record_requests: Vec::new(),
             tempo: TempoInput::default(),
+            audio,
+            audio_mapper: AudioMapper::new(scene),
+            audio_frame: None,
             frame_count: 0,
             preset_names,
         }
@@ -134,6 +149,7 @@ impl ControlHub {
     /// it left the scene.
     pub fn set_scene(&mut self, scene: &Scene, remap: Option<&Remap>) {
         self.router = OscRouter::new(scene);
+        self.audio_mapper = AudioMapper::new(scene);
         let learning = self.mapper.learning.take();
         self.mapper = MidiMapper::new(scene, &self.learn.load());
         self.mapper.learning = learning.and_then(|t| match remap {
@@ -169,6 +185,12 @@ impl ControlHub {
         let messages = self.midi.as_ref().map(MidiInput::drain).unwrap_or_default();
         for bytes in messages {
             events.extend(self.midi_bytes(&bytes, scene, seconds));
+        }
+        if let Some(sound) = self.audio.as_mut()
+            && let Some((frame, dt)) = sound.analyse()
+        {
+            events.extend(self.audio_mapper.events(&frame, dt, scene));
+            self.audio_frame = Some(frame);
         }
         // A running MIDI clock sets the show's tempo.
         if self.mapper.clock.playing {
@@ -300,5 +322,66 @@ impl ControlHub {
     fn notice(&mut self, message: String) {
         log::warn!("{message}");
         self.notices.push(message);
+    }
+}
+
+/// A live input with its analyzer and the time of its last frame.
+struct LiveSound {
+    #[cfg(feature = "audio")]
+    input: super::audio::live::LiveAudio,
+    analyzer: super::audio::Analyzer,
+    started: std::time::Instant,
+    last: f64,
+}
+
+impl LiveSound {
+    /// Analyses what arrived since the last frame; with the real seconds it covered.
+    fn analyse(&mut self) -> Option<(AudioFrame, f64)> {
+        #[cfg(feature = "audio")]
+        let samples = self.input.drain();
+        #[cfg(not(feature = "audio"))]
+        let samples: Vec<f32> = Vec::new();
+        if samples.is_empty() {
+            return None;
+        }
+        let now = self.started.elapsed().as_secs_f64();
+        let dt = (now - self.last).max(1e-3);
+        self.last = now;
+        Some((self.analyzer.frame(&samples, now), dt))
+    }
+}
+
+/// Opens the audio input `wanted` asks for (see [`ControlOptions::audio_in`]). No device, or a
+/// build without the `audio` feature, is a logged fact (a notice when a device was named).
+fn open_audio(wanted: Option<&Option<String>>, scene: &Scene, notices: &mut Vec<String>) -> Option<LiveSound> {
+    let filter = match wanted {
+        None => return None,
+        Some(None) if scene.audio.is_empty() => return None,
+        Some(filter) => filter.as_deref(),
+    };
+    #[cfg(feature = "audio")]
+    {
+        match super::audio::live::LiveAudio::open(filter) {
+            Ok(input) => {
+                let analyzer = super::audio::Analyzer::new(input.rate);
+                Some(LiveSound { input, analyzer, started: std::time::Instant::now(), last: 0.0 })
+            }
+            Err(e) => {
+                log::info!("{e}; the scene's audio mappings stay still");
+                if filter.is_some() {
+                    notices.push(e);
+                }
+                None
+            }
+        }
+    }
+    #[cfg(not(feature = "audio"))]
+    {
+        let message = "this build has no live audio input (built without the `audio` feature)";
+        log::info!("{message}");
+        if filter.is_some() {
+            notices.push(message.into());
+        }
+        None
     }
 }

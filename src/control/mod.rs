@@ -5,6 +5,7 @@
 //! [`ControlEvent`]: crate::scene::ControlEvent
 
 pub mod address;
+pub mod audio;
 pub mod feedback;
 pub mod http;
 pub mod hub;

@@ -29,6 +29,9 @@ pub struct VideoSettings {
     /// Quality: the CRF for H.264/H.265/VP9/AV1 (lower is better), the ProRes profile (0 proxy …
     /// 3 HQ, 4 4444); lossless FFV1 ignores it.
     pub quality: Option<u32>,
+    /// A sound track: the audio file and the second of it the first frame shows (a render that
+    /// starts at frame n starts n × dt into the file).
+    pub audio: Option<(PathBuf, f64)>,
 }
 
 /// Why a video could not be written; each is one sentence for the user.
@@ -181,6 +184,19 @@ impl VideoSettings {
         ]
         .map(String::from)
         .to_vec();
+        if let Some((file, offset)) = &self.audio {
+            args.extend(["-ss".into(), format!("{offset:.6}"), "-i".into(), file.display().to_string()]);
+            args.extend(["-map".into(), "0:v".into(), "-map".into(), "1:a".into()]);
+            let ext = self.path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+            let audio_codec: &[&str] = match ext.as_str() {
+                "mov" => &["-c:a", "pcm_s16le"],
+                "webm" => &["-c:a", "libopus", "-b:a", "160k"],
+                _ => &["-c:a", "aac", "-b:a", "192k"],
+            };
+            args.extend(audio_codec.iter().map(|s| s.to_string()));
+            // The video decides the length; the sound stops with the last frame.
+            args.push("-shortest".into());
+        }
         // Pad odd sides (4:2:0 needs even ones) and convert with the BT.709 matrix players assume
         // for HD, instead of swscale's BT.601 default.
         args.extend([
@@ -302,7 +318,7 @@ mod tests {
     use super::*;
 
     fn settings(path: &str) -> VideoSettings {
-        VideoSettings { path: path.into(), size: (64, 48), fps: 60.0, codec: None, quality: None }
+        VideoSettings { path: path.into(), size: (64, 48), fps: 60.0, codec: None, quality: None, audio: None }
     }
 
     #[test]

@@ -15,6 +15,8 @@ pub enum Source {
     Preset,
     /// A recorded control stream played back.
     Replay,
+    /// Audio analysis (a band, the level, an onset) through the scene's audio mappings.
+    Audio,
 }
 
 /// Set parameter `param` (or one `component` of it) of node `node` to `value`.

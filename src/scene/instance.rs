@@ -126,7 +126,7 @@ impl SceneInstance {
             }
             return;
         }
-        let live = matches!(w.source, Source::Ui | Source::Osc | Source::Midi | Source::Replay);
+        let live = matches!(w.source, Source::Ui | Source::Osc | Source::Midi | Source::Replay | Source::Audio);
         if live && self.has_track(w.node, w.param) {
             self.overridden.insert((w.node, w.param));
         }

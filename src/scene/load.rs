@@ -3,7 +3,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use super::error::{SceneError, SceneErrors, locate};
-use super::schema::{MidiMapping, SceneFile};
+use super::schema::{AUDIO_BANDS, AudioSource, MidiMapping, SceneFile};
 use crate::assets::{AssetKind, Assets};
 use crate::params::{Key, Lfo, ParamDecl, ParamSet, ParamType, ParamValue, RawValue, Target, Track, coerce};
 use crate::techniques::{self, TechniqueInfo};
@@ -27,6 +27,8 @@ pub struct Scene {
     pub bpm: f64,
     /// LFOs bound to parameters.
     pub lfos: Vec<Lfo>,
+    /// Audio analysis bound to parameters.
+    pub audio: Vec<AudioMapping>,
     /// Samples per pixel wanted for rasterising nodes (1, 2, 4 or 8; the adapter may allow fewer).
     pub msaa: u32,
     /// Nodes in dependency order (inputs before their consumers).
@@ -41,6 +43,21 @@ pub struct Scene {
     pub osc_aliases: Vec<(String, Target)>,
     /// MIDI mappings declared in the scene's `controls`.
     pub midi: Vec<(MidiMapping, Target)>,
+}
+
+/// An audio mapping, resolved (see the scene file's `controls.audio`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AudioMapping {
+    /// What it follows.
+    pub source: AudioSource,
+    /// The parameter it writes.
+    pub target: Target,
+    /// Values at silence and at full scale.
+    pub range: (f32, f32),
+    /// Rise time, seconds.
+    pub attack: f32,
+    /// Fall time, seconds.
+    pub release: f32,
 }
 
 /// One more output of a scene, resolved.
@@ -381,6 +398,7 @@ impl Validator<'_> {
         let (mut osc_aliases, midi) = self.controls(&file, &ordered);
         let outputs = self.outputs(&file, &ordered, output);
         let lfos = self.lfos(&file, &ordered);
+        let audio = self.audio(&file, &ordered);
         osc_aliases.extend(corner_aliases(&outputs, &ordered));
         if !self.errors.is_empty() {
             return Err(self.failure());
@@ -394,6 +412,7 @@ impl Validator<'_> {
             dt: file.dt,
             bpm: file.bpm,
             lfos,
+            audio,
             msaa: file.msaa,
             nodes: ordered,
             output,
@@ -437,6 +456,48 @@ impl Validator<'_> {
             lfos.push(Lfo { target, shape: l.shape, rate: l.rate, range: l.range, phase: l.phase });
         }
         lfos
+    }
+
+    /// Binds the audio mappings to numbers, bools, triggers or components.
+    fn audio(&mut self, file: &SceneFile, nodes: &[SceneNode]) -> Vec<AudioMapping> {
+        let mut out = Vec::new();
+        for a in &file.controls.audio {
+            let anchor = format!("\"{}\"", a.target);
+            let anchors = ["audio", anchor.as_str()];
+            let target = match resolve_target(nodes, &a.target) {
+                Ok(t) => t,
+                Err(e) => {
+                    self.error(&anchors, format!("audio mapping {e}"));
+                    continue;
+                }
+            };
+            let ty = nodes[target.node].params.decls()[target.param].ty();
+            let fits = target.component.is_some()
+                || matches!(ty, ParamType::Float | ParamType::Int | ParamType::Bool | ParamType::Trigger);
+            let problem = if !fits {
+                Some(format!("'{}' is a {ty}: name a number, a bool, a trigger or one component", a.target))
+            } else if matches!(a.source, AudioSource::Band(b) if usize::from(b) >= AUDIO_BANDS) {
+                Some(format!("there are {AUDIO_BANDS} bands, Band(0) to Band({})", AUDIO_BANDS - 1))
+            } else if ![a.range.0, a.range.1, a.attack, a.release].iter().all(|v| v.is_finite())
+                || a.attack < 0.0
+                || a.release < 0.0
+            {
+                Some("range must be finite and attack and release 0 or more seconds".into())
+            } else {
+                None
+            };
+            match problem {
+                Some(p) => self.error(&anchors, format!("audio mapping to '{}': {p}", a.target)),
+                None => out.push(AudioMapping {
+                    source: a.source,
+                    target,
+                    range: a.range,
+                    attack: a.attack,
+                    release: a.release,
+                }),
+            }
+        }
+        out
     }
 
     /// Resolves the extra outputs' sources (after [`add_output_warps`]).

@@ -99,6 +99,63 @@ pub struct ControlsFile {
     /// LFOs moving parameters on the fixed clock.
     #[serde(default)]
     pub lfo: Vec<LfoFile>,
+    /// Audio analysis moving parameters.
+    #[serde(default)]
+    pub audio: Vec<AudioFile>,
+}
+
+/// An audio mapping: `(source: Band(0), target: "limit_set.scale", range: (1.5, 3.0),
+/// attack: 0.01, release: 0.3)`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AudioFile {
+    /// What it follows.
+    pub source: AudioSource,
+    /// `node.param` or `node.param.<component>`: a number, a bool, a trigger or a component.
+    pub target: String,
+    /// The values at silence and at full scale (default 0–1).
+    #[serde(default = "unit_range")]
+    pub range: (f32, f32),
+    /// Seconds to rise (default 0.01).
+    #[serde(default = "default_attack")]
+    pub attack: f32,
+    /// Seconds to fall (default 0.3).
+    #[serde(default = "default_release")]
+    pub release: f32,
+}
+
+/// Log-spaced bands the audio analysis measures.
+pub const AUDIO_BANDS: usize = 16;
+
+/// What an audio mapping follows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+pub enum AudioSource {
+    /// RMS level (a full-scale sine is 0.707).
+    Level,
+    /// Peak sample.
+    Peak,
+    /// Bands below 250 Hz, 0–1 over −60…0 dBFS.
+    Low,
+    /// Bands 250 Hz – 4 kHz.
+    Mid,
+    /// Bands above 4 kHz.
+    High,
+    /// One of the 16 log-spaced bands (30 Hz – 16 kHz), 0 the lowest.
+    Band(u8),
+    /// 1 on an onset (a hit), then released; fires a trigger target.
+    Onset,
+}
+
+fn unit_range() -> (f32, f32) {
+    (0.0, 1.0)
+}
+
+fn default_attack() -> f32 {
+    0.01
+}
+
+fn default_release() -> f32 {
+    0.3
 }
 
 /// An LFO: `(target: "glow.angle", shape: Sine, rate: Beats(1.0), range: (0, 90), phase: 0.0)`.

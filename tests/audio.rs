@@ -1,0 +1,153 @@
+//! Sound as a control source: analysis of a synthetic beat (onsets, bands, tempo), renders that
+//! hear a WAV file exactly (twice the same bytes, sought or played), the file as a video's sound
+//! track, and bad files as one sentence.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use indra::control::audio::{Analyzer, AudioFile};
+
+const RATE: u32 = 48_000;
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("indra-audio-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `seconds` of a 120 bpm beat: a 60 Hz kick of 80 ms every half second over faint 6 kHz hiss,
+/// as 16-bit stereo (the channels are mixed on reading).
+fn write_beat(path: &Path, seconds: f32) {
+    let spec =
+        hound::WavSpec { channels: 2, sample_rate: RATE, bits_per_sample: 16, sample_format: hound::SampleFormat::Int };
+    let mut w = hound::WavWriter::create(path, spec).unwrap();
+    for i in 0..(seconds * RATE as f32) as usize {
+        let t = i as f32 / RATE as f32;
+        let in_beat = t % 0.5;
+        let kick =
+            if in_beat < 0.08 { 0.8 * (std::f32::consts::TAU * 60.0 * t).sin() * (1.0 - in_beat / 0.08) } else { 0.0 };
+        let hiss = 0.01 * (std::f32::consts::TAU * 6000.0 * t).sin();
+        let s = ((kick + hiss) * 32767.0) as i16;
+        w.write_sample(s).unwrap();
+        w.write_sample(s).unwrap();
+    }
+    w.finalize().unwrap();
+}
+
+#[test]
+fn a_beat_gives_onsets_on_the_beat_bass_in_the_low_band_and_its_tempo() {
+    let dir = temp_dir("analysis");
+    let path = dir.join("beat.wav");
+    write_beat(&path, 10.0);
+    let file = AudioFile::open(&path).unwrap();
+    assert_eq!(file.rate, RATE);
+    assert!((file.seconds() - 10.0).abs() < 1e-3);
+    let mut analyzer = Analyzer::new(file.rate);
+    let dt = 1.0 / 60.0;
+    let mut onsets = Vec::new();
+    let mut last = None;
+    for f in 0..600u64 {
+        let frame = analyzer.frame(file.hop(f, dt), (f + 1) as f64 * dt);
+        if frame.onset {
+            onsets.push(f);
+        }
+        if f % 30 == 2 {
+            assert!(
+                frame.low > frame.high + 0.3,
+                "frame {f}: the kick is bass (low {}, high {})",
+                frame.low,
+                frame.high
+            );
+        }
+        last = Some(frame);
+    }
+    // A kick every 30 frames, found within a frame of where it starts.
+    assert!((19..=20).contains(&onsets.len()), "{onsets:?}");
+    for f in &onsets {
+        assert!(f % 30 <= 1 || f % 30 == 29, "onset at frame {f}: {onsets:?}");
+    }
+    let bpm = last.unwrap().bpm.expect("a tempo after 10 s");
+    assert!((bpm - 120.0).abs() < 3.0, "{bpm}");
+}
+
+fn indra(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_indra"))
+        .args(args)
+        .args(["--backend", "vulkan"])
+        .env("INDRA_ROOT", env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
+}
+
+fn text(o: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+#[test]
+fn a_render_hears_the_file_exactly_played_or_sought_and_carries_it_as_sound() {
+    let dir = temp_dir("render");
+    let wav = dir.join("beat.wav");
+    write_beat(&wav, 2.0);
+    let render = |out: &str, start: &str, frames: &str, audio: bool| {
+        let out = dir.join(out);
+        let mut args = vec!["render", "kleinian_star_glow", "--size", "64x36", "--start", start, "--frames", frames];
+        args.extend(["--out", out.to_str().unwrap()]);
+        if audio {
+            args.extend(["--audio", wav.to_str().unwrap()]);
+        }
+        let o = indra(&args);
+        assert!(o.status.success(), "{}", text(&o));
+        out
+    };
+    let (a, b) = (render("a", "0", "31", true), render("b", "0", "31", true));
+    let sought = render("c", "30", "1", true);
+    let silent = render("d", "0", "31", false);
+    let png = |dir: &Path, f: u32| std::fs::read(dir.join(format!("kleinian_star_glow_{f:05}.png"))).unwrap();
+    for f in [0, 15, 30] {
+        assert_eq!(png(&a, f), png(&b, f), "frame {f}: two renders hear the same");
+    }
+    assert_eq!(png(&a, 30), png(&sought, 30), "frame 30 sought hears what playing hears");
+    assert_ne!(png(&a, 30), png(&silent, 30), "the kick moves the glow and the zoom");
+
+    let video = dir.join("clip.mp4");
+    let o = indra(&[
+        "render",
+        "kleinian_star_glow",
+        "--size",
+        "64x36",
+        "--frames",
+        "30",
+        "--start",
+        "15",
+        "--audio",
+        wav.to_str().unwrap(),
+        "--video",
+        video.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let probe = Command::new("ffprobe")
+        .args(["-v", "error", "-show_entries", "stream=codec_type,codec_name,duration", "-of", "csv=p=0"])
+        .arg(&video)
+        .output()
+        .expect("ffprobe runs");
+    let streams = String::from_utf8_lossy(&probe.stdout);
+    let audio = streams.lines().find(|l| l.contains("audio")).unwrap_or_else(|| panic!("no sound track: {streams}"));
+    assert!(audio.starts_with("aac"), "{audio}");
+    let duration: f64 = audio.rsplit(',').next().unwrap().parse().unwrap();
+    assert!((duration - 0.5).abs() < 0.06, "the sound lasts as long as the 30 frames: {duration}");
+}
+
+#[test]
+fn a_bad_audio_file_is_one_sentence() {
+    let dir = temp_dir("bad");
+    let not_wav = dir.join("song.wav");
+    std::fs::write(&not_wav, b"ID3 this is an mp3, really").unwrap();
+    for (path, said) in [(not_wav, "is not a WAV file"), (dir.join("missing.wav"), "cannot read audio file")] {
+        let o = indra(&["render", "kleinian_star_glow", "--size", "32x32", "--audio", path.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+        assert!(text(&o).contains(said) && !text(&o).contains("panicked"), "{}", text(&o));
+    }
+}
