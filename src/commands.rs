@@ -66,6 +66,10 @@ pub struct RunArgs {
     /// No audio input.
     #[arg(long)]
     pub no_audio: bool,
+    /// Open one more output window (repeatable): source=NODE, warp=FILE.ron, monitor=N,
+    /// fullscreen — e.g. `--output-window warp=wall.ron,monitor=1,fullscreen`.
+    #[arg(long = "output-window", value_name = "SPEC")]
+    pub output_windows: Vec<String>,
     /// List the audio input devices and exit.
     #[arg(long)]
     pub list_audio: bool,
@@ -108,6 +112,7 @@ impl Default for RunArgs {
             audio_in: None,
             no_audio: false,
             list_audio: false,
+            output_windows: Vec::new(),
             record_controls: None,
             presets: "presets".into(),
             midi_learn: "midi-learn.ron".into(),
@@ -258,7 +263,7 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         return list_audio();
     }
     let mut notices = Vec::new();
-    let scene = match scene_with_sets(assets, &args.scene, &args.sets, args.msaa) {
+    let mut scene = match scene_with_sets(assets, &args.scene, &args.sets, args.msaa) {
         Ok(scene) => scene,
         Err(e) => match scene_with_sets(&Assets::new(None), &args.scene, &args.sets, args.msaa) {
             Ok(builtin) => {
@@ -268,6 +273,9 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
             Err(_) => return Err(e),
         },
     };
+    for spec in &args.output_windows {
+        scene.add_output(spec)?;
+    }
     let options = indra::app::WindowOptions {
         fullscreen: args.fullscreen,
         monitor: args.monitor,

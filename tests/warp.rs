@@ -335,3 +335,34 @@ fn mesh_points_move_where_the_pointer_puts_them_and_save_with_the_warp() {
         assert!((a[0] - b[0]).abs() < 1e-5 && (a[1] - b[1]).abs() < 1e-5);
     }
 }
+
+#[test]
+fn outputs_from_the_command_line_get_the_same_warp_nodes_and_addresses() {
+    let mut scene = indra::scene::load_scene(&assets(), "projection_mapping").unwrap();
+    scene.add_output("warp=warps/wall-right.ron, monitor=2, fullscreen").unwrap();
+    scene.add_output("source=limit_set").unwrap();
+    assert_eq!(scene.outputs.len(), 2);
+    let warped = &scene.nodes[scene.outputs[0].node];
+    assert_eq!((warped.id.as_str(), warped.technique.name), ("output1", "warp"));
+    assert_eq!((scene.outputs[0].monitor, scene.outputs[0].fullscreen), (Some(2), true));
+    assert_eq!(scene.nodes[scene.outputs[1].node].id, "limit_set");
+    let map = indra::control::AddressMap::new(&scene);
+    assert!(map.route("/indra/output/1/corner/3").is_some() && map.route("/indra/output/2/corner/0").is_none());
+    for (bad, said) in
+        [("colour=red", "'colour=red'"), ("source=nowhere", "'nowhere'"), ("monitor=left", "not a number")]
+    {
+        let e = scene.clone().add_output(bad).unwrap_err();
+        assert!(e.contains(said), "{bad}: {e}");
+    }
+    // The added output renders what its warp makes of the scene's image.
+    let render = |n: usize| {
+        let mut r =
+            indra::offscreen::OffscreenRenderer::new(gpu(), &assets(), scene.clone(), Some((96, 54)), None, None)
+                .unwrap();
+        r.show_output(n).unwrap();
+        r.render_next().unwrap().rgba
+    };
+    let (main, projector) = (render(0), render(1));
+    assert_ne!(main, projector);
+    assert_eq!(&projector[..4], &[0, 0, 0, 255], "the right projector's region leaves its top-left corner black");
+}

@@ -166,6 +166,53 @@ impl Scene {
         ))
     }
 
+    /// Adds an output from the command line (`run --output-window`): `source=NODE` (default the
+    /// scene's output), `warp=FILE.ron` (a warp node `output<n>` in between, with its corner
+    /// addresses), `monitor=N`, `fullscreen` — separated by commas, as a scene's `outputs` has.
+    pub fn add_output(&mut self, spec: &str) -> Result<(), String> {
+        let mut source = None;
+        let mut warp = None;
+        let mut monitor = None;
+        let mut fullscreen = false;
+        for part in spec.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+            match part.split_once('=').map(|(k, v)| (k.trim(), v.trim())) {
+                Some(("source", v)) => source = Some(v.to_string()),
+                Some(("warp", v)) => warp = Some(v.to_string()),
+                Some(("monitor", v)) => {
+                    monitor = Some(v.parse::<usize>().map_err(|_| format!("monitor '{v}' is not a number"))?);
+                }
+                None if part == "fullscreen" => fullscreen = true,
+                _ => {
+                    return Err(format!(
+                        "'{part}' in output '{spec}': use source=NODE, warp=FILE.ron, monitor=N and fullscreen"
+                    ));
+                }
+            }
+        }
+        let number = self.outputs.len() + 1;
+        let main = &self.nodes[self.output].id;
+        let source_id = source.unwrap_or_else(|| main.clone());
+        let mut node = self
+            .node_index(&source_id)
+            .ok_or_else(|| format!("output {number}: '{source_id}' is not a node of scene '{}'", self.name))?;
+        if let Some(file) = warp {
+            let id = format!("output{number}");
+            if self.node_index(&id).is_some() {
+                return Err(format!("output {number}: the scene already has a node '{id}'"));
+            }
+            let mut params = ParamSet::new((techniques::warp::INFO.params)());
+            let index = params.index("file").expect("a warp node has a file parameter");
+            params.set_at(index, ParamValue::Text(crate::params::Text::new(&file)));
+            params.snap();
+            self.nodes.push(SceneNode { id, technique: &techniques::warp::INFO, params, inputs: vec![node] });
+            node = self.nodes.len() - 1;
+        }
+        self.outputs.push(SceneOutput { node, monitor, fullscreen });
+        self.osc_aliases.retain(|(a, _)| !a.starts_with("/indra/output/"));
+        self.osc_aliases.extend(corner_aliases(&self.outputs, &self.nodes));
+        Ok(())
+    }
+
     /// Applies `node.param=value` (value: numbers separated by commas, or true/false), as the
     /// CLI's `--set` does. The value is typed and clamped like any other.
     pub fn set_from_str(&mut self, assignment: &str) -> Result<(), String> {
