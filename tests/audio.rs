@@ -5,7 +5,9 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
+
+use common::{indra, text};
 
 use indra::control::audio::{Analyzer, AudioFile};
 
@@ -71,19 +73,6 @@ fn a_beat_gives_onsets_on_the_beat_bass_in_the_low_band_and_its_tempo() {
     }
     let bpm = last.unwrap().bpm.expect("a tempo after 10 s");
     assert!((bpm - 120.0).abs() < 3.0, "{bpm}");
-}
-
-fn indra(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_indra"))
-        .args(args)
-        .args(["--backend", "vulkan"])
-        .env("INDRA_ROOT", env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap()
-}
-
-fn text(o: &Output) -> String {
-    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
 }
 
 #[test]

@@ -1,21 +1,12 @@
 //! The `indra` binary end to end: render, check, list, bench, and one clear sentence for every
 //! kind of bad input.
 
+mod common;
+
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn indra(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_indra"))
-        .args(args)
-        .args(["--backend", "vulkan"])
-        .env("INDRA_ROOT", env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("the binary runs")
-}
-
-fn text(o: &Output) -> String {
-    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
-}
+use common::{indra, text};
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("indra-cli-{name}-{}", std::process::id()));

@@ -70,21 +70,7 @@ impl OutputWindow {
             .instance
             .create_surface(window.clone())
             .map_err(|e| format!("cannot draw into output {number}'s window: {e}"))?;
-        let caps = surface.get_capabilities(&gpu.adapter);
-        let (format, alpha_mode) = super::surface::choose_surface_format(&caps, &gpu.adapter_label())?;
-        let inner = window.inner_size();
-        let config = wgpu::SurfaceConfiguration {
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            format,
-            color_space: wgpu::SurfaceColorSpace::Auto,
-            width: inner.width.max(1),
-            height: inner.height.max(1),
-            present_mode: wgpu::PresentMode::AutoVsync,
-            desired_maximum_frame_latency: 2,
-            alpha_mode,
-            view_formats: vec![],
-        };
-        surface.configure(&gpu.device, &config);
+        let config = super::surface::configure_surface(&surface, &window, gpu)?;
         log::info!("output {number}: window {}x{}", config.width, config.height);
         Ok(Self {
             number,

@@ -17,6 +17,31 @@ pub fn choose_surface_format(
     Ok((format, alpha))
 }
 
+/// Configures `surface` of `window` for `gpu` (a format and alpha mode it offers, vsync, two
+/// frames in flight) and returns the configuration, or one sentence on why it cannot be drawn.
+pub fn configure_surface(
+    surface: &wgpu::Surface<'_>,
+    window: &winit::window::Window,
+    gpu: &crate::gpu::Gpu,
+) -> Result<wgpu::SurfaceConfiguration, String> {
+    let caps = surface.get_capabilities(&gpu.adapter);
+    let (format, alpha_mode) = choose_surface_format(&caps, &gpu.adapter_label())?;
+    let size = window.inner_size();
+    let config = wgpu::SurfaceConfiguration {
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        format,
+        color_space: wgpu::SurfaceColorSpace::Auto,
+        width: size.width.max(1),
+        height: size.height.max(1),
+        present_mode: wgpu::PresentMode::AutoVsync,
+        desired_maximum_frame_latency: 2,
+        alpha_mode,
+        view_formats: vec![],
+    };
+    surface.configure(&gpu.device, &config);
+    Ok(config)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

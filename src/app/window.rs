@@ -129,21 +129,7 @@ impl WindowApp {
             wgpu_instance.create_surface(window.clone()).map_err(|e| format!("cannot draw into the window: {e}"))?;
         let gpu = pollster::block_on(Gpu::with_instance(wgpu_instance, &self.gpu_options, Some(&surface)))
             .map_err(|e| e.to_string())?;
-        let caps = surface.get_capabilities(&gpu.adapter);
-        let (format, alpha_mode) = super::surface::choose_surface_format(&caps, &gpu.adapter_label())?;
-        let size = window.inner_size();
-        let config = wgpu::SurfaceConfiguration {
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            format,
-            color_space: wgpu::SurfaceColorSpace::Auto,
-            width: size.width.max(1),
-            height: size.height.max(1),
-            present_mode: wgpu::PresentMode::AutoVsync,
-            desired_maximum_frame_latency: 2,
-            alpha_mode,
-            view_formats: vec![],
-        };
-        surface.configure(&gpu.device, &config);
+        let config = super::surface::configure_surface(&surface, &window, &gpu)?;
         log::info!("window {}x{} on {}", config.width, config.height, gpu.adapter_label());
         for (i, m) in event_loop.available_monitors().enumerate() {
             log::info!("monitor {i}: {}", m.name().unwrap_or_default());
@@ -179,7 +165,7 @@ impl WindowApp {
         }
         let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
         let blit = Blit::new(&gpu.device);
-        let (egui_state, egui_renderer) = egui_parts(&window, &gpu, format);
+        let (egui_state, egui_renderer) = egui_parts(&window, &gpu, config.format);
         let mut hub = hub;
         if self.options.record_video.is_some() {
             hub.record_requests.push(RecordRequest::Start(None));

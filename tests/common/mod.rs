@@ -85,3 +85,18 @@ pub fn read_float_texture(gpu: &Gpu, texture: &wgpu::Texture) -> Vec<[f32; 4]> {
         .map(|t| std::array::from_fn(|c| half::f16::from_le_bytes([t[2 * c], t[2 * c + 1]]).to_f32()))
         .collect()
 }
+
+/// Runs the `indra` binary with `args` on Vulkan, against this checkout's scenes and shaders.
+pub fn indra(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_indra"))
+        .args(args)
+        .args(["--backend", "vulkan"])
+        .env("INDRA_ROOT", env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the binary runs")
+}
+
+/// What a run printed, stdout then stderr.
+pub fn text(o: &std::process::Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
