@@ -5,16 +5,14 @@
 mod common;
 
 use std::path::{Path, PathBuf};
+
+use common::text;
 use std::process::{Command, Output};
 
 fn indra(args: &[&str]) -> Command {
     let mut command = Command::new(env!("CARGO_BIN_EXE_indra"));
     command.args(args).args(["--backend", "vulkan"]).env("INDRA_ROOT", env!("CARGO_MANIFEST_DIR"));
     command
-}
-
-fn text(o: &Output) -> String {
-    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
 }
 
 fn temp_dir(name: &str) -> PathBuf {

@@ -375,7 +375,7 @@ impl OscRouter {
             }
         };
         let routed: Vec<Routed> = targets.iter().filter_map(|t| write_for(*t, &msg.args, scene)).collect();
-        self.count(&routed.first().cloned(), msg, rx);
+        count(!routed.is_empty(), msg, rx);
         routed
     }
 
@@ -395,24 +395,23 @@ impl OscRouter {
             Route::Command(command) => route_command(command, &msg.args),
             Route::Param(t) => write_for(t, &msg.args, scene),
         };
-        self.count(&routed, msg, rx);
+        count(routed.is_some(), msg, rx);
         routed
     }
+}
 
-    /// Counts a routed message as applied, or as having bad arguments (logged once).
-    fn count(&self, routed: &Option<Routed>, msg: &OscMessage, rx: &OscReceiver) {
-        let counters = rx.counters();
-        match routed {
-            Some(_) => counters.applied.fetch_add(1, Ordering::Relaxed),
-            None => {
-                rx.log_once(
-                    &format!("args {}", msg.addr),
-                    &format!("{} does not take the arguments ({})", msg.addr, describe_args(&msg.args)),
-                );
-                counters.bad_arguments.fetch_add(1, Ordering::Relaxed)
-            }
-        };
+/// Counts a message as applied, or as having bad arguments (logged once per address).
+fn count(applied: bool, msg: &OscMessage, rx: &OscReceiver) {
+    let counters = rx.counters();
+    if applied {
+        counters.applied.fetch_add(1, Ordering::Relaxed);
+        return;
     }
+    rx.log_once(
+        &format!("args {}", msg.addr),
+        &format!("{} does not take the arguments ({})", msg.addr, describe_args(&msg.args)),
+    );
+    counters.bad_arguments.fetch_add(1, Ordering::Relaxed);
 }
 
 /// The write of `args` to target `t`, if they fit its type.

@@ -3,7 +3,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use super::error::{SceneError, SceneErrors, locate};
-use super::schema::{AUDIO_BANDS, AudioSource, MidiMapping, SceneFile};
+use super::schema::{AUDIO_BANDS, AudioSource, MidiMapping, OutputFile, SceneFile};
 use crate::assets::{AssetKind, Assets};
 use crate::params::{Key, Lfo, ParamDecl, ParamSet, ParamType, ParamValue, RawValue, Target, Track, coerce};
 use crate::techniques::{self, TechniqueInfo};
@@ -189,25 +189,32 @@ impl Scene {
                 }
             }
         }
+        self.attach_output(&OutputFile { source, warp, monitor, fullscreen })
+    }
+
+    /// Adds output `output` (from the scene file's `outputs` or the command line): resolves its
+    /// source, puts a warp node `output<n>` in between when it names a warp file, and gives
+    /// warped outputs their corner addresses.
+    fn attach_output(&mut self, output: &OutputFile) -> Result<(), String> {
         let number = self.outputs.len() + 1;
         let main = &self.nodes[self.output].id;
-        let source_id = source.unwrap_or_else(|| main.clone());
+        let source_id = output.source.clone().unwrap_or_else(|| main.clone());
         let mut node = self
             .node_index(&source_id)
             .ok_or_else(|| format!("output {number}: '{source_id}' is not a node of scene '{}'", self.name))?;
-        if let Some(file) = warp {
+        if let Some(file) = &output.warp {
             let id = format!("output{number}");
             if self.node_index(&id).is_some() {
                 return Err(format!("output {number}: the scene already has a node '{id}'"));
             }
             let mut params = ParamSet::new((techniques::warp::INFO.params)());
             let index = params.index("file").expect("a warp node has a file parameter");
-            params.set_at(index, ParamValue::Text(crate::params::Text::new(&file)));
+            params.set_at(index, ParamValue::Text(crate::params::Text::new(file)));
             params.snap();
             self.nodes.push(SceneNode { id, technique: &techniques::warp::INFO, params, inputs: vec![node] });
             node = self.nodes.len() - 1;
         }
-        self.outputs.push(SceneOutput { node, monitor, fullscreen });
+        self.outputs.push(SceneOutput { node, monitor: output.monitor, fullscreen: output.fullscreen });
         self.osc_aliases.retain(|(a, _)| !a.starts_with("/indra/output/"));
         self.osc_aliases.extend(corner_aliases(&self.outputs, &self.nodes));
         Ok(())
@@ -316,25 +323,6 @@ pub fn parse_scene(origin: &str, source: &str) -> Result<Scene, SceneErrors> {
     Validator { origin, source, errors: Vec::new(), more: 0 }.validate(file)
 }
 
-/// Puts a `warp` node `output<n>` between each warped output and its source (the scene's output
-/// when it names none), and points the output at it.
-fn add_output_warps(file: &mut SceneFile) {
-    for (i, output) in file.outputs.iter_mut().enumerate() {
-        let Some(warp) = output.warp.take() else { continue };
-        let id = format!("output{}", i + 1);
-        let source = output.source.clone().unwrap_or_else(|| file.output.clone());
-        file.nodes.push(super::schema::NodeFile {
-            id: id.clone(),
-            technique: techniques::warp::INFO.name.into(),
-            params: [("file".to_string(), RawValue::Text(warp))].into(),
-            ranges: Default::default(),
-            smoothing: Default::default(),
-            inputs: [("source".to_string(), source)].into(),
-        });
-        output.source = Some(id);
-    }
-}
-
 /// `/indra/output/<n>/corner/<i>` for every output that shows a warp node: a controller can
 /// drag corner i (clockwise from the top left) of output n without knowing node ids.
 fn corner_aliases(outputs: &[SceneOutput], nodes: &[SceneNode]) -> Vec<(String, Target)> {
@@ -394,8 +382,7 @@ impl Validator<'_> {
         SceneErrors(self.errors)
     }
 
-    fn validate(mut self, mut file: SceneFile) -> Result<Scene, SceneErrors> {
-        add_output_warps(&mut file);
+    fn validate(mut self, file: SceneFile) -> Result<Scene, SceneErrors> {
         if file.size.0 == 0 || file.size.1 == 0 || file.size.0 > 16384 || file.size.1 > 16384 {
             self.error(&["size"], format!("size {:?} must be between 1 and 16384 on each axis", file.size));
         }
@@ -442,15 +429,13 @@ impl Validator<'_> {
         }
         let output = position[&output.expect("checked above")];
         let tracks = self.tracks(&file, &ordered);
-        let (mut osc_aliases, midi) = self.controls(&file, &ordered);
-        let outputs = self.outputs(&file, &ordered, output);
+        let (osc_aliases, midi) = self.controls(&file, &ordered);
         let lfos = self.lfos(&file, &ordered);
         let audio = self.audio(&file, &ordered);
-        osc_aliases.extend(corner_aliases(&outputs, &ordered));
         if !self.errors.is_empty() {
             return Err(self.failure());
         }
-        let scene = Scene {
+        let mut scene = Scene {
             origin: self.origin.into(),
             name: file.name,
             description: file.description,
@@ -463,11 +448,20 @@ impl Validator<'_> {
             msaa: file.msaa,
             nodes: ordered,
             output,
-            outputs,
+            outputs: Vec::new(),
             tracks,
             osc_aliases,
             midi,
         };
+        for o in &file.outputs {
+            if let Err(e) = scene.attach_output(o) {
+                let anchor = format!("\"{}\"", o.source.as_deref().unwrap_or_default());
+                self.error(&["outputs", &anchor], e);
+            }
+        }
+        if !self.errors.is_empty() {
+            return Err(self.failure());
+        }
         if let Err(message) = scene.check_texture_budget(scene.size) {
             self.error(&["size"], message);
             return Err(self.failure());
@@ -545,26 +539,6 @@ impl Validator<'_> {
             }
         }
         out
-    }
-
-    /// Resolves the extra outputs' sources (after [`add_output_warps`]).
-    fn outputs(&mut self, file: &SceneFile, nodes: &[SceneNode], main: usize) -> Vec<SceneOutput> {
-        let mut outputs = Vec::new();
-        for (i, o) in file.outputs.iter().enumerate() {
-            let node = match &o.source {
-                None => Some(main),
-                Some(id) => nodes.iter().position(|n| &n.id == id),
-            };
-            match node {
-                Some(node) => outputs.push(SceneOutput { node, monitor: o.monitor, fullscreen: o.fullscreen }),
-                None => {
-                    let id = o.source.clone().unwrap_or_default();
-                    let anchor = format!("\"{id}\"");
-                    self.error(&["outputs", &anchor], format!("output {}: '{id}' is not a node of this scene", i + 1));
-                }
-            }
-        }
-        outputs
     }
 
     /// Resolves OSC aliases and MIDI mappings to parameters.

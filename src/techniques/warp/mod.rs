@@ -136,9 +136,7 @@ pub struct Warp {
     root: Option<PathBuf>,
     /// The mesh in use (a regular 2×2 grid without one).
     mesh: MeshWarp,
-    /// View units → unit square (the inverse corner pin of the last frame), for the pointer.
-    unpin: Option<Homography>,
-    /// The part of the source shown in the last frame, for the pointer.
+    /// The part of the source shown at the last step, for the pointer.
     region: Region,
     /// The `mesh_size` last applied (the loaded mesh's after a file load).
     applied_size: [u32; 2],
@@ -226,7 +224,6 @@ impl Warp {
             queue: setup.gpu.queue.clone(),
             root: setup.assets.root().map(std::path::Path::to_path_buf),
             mesh: MeshWarp::regular(2, 2),
-            unpin: None,
             applied_size: [2, 2],
             applied_point: [-1.0, 0.0, 0.0],
             pin: Corners::default().homography(),
@@ -456,7 +453,9 @@ impl Technique for Warp {
     fn step(&mut self, params: &ParamSet, _time: &FrameTime) {
         // Edits first: a file loaded in this step replaces the mesh, and its size reaches the
         // parameters only after the step.
-        self.pin = warp_from(params, None).corners.homography();
+        let warp = warp_from(params, None);
+        self.pin = warp.corners.homography();
+        self.region = warp.region;
         self.edit_mesh(params);
         let ParamValue::Text(path) = params.get("file") else { return };
         let path = path.as_str().trim().to_string();
@@ -492,7 +491,7 @@ impl Technique for Warp {
     fn map_pointer(&self, view: [f32; 2]) -> Option<[f32; 2]> {
         // A pointer on the wall lands on the source point shown there (a fluid is stirred under
         // it): undo the corner pin exactly, then the mesh by Newton steps.
-        let pinned = self.unpin?.apply([f64::from(view[0]), f64::from(view[1])])?;
+        let pinned = self.pin.inverse()?.apply([f64::from(view[0]), f64::from(view[1])])?;
         let target = [pinned[0] as f32, pinned[1] as f32];
         let uv = invert_mesh(&self.mesh, target)?;
         let (lo, hi) = (self.region.min, self.region.max);
@@ -512,9 +511,6 @@ impl Technique for Warp {
         let targets = graph.create_raster_targets("warp", FORMAT, None, self.samples);
         let Some(&source) = inputs.first() else { return targets.color };
         let uniforms = uniforms(params, &self.mesh);
-        let warp = warp_from(params, None);
-        self.unpin = warp.corners.homography().inverse();
-        self.region = warp.region;
         let this = &*self;
         graph.add_pass("warp/draw").read(source).draws_into(&targets).record(move |ctx| {
             this.record(ctx, source, &targets, &uniforms);
