@@ -72,7 +72,7 @@ fn a_beat_gives_onsets_on_the_beat_bass_in_the_low_band_and_its_tempo() {
         assert!(f % 30 <= 1 || f % 30 == 29, "onset at frame {f}: {onsets:?}");
     }
     let bpm = last.unwrap().bpm.expect("a tempo after 10 s");
-    assert!((bpm - 120.0).abs() < 3.0, "{bpm}");
+    assert!((bpm - 120.0).abs() < 1.0, "{bpm}");
 }
 
 #[test]

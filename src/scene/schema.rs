@@ -144,6 +144,9 @@ pub enum AudioSource {
     Band(u8),
     /// 1 on an onset (a hit), then released; fires a trigger target.
     Onset,
+    /// 1 on each beat of the music (onsets locked to the heard tempo, kept through a missed
+    /// hit), then released; fires a trigger target.
+    Beat,
 }
 
 fn unit_range() -> (f32, f32) {

@@ -1,6 +1,7 @@
 //! Audio analysis for modulation: level (RMS, peak), log-spaced bands from a real FFT, onsets by
 //! spectral flux against an adaptive threshold, and a tempo estimate from the onset strength's
-//! autocorrelation. It sees audio in hops (whatever arrived since the last frame) and keeps the
+//! autocorrelation, with a beat tracker that locks to the onsets on that tempo's grid and keeps
+//! the beat through a missed hit. It sees audio in hops (whatever arrived since the last frame) and keeps the
 //! last [`FFT_SIZE`] samples for the spectrum, so a file analysed hop by hop on the fixed clock
 //! gives the same numbers every time.
 
@@ -27,8 +28,12 @@ const FLUX_SECONDS: f64 = 1.0;
 const TEMPO_SECONDS: f64 = 8.0;
 /// Tempi the estimate considers.
 const TEMPO_BPM: (f64, f64) = (60.0, 180.0);
+/// The tempo the estimate leans to when a period and its multiples match equally.
+const TEMPO_PRIOR_BPM: f64 = 120.0;
 /// Onsets closer than this are one.
 const REFRACTORY_SECONDS: f64 = 0.1;
+/// An onset this close to the predicted beat (a share of the beat period) is the beat.
+const BEAT_WINDOW: f64 = 0.2;
 
 /// What one frame of audio measures.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -47,6 +52,9 @@ pub struct AudioFrame {
     pub high: f32,
     /// An onset (a hit, a note) started in this hop.
     pub onset: bool,
+    /// A beat of the music falls in this hop: an onset on the tempo's grid, or the grid's beat
+    /// when the hit is missing. Before a tempo is heard, every onset is a beat.
+    pub beat: bool,
     /// The tempo the onsets suggest, once a few seconds were heard.
     pub bpm: Option<f64>,
 }
@@ -65,6 +73,9 @@ pub struct Analyzer {
     strength: VecDeque<(f64, f32)>,
     /// Band edges as FFT bin ranges.
     band_bins: Vec<(usize, usize)>,
+    /// The beat tracker: when the next beat is due, and when the last one fell.
+    next_beat: Option<f64>,
+    last_beat: Option<f64>,
 }
 
 impl Analyzer {
@@ -94,6 +105,8 @@ impl Analyzer {
             last_onset: None,
             strength: VecDeque::new(),
             band_bins,
+            next_beat: None,
+            last_beat: None,
         }
     }
 
@@ -131,7 +144,37 @@ impl Analyzer {
         let (low, mid, high) = (mean_of(0.0..250.0), mean_of(250.0..4000.0), mean_of(4000.0..f32::MAX));
         let onset = self.onset(&magnitudes, seconds);
         self.previous = magnitudes;
-        AudioFrame { level, peak, bands, low, mid, high, onset, bpm: self.tempo() }
+        let bpm = self.tempo();
+        let beat = self.beat(onset, bpm, seconds);
+        AudioFrame { level, peak, bands, low, mid, high, onset, beat, bpm }
+    }
+
+    /// Whether a beat falls at `seconds`: an onset near (or past) the predicted beat is the beat
+    /// and sets the phase; a predicted beat with no onset near it still beats (the flywheel); an
+    /// onset just after a flywheel beat moves the phase to it without beating twice; an onset
+    /// between beats (an off-beat hit) is not a beat. No tempo: every onset beats.
+    fn beat(&mut self, onset: bool, bpm: Option<f64>, seconds: f64) -> bool {
+        let Some(bpm) = bpm else {
+            self.next_beat = None;
+            return onset;
+        };
+        let period = 60.0 / bpm;
+        let window = BEAT_WINDOW * period;
+        let just_beat = self.last_beat.is_some_and(|t| seconds - t <= window);
+        if onset && just_beat {
+            self.next_beat = Some(seconds + period);
+            return false;
+        }
+        let due = self.next_beat.is_none_or(|next| seconds >= next - window);
+        if onset && due {
+            self.next_beat = Some(seconds + period);
+        } else if let Some(next) = self.next_beat.filter(|&next| seconds >= next) {
+            self.next_beat = Some(next + period);
+        } else {
+            return false;
+        }
+        self.last_beat = Some(seconds);
+        true
     }
 
     /// Magnitudes of the last [`FFT_SIZE`] samples, scaled so a full-scale sine peaks at 1.
@@ -169,7 +212,8 @@ impl Analyzer {
         onset
     }
 
-    /// The lag between 60 and 180 bpm at which the onset strength best matches itself.
+    /// The beat period between 60 and 180 bpm at which the onset strength best matches itself,
+    /// refined to a fraction of a frame over several periods.
     fn tempo(&self) -> Option<f64> {
         let (first, last) = (self.strength.front()?.0, self.strength.back()?.0);
         let n = self.strength.len();
@@ -178,12 +222,48 @@ impl Analyzer {
         }
         let frame = (last - first) / (n - 1) as f64;
         let values: Vec<f32> = self.strength.iter().map(|s| s.1).collect();
+        let matched = |lag: usize| {
+            if lag == 0 || lag >= n {
+                return 0.0;
+            }
+            values.iter().zip(&values[lag..]).map(|(a, b)| a * b).sum::<f32>() / (n - lag) as f32
+        };
+        // A period that is not a whole number of frames splits its match over two lags.
+        let near = |lag: usize| matched(lag.saturating_sub(1)).max(matched(lag)).max(matched(lag + 1));
         // Beat periods from 1/3 s (180 bpm) to 1 s (60 bpm), in frames.
         let (min_lag, max_lag) =
             ((60.0 / TEMPO_BPM.1 / frame).ceil() as usize, (60.0 / TEMPO_BPM.0 / frame).floor() as usize);
-        let score = |lag: usize| values.iter().zip(&values[lag..]).map(|(a, b)| a * b).sum::<f32>() / (n - lag) as f32;
-        let best = (min_lag.max(1)..=max_lag.min(n - 1)).max_by(|&a, &b| score(a).total_cmp(&score(b)))?;
-        (score(best) > 0.0).then(|| 60.0 / (best as f64 * frame))
+        // A pulse matches itself at every multiple of its period too. A tempo prior (an
+        // octave-wide log-normal around 120 bpm, as in Ellis's beat tracker) leans to the middle,
+        // and a lag whose half matches well is taken at its half.
+        let prior = |lag: usize| {
+            let octaves = (60.0 / (lag as f64 * frame) / TEMPO_PRIOR_BPM).log2();
+            (-0.5 * octaves * octaves).exp() as f32
+        };
+        let best = (min_lag.max(1)..=max_lag.min(n - 1))
+            .max_by(|&a, &b| (near(a) * prior(a)).total_cmp(&(near(b) * prior(b))))?;
+        if near(best) <= 0.0 {
+            return None;
+        }
+        // The prior must not pull the period off its own peak within the tolerance.
+        let best = (best.saturating_sub(1).max(1)..=best + 1).max_by(|&a, &b| matched(a).total_cmp(&matched(b)))?;
+        let half = best / 2;
+        let mut period = best as f64;
+        if half + 1 >= min_lag && near(half).max(near(half + 1)) >= 0.5 * near(best) {
+            period /= 2.0;
+        }
+        // Refine over as many periods as half the history holds: the peak of the match near k
+        // periods, interpolated by a parabola, divided by k.
+        let k = ((n / 2) as f64 / period).floor().max(1.0);
+        let around = (k * period).round() as usize;
+        let reach = (k / 2.0).ceil() as usize + 1;
+        let peak = (around.saturating_sub(reach).max(1)..=(around + reach).min(n - 2))
+            .max_by(|&a, &b| matched(a).total_cmp(&matched(b)))?;
+        let (l, c, r) = (matched(peak - 1), matched(peak), matched(peak + 1));
+        let curvature = l - 2.0 * c + r;
+        let offset = if curvature < 0.0 { (0.5 * (l - r) / curvature).clamp(-0.5, 0.5) } else { 0.0 };
+        let refined = (peak as f64 + f64::from(offset)) / k;
+        Some(60.0 / (refined * frame))
     }
 }
 
@@ -223,5 +303,50 @@ mod tests {
         assert_eq!((f.level, f.low, f.onset), (0.0, 0.0, false));
         let f = a.frame(&[f32::NAN; 735], 2.0 / 60.0);
         assert!(f.level == 0.0 && f.bands.iter().all(|b| b.is_finite()));
+    }
+
+    /// `seconds` of 60 Hz kicks (80 ms) at `bpm`, leaving out the kicks for which `missing` holds.
+    fn kicks(rate: u32, bpm: f32, seconds: usize, missing: impl Fn(usize) -> bool) -> Vec<f32> {
+        let period = 60.0 / bpm;
+        (0..seconds * rate as usize)
+            .map(|i| {
+                let t = i as f32 / rate as f32;
+                let (k, in_beat) = ((t / period) as usize, t % period);
+                let on = !missing(k) && in_beat < 0.08;
+                if on { 0.8 * (std::f32::consts::TAU * 60.0 * t).sin() * (1.0 - in_beat / 0.08) } else { 0.0 }
+            })
+            .collect()
+    }
+
+    /// Analyses `samples` in 60 Hz frames; the frames' results.
+    fn frames(rate: u32, samples: &[f32]) -> Vec<AudioFrame> {
+        let mut a = Analyzer::new(rate);
+        let hop = rate as usize / 60;
+        (0..samples.len() / hop).map(|f| a.frame(&samples[f * hop..(f + 1) * hop], (f + 1) as f64 / 60.0)).collect()
+    }
+
+    #[test]
+    fn beats_lock_to_the_kicks_and_carry_on_through_missing_ones() {
+        // 120 bpm; from 6 s on every fourth kick is missing.
+        let rate = 48_000;
+        let heard = frames(rate, &kicks(rate, 120.0, 12, |k| k >= 12 && k % 4 == 3));
+        let beats: Vec<usize> = (0..heard.len()).filter(|&f| heard[f].beat).collect();
+        // Every half second from 1 s on is a beat, within a frame of the grid, missing kicks
+        // included; nothing else is.
+        let late: Vec<usize> = beats.iter().copied().filter(|&f| f >= 60).collect();
+        assert_eq!(late.len(), 22, "{beats:?}");
+        for (i, f) in late.iter().enumerate() {
+            assert!(f.abs_diff(60 + 30 * i) <= 1, "beat {i} at frame {f}: {beats:?}");
+        }
+    }
+
+    #[test]
+    fn slow_and_fast_tempi_are_heard_as_themselves_not_as_their_octaves() {
+        let rate = 48_000;
+        for bpm in [72.0, 100.0, 150.0, 175.0] {
+            let heard = frames(rate, &kicks(rate, bpm, 9, |_| false));
+            let estimate = heard.last().unwrap().bpm.expect("a tempo after 9 s");
+            assert!((estimate - f64::from(bpm)).abs() < 1.0, "{bpm} heard as {estimate}");
+        }
     }
 }

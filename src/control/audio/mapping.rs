@@ -1,5 +1,5 @@
 //! Audio analysis → parameter writes: each mapping follows one source (a band, the level, an
-//! onset) with its own attack and release, scaled into a range — an envelope follower per
+//! onset, a beat) with its own attack and release, scaled into a range — an envelope follower per
 //! mapping, stepped with the frames it is fed, so a file's writes are the same every render.
 
 use super::analysis::{AudioFrame, BANDS};
@@ -28,7 +28,7 @@ impl AudioMapper {
 
     /// The writes for one frame of `dt` seconds: each mapping's envelope moves towards its
     /// source (attack when rising, release when falling) and is written across its range; an
-    /// onset mapped to a trigger fires it.
+    /// onset or beat mapped to a trigger fires it, a level fires it as it rises through half.
     pub fn events(&mut self, frame: &AudioFrame, dt: f64, scene: &Scene) -> Vec<ControlEvent> {
         let mut events = Vec::new();
         for (m, envelope) in self.mappings.iter().zip(&mut self.envelopes) {
@@ -40,10 +40,13 @@ impl AudioMapper {
                 AudioSource::High => frame.high,
                 AudioSource::Band(b) => frame.bands.get(usize::from(b).min(BANDS - 1)).copied().unwrap_or(0.0),
                 AudioSource::Onset => f32::from(u8::from(frame.onset)),
+                AudioSource::Beat => f32::from(u8::from(frame.beat)),
             };
             let decl = &scene.nodes[m.target.node].params.decls()[m.target.param];
             if decl.ty() == ParamType::Trigger {
-                if frame.onset || (m.source != AudioSource::Onset && input > 0.5 && *envelope <= 0.5) {
+                // A pulse source fires on each pulse; a level fires as it rises through half.
+                let pulse = matches!(m.source, AudioSource::Onset | AudioSource::Beat);
+                if input > 0.5 && (pulse || *envelope <= 0.5) {
                     events.push(write(m.target, ParamValue::Trigger(true)));
                 }
                 *envelope = input;
@@ -73,4 +76,46 @@ fn write(target: Target, value: ParamValue) -> ControlEvent {
         value,
         source: Source::Audio,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::parse_scene;
+
+    const SCENE: &str = r#"(
+        name: "t", size: (8, 8), dt: 0.1,
+        nodes: [(id: "fluid", technique: "grid_fluid")],
+        output: "fluid",
+        controls: (audio: [
+            (source: Beat, target: "fluid.reset"),
+            (source: Low, target: "fluid.reset"),
+            (source: Low, target: "fluid.velocity_coef", range: (2.0, 6.0), attack: 0.0, release: 1.0),
+        ]),
+    )"#;
+
+    /// How many times `events` fire the reset trigger.
+    fn fired(events: &[ControlEvent], scene: &Scene) -> usize {
+        let reset = scene.nodes[0].params.decls().iter().position(|d| d.name == "reset").unwrap();
+        events.iter().filter(|e| matches!(e, ControlEvent::Write(w) if w.param == reset)).count()
+    }
+
+    #[test]
+    fn a_beat_fires_its_trigger_a_level_fires_as_it_rises_and_an_envelope_releases() {
+        let scene = parse_scene("t.ron", SCENE).unwrap();
+        let mut mapper = AudioMapper::new(&scene);
+        let frame = |low: f32, onset: bool, beat: bool| AudioFrame { low, onset, beat, ..AudioFrame::default() };
+        // An onset off the beat fires neither trigger (the level one only listens to the level).
+        assert_eq!(fired(&mapper.events(&frame(0.0, true, false), 0.1, &scene), &scene), 0);
+        assert_eq!(fired(&mapper.events(&frame(0.0, true, true), 0.1, &scene), &scene), 1, "the beat");
+        assert_eq!(fired(&mapper.events(&frame(0.8, false, false), 0.1, &scene), &scene), 1, "the rise");
+        assert_eq!(fired(&mapper.events(&frame(0.9, false, false), 0.1, &scene), &scene), 0, "still high");
+        // The level's envelope: attack 0 jumps, release 1 s decays by e^(-dt) per step.
+        let events = mapper.events(&frame(0.0, false, false), 0.1, &scene);
+        let Some(ControlEvent::Write(ParamWrite { value: ParamValue::Float(v), .. })) = events.last() else {
+            panic!("{events:?}")
+        };
+        let expected = 2.0 + 4.0 * 0.9 * (-0.1f32).exp();
+        assert!((v - expected).abs() < 1e-4, "{v} vs {expected}");
+    }
 }
