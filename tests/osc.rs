@@ -1,6 +1,6 @@
 //! OSC over real UDP on loopback: messages of every argument type, clamping, atomic bundles,
 //! future time tags, an external client (liblo's `oscsend`), 100,000 hostile packets, feedback
-//! out and the OSCQuery tree.
+//! out, the OSCQuery tree, its LISTEN WebSocket and its mDNS advertisement.
 
 mod common;
 
@@ -522,4 +522,117 @@ fn tempo_is_set_and_tapped_over_osc() {
     );
     assert_eq!(routed, [Routed::Event(ControlEvent::Tempo { bpm: 128.0, resync: false }), Routed::TapTempo]);
     assert_eq!(rx.counters().snapshot()[4], 1, "the word is a bad argument");
+}
+
+/// Writes `value` to parameter `name` of node 0.
+fn set(instance: &mut SceneInstance, name: &str, value: ParamValue) {
+    let param = instance.params(0).index(name).unwrap();
+    let write =
+        indra::params::ParamWrite { node: 0, param, component: None, value, source: indra::params::Source::Osc };
+    instance.apply(&[ControlEvent::Write(write)]);
+}
+
+type Socket = tungstenite::WebSocket<tungstenite::stream::MaybeTlsStream<std::net::TcpStream>>;
+
+/// The next message within `wait`, skipping pings; None when none came.
+fn next_message(socket: &mut Socket, wait: Duration) -> Option<tungstenite::Message> {
+    if let tungstenite::stream::MaybeTlsStream::Plain(s) = socket.get_mut() {
+        s.set_read_timeout(Some(wait)).unwrap();
+    }
+    loop {
+        match socket.read() {
+            Ok(tungstenite::Message::Ping(_) | tungstenite::Message::Pong(_)) => continue,
+            Ok(m) => return Some(m),
+            Err(_) => return None,
+        }
+    }
+}
+
+#[test]
+fn oscquery_listen_sends_changes_of_listened_values_over_a_websocket() {
+    use tungstenite::Message;
+    let gpu = common::gpu();
+    let mut instance = SceneInstance::new(&gpu, &common::assets(), scene("kleinian"), (32, 32)).unwrap();
+    let mut server = OscQueryServer::start("127.0.0.1:0", 9000).unwrap();
+    let (_, info) = http_get(server.local_addr(), "/?HOST_INFO");
+    assert_eq!(info["EXTENSIONS"]["LISTEN"], true);
+    let (mut socket, _) = tungstenite::connect(format!("ws://{}/", server.local_addr())).unwrap();
+    socket.send(Message::text(r#"{"COMMAND":"LISTEN","DATA":"/indra/limit_set/scale"}"#)).unwrap();
+    // The session reads the command between polls: change the value until it is heard.
+    let started = Instant::now();
+    let heard = loop {
+        assert!(started.elapsed() < Duration::from_secs(5), "no change arrived");
+        set(&mut instance, "scale", ParamValue::Float(2.0 + started.elapsed().as_secs_f32()));
+        server.after_frame(&instance, false);
+        if let Some(Message::Binary(bytes)) = next_message(&mut socket, Duration::from_millis(50)) {
+            break rosc::decoder::decode_udp(&bytes).unwrap().1;
+        }
+    };
+    let OscPacket::Message(m) = heard else { panic!("{heard:?}") };
+    assert_eq!(m.addr, "/indra/limit_set/scale");
+    assert!(matches!(m.args[..], [OscType::Float(v)] if v > 2.0), "{m:?}");
+    // A value nobody listens to is not sent.
+    while next_message(&mut socket, Duration::from_millis(100)).is_some() {}
+    set(&mut instance, "iterations", ParamValue::Int(7));
+    assert_eq!(server.after_frame(&instance, false), 0, "iterations changed, but nobody listens to it");
+    // After IGNORE, nothing more.
+    socket.send(Message::text(r#"{"COMMAND":"IGNORE","DATA":"/indra/limit_set/scale"}"#)).unwrap();
+    std::thread::sleep(Duration::from_millis(300));
+    set(&mut instance, "scale", ParamValue::Float(1.5));
+    assert_eq!(server.after_frame(&instance, false), 0, "ignored");
+    assert!(next_message(&mut socket, Duration::from_millis(200)).is_none());
+    // A new scene is announced once its tree is published.
+    server.scene_changed();
+    server.after_frame(&instance, false);
+    let Some(Message::Text(text)) = next_message(&mut socket, Duration::from_secs(2)) else {
+        panic!("no PATH_CHANGED")
+    };
+    let said: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!((said["COMMAND"].as_str(), said["DATA"].as_str()), (Some("PATH_CHANGED"), Some("/indra")));
+    // Garbage, unknown commands and huge messages end nothing but (at most) that session.
+    socket.send(Message::text("not json")).unwrap();
+    socket.send(Message::text(r#"{"COMMAND":"FLY","DATA":3}"#)).unwrap();
+    let _ = socket.send(Message::binary(vec![0u8; 200_000]));
+    assert_eq!(http_get(server.local_addr(), "/?HOST_INFO").0, 200, "the server still answers");
+}
+
+#[test]
+fn oscquery_serves_a_bounded_number_of_websockets() {
+    let server = OscQueryServer::start("127.0.0.1:0", 9000).unwrap();
+    let url = format!("ws://{}/", server.local_addr());
+    let open: Vec<_> = (0..indra::control::http::MAX_SOCKETS).map(|_| tungstenite::connect(&url).unwrap()).collect();
+    match tungstenite::connect(&url) {
+        Err(tungstenite::Error::Http(response)) => assert_eq!(response.status(), 503),
+        other => panic!("one past the cap was let in: {:?}", other.map(|_| ())),
+    }
+    drop(open);
+    // Closed sessions free their places.
+    let started = Instant::now();
+    while tungstenite::connect(&url).is_err() {
+        assert!(started.elapsed() < Duration::from_secs(5), "places were not freed");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+#[test]
+fn oscquery_is_found_by_an_mdns_browser() {
+    use mdns_sd::{ServiceDaemon, ServiceEvent};
+    let server = OscQueryServer::start("0.0.0.0:0", 9123).unwrap();
+    let browser = ServiceDaemon::new().unwrap();
+    let found = |service: &str, port: u16| {
+        let events = browser.browse(service).unwrap();
+        let started = Instant::now();
+        while started.elapsed() < Duration::from_secs(10) {
+            if let Ok(ServiceEvent::ServiceResolved(info)) = events.recv_timeout(Duration::from_millis(200))
+                && info.get_port() == port
+                && info.get_fullname().starts_with("indra-")
+            {
+                return true;
+            }
+        }
+        false
+    };
+    assert!(found(indra::control::discovery::OSCQUERY_SERVICE, server.local_addr().port()), "no _oscjson._tcp");
+    assert!(found(indra::control::discovery::OSC_SERVICE, 9123), "no _osc._udp");
+    let _ = browser.shutdown();
 }

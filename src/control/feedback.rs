@@ -10,11 +10,49 @@ use super::address::param_address;
 use crate::params::ParamValue;
 use crate::scene::SceneInstance;
 
+/// Which parameter values changed since they were last seen, as the OSC messages that carry
+/// them (triggers have no value and never appear). Shared by OSC feedback and OSCQuery LISTEN.
+#[derive(Default)]
+pub struct ParamChanges {
+    last: HashMap<(usize, usize), ParamValue>,
+}
+
+impl ParamChanges {
+    /// Forgets what was seen (after a scene change: everything counts as changed).
+    pub fn reset(&mut self) {
+        self.last.clear();
+    }
+
+    /// One message per parameter whose value differs from the last one seen.
+    pub fn collect(&mut self, instance: &SceneInstance) -> Vec<OscMessage> {
+        let mut messages = Vec::new();
+        for (n, node) in instance.scene().nodes.iter().enumerate() {
+            let params = instance.params(n);
+            for (p, decl) in params.decls().iter().enumerate() {
+                let value = params.target_at(p);
+                if matches!(value, ParamValue::Trigger(_)) || self.last.get(&(n, p)) == Some(&value) {
+                    continue;
+                }
+                let args = match &value {
+                    ParamValue::Int(i) => vec![OscType::Int(*i)],
+                    ParamValue::Bool(b) => vec![OscType::Bool(*b)],
+                    ParamValue::Enum(_) => vec![OscType::String(decl.format(&value))],
+                    ParamValue::Text(t) => vec![OscType::String(t.as_str().to_string())],
+                    other => other.components().into_iter().map(OscType::Float).collect(),
+                };
+                messages.push(OscMessage { addr: param_address(&node.id, &decl.name), args });
+                self.last.insert((n, p), value);
+            }
+        }
+        messages
+    }
+}
+
 /// Sends parameter changes to one OSC destination.
 pub struct OscFeedback {
     socket: UdpSocket,
     target: SocketAddr,
-    last: HashMap<(usize, usize), ParamValue>,
+    changes: ParamChanges,
 }
 
 impl OscFeedback {
@@ -27,38 +65,22 @@ impl OscFeedback {
             .ok_or_else(|| format!("OSC output {target} resolves to no address"))?;
         let bind = if target.is_ipv4() { "0.0.0.0:0" } else { "[::]:0" };
         let socket = UdpSocket::bind(bind).map_err(|e| format!("cannot open a UDP socket for OSC output: {e}"))?;
-        Ok(Self { socket, target, last: HashMap::new() })
+        Ok(Self { socket, target, changes: ParamChanges::default() })
     }
 
     /// Forgets what was sent (after a scene change: everything is sent again).
     pub fn reset(&mut self) {
-        self.last.clear();
+        self.changes.reset();
     }
 
     /// Sends every parameter whose value differs from the last one sent; returns how many.
     pub fn send_changes(&mut self, instance: &SceneInstance) -> usize {
         let mut sent = 0;
-        for (n, node) in instance.scene().nodes.iter().enumerate() {
-            let params = instance.params(n);
-            for (p, decl) in params.decls().iter().enumerate() {
-                let value = params.target_at(p);
-                if matches!(value, ParamValue::Trigger(_)) || self.last.get(&(n, p)) == Some(&value) {
-                    continue;
-                }
-                let args = match value {
-                    ParamValue::Int(i) => vec![OscType::Int(i)],
-                    ParamValue::Bool(b) => vec![OscType::Bool(b)],
-                    ParamValue::Enum(i) => vec![OscType::String(decl.format(&ParamValue::Enum(i)))],
-                    ParamValue::Text(t) => vec![OscType::String(t.as_str().to_string())],
-                    other => other.components().into_iter().map(OscType::Float).collect(),
-                };
-                let packet = OscPacket::Message(OscMessage { addr: param_address(&node.id, &decl.name), args });
-                if let Ok(bytes) = rosc::encoder::encode(&packet)
-                    && self.socket.send_to(&bytes, self.target).is_ok()
-                {
-                    sent += 1;
-                }
-                self.last.insert((n, p), value);
+        for message in self.changes.collect(instance) {
+            if let Ok(bytes) = rosc::encoder::encode(&OscPacket::Message(message))
+                && self.socket.send_to(&bytes, self.target).is_ok()
+            {
+                sent += 1;
             }
         }
         sent

@@ -7,7 +7,10 @@
 //! - only GET is served (`405` otherwise); a request that declares a body is `413`, unread;
 //! - each connection has its own thread with 2 s read and write timeouts, so a stalled client
 //!   delays nobody else; at most 32 connections are served at once, more are closed at once;
-//! - one request per connection (`Connection: close`).
+//! - one request per connection (`Connection: close`);
+//! - a `GET` that asks to upgrade to a WebSocket (RFC 6455) is handed, after the handshake, to the
+//!   server's socket handler, if it has one: at most [`MAX_SOCKETS`] at once (`503` past that),
+//!   messages capped at [`MAX_SOCKET_MESSAGE`] bytes, reads polled every [`SOCKET_POLL`].
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
@@ -16,6 +19,9 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
+use tungstenite::WebSocket;
+use tungstenite::protocol::{Role, WebSocketConfig};
+
 /// Largest request head (request line + headers) read.
 pub const MAX_HEAD: usize = 16 * 1024;
 /// Connections served at once.
@@ -23,8 +29,29 @@ pub const MAX_CONNECTIONS: usize = 32;
 /// Read and write timeout of a connection.
 pub const TIMEOUT: Duration = Duration::from_secs(2);
 
+/// WebSocket sessions open at once.
+pub const MAX_SOCKETS: usize = 8;
+/// Largest WebSocket message (and frame) accepted.
+pub const MAX_SOCKET_MESSAGE: usize = 64 * 1024;
+/// How long a WebSocket read waits before the session gets to send.
+pub const SOCKET_POLL: Duration = Duration::from_millis(20);
+
 /// What a handler answers for a request target (path and query): status and JSON body.
 pub type Handler = dyn Fn(&str) -> (u16, String) + Send + Sync;
+
+/// Serves one upgraded WebSocket session; it owns the connection until it returns. Reads time
+/// out every [`SOCKET_POLL`] (an `Io` error of kind `WouldBlock` or `TimedOut`), so the session
+/// can send between reads.
+pub type SocketHandler = dyn Fn(WebSocket<TcpStream>) + Send + Sync;
+
+/// What the server answers: GETs, and optionally WebSocket sessions.
+#[derive(Clone)]
+pub struct Routes {
+    /// Answers plain GETs.
+    pub get: Arc<Handler>,
+    /// Serves upgraded connections; without one, an upgrade is an ordinary GET.
+    pub socket: Option<Arc<SocketHandler>>,
+}
 
 /// A running server; stops when dropped.
 pub struct HttpServer {
@@ -34,8 +61,8 @@ pub struct HttpServer {
 }
 
 impl HttpServer {
-    /// Listens on `addr` (port 0 picks one) and answers GETs with `handler`.
-    pub fn start(addr: &str, name: &str, handler: Arc<Handler>) -> Result<Self, String> {
+    /// Listens on `addr` (port 0 picks one) and answers with `routes`.
+    pub fn start(addr: &str, name: &str, routes: Routes) -> Result<Self, String> {
         let listener = TcpListener::bind(addr).map_err(|e| format!("cannot serve {name} on {addr}: {e}"))?;
         listener.set_nonblocking(true).map_err(|e| e.to_string())?;
         let local = listener.local_addr().map_err(|e| e.to_string())?;
@@ -44,7 +71,7 @@ impl HttpServer {
             let stop = stop.clone();
             std::thread::Builder::new()
                 .name(format!("indra-{name}"))
-                .spawn(move || accept_loop(&listener, &stop, &handler))
+                .spawn(move || accept_loop(&listener, &stop, &routes))
                 .map_err(|e| e.to_string())?
         };
         Ok(Self { local, stop, thread: Some(thread) })
@@ -65,8 +92,9 @@ impl Drop for HttpServer {
     }
 }
 
-fn accept_loop(listener: &TcpListener, stop: &AtomicBool, handler: &Arc<Handler>) {
+fn accept_loop(listener: &TcpListener, stop: &AtomicBool, routes: &Routes) {
     let active = Arc::new(AtomicUsize::new(0));
+    let sockets = Arc::new(AtomicUsize::new(0));
     while !stop.load(Ordering::Relaxed) {
         let Ok((stream, _)) = listener.accept() else {
             std::thread::sleep(Duration::from_millis(20));
@@ -78,9 +106,9 @@ fn accept_loop(listener: &TcpListener, stop: &AtomicBool, handler: &Arc<Handler>
             continue;
         }
         active.fetch_add(1, Ordering::Relaxed);
-        let (active, handler) = (active.clone(), handler.clone());
+        let (active, sockets, routes) = (active.clone(), sockets.clone(), routes.clone());
         let spawned = std::thread::Builder::new().name("indra-http-conn".into()).spawn(move || {
-            serve(stream, &handler);
+            serve(stream, &routes, &sockets);
             active.fetch_sub(1, Ordering::Relaxed);
         });
         if spawned.is_err() {
@@ -89,13 +117,24 @@ fn accept_loop(listener: &TcpListener, stop: &AtomicBool, handler: &Arc<Handler>
     }
 }
 
-/// Answers one request on `stream`, within the limits.
-fn serve(mut stream: TcpStream, handler: &Arc<Handler>) {
+/// Answers one request on `stream`, within the limits, or serves the WebSocket it upgrades to.
+fn serve(mut stream: TcpStream, routes: &Routes, sockets: &AtomicUsize) {
     let _ = stream.set_nonblocking(false);
     let _ = stream.set_read_timeout(Some(TIMEOUT));
     let _ = stream.set_write_timeout(Some(TIMEOUT));
     let (status, body) = match read_head(&mut stream) {
-        Ok(head) => answer(&head, handler),
+        Ok(head) => match (&routes.socket, websocket_key(&head)) {
+            (Some(handler), Some(key)) => {
+                if sockets.fetch_add(1, Ordering::Relaxed) < MAX_SOCKETS {
+                    upgrade(stream, &key, handler);
+                    sockets.fetch_sub(1, Ordering::Relaxed);
+                    return;
+                }
+                sockets.fetch_sub(1, Ordering::Relaxed);
+                (503, String::from("{}"))
+            }
+            _ => answer(&head, &routes.get),
+        },
         Err(status) => (status, String::from("{}")),
     };
     let reason = match status {
@@ -103,6 +142,7 @@ fn serve(mut stream: TcpStream, handler: &Arc<Handler>) {
         404 => "Not Found",
         405 => "Method Not Allowed",
         413 => "Content Too Large",
+        503 => "Service Unavailable",
         431 => "Request Header Fields Too Large",
         _ => "Bad Request",
     };
@@ -111,6 +151,38 @@ fn serve(mut stream: TcpStream, handler: &Arc<Handler>) {
         "HTTP/1.1 {status} {reason}\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{body}",
         body.len()
     );
+}
+
+/// The `Sec-WebSocket-Key` of a GET that asks for a WebSocket (version 13), if it does.
+fn websocket_key(head: &str) -> Option<String> {
+    if !head.starts_with("GET ") {
+        return None;
+    }
+    let header = |wanted: &str| {
+        head.split("\r\n")
+            .skip(1)
+            .filter_map(|l| l.split_once(':'))
+            .find(|(name, _)| name.trim().eq_ignore_ascii_case(wanted))
+            .map(|(_, value)| value.trim())
+    };
+    let upgrade = header("upgrade").is_some_and(|v| v.eq_ignore_ascii_case("websocket"));
+    (upgrade && header("sec-websocket-version") == Some("13"))
+        .then(|| header("sec-websocket-key").map(str::to_string))?
+}
+
+/// Completes the handshake and hands the session to `handler`.
+fn upgrade(mut stream: TcpStream, key: &str, handler: &Arc<SocketHandler>) {
+    let accept = tungstenite::handshake::derive_accept_key(key.as_bytes());
+    let answered = write!(
+        stream,
+        "HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: {accept}\r\n\r\n"
+    );
+    if answered.is_err() || stream.set_read_timeout(Some(SOCKET_POLL)).is_err() {
+        return;
+    }
+    let config =
+        WebSocketConfig::default().max_message_size(Some(MAX_SOCKET_MESSAGE)).max_frame_size(Some(MAX_SOCKET_MESSAGE));
+    handler(WebSocket::from_raw_socket(stream, Role::Server, Some(config)));
 }
 
 /// The request head (up to the blank line), or the status to answer with.
@@ -167,5 +239,16 @@ mod tests {
         assert_eq!(answer("GET / HTTP/1.1\r\nContent-Length: 99999999999", &h).0, 413);
         assert_eq!(answer("GET / HTTP/1.1\r\ntransfer-encoding: chunked", &h).0, 413);
         assert_eq!(answer("GET / HTTP/1.1\r\nContent-Length: 0", &h).0, 200);
+    }
+
+    #[test]
+    fn only_a_get_asking_for_websocket_version_13_upgrades() {
+        let ask = |head: &str| websocket_key(head);
+        let good = "GET / HTTP/1.1\r\nUpgrade: WebSocket\r\nConnection: Upgrade\r\nSec-WebSocket-Version: 13\r\nSec-WebSocket-Key: abc==";
+        assert_eq!(ask(good).as_deref(), Some("abc=="));
+        assert_eq!(ask(&good.replace("GET", "POST")), None);
+        assert_eq!(ask(&good.replace("13", "8")), None);
+        assert_eq!(ask(&good.replace("WebSocket\r", "h2c\r")), None);
+        assert_eq!(ask("GET / HTTP/1.1\r\nUpgrade: websocket\r\nSec-WebSocket-Version: 13"), None, "no key");
     }
 }

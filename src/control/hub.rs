@@ -159,6 +159,9 @@ impl ControlHub {
         if let Some(f) = self.feedback.as_mut() {
             f.reset();
         }
+        if let Some(q) = self.oscquery.as_mut() {
+            q.scene_changed();
+        }
     }
 
     /// Everything that arrived since the last frame, as control events, in arrival order per
@@ -281,16 +284,14 @@ impl ControlHub {
         }
     }
 
-    /// After a frame: sends changed values to the OSC feedback target and refreshes the OSCQuery
-    /// tree (every 6th frame: clients poll far slower than that).
+    /// After a frame: sends changed values to the OSC feedback target and to OSCQuery listeners,
+    /// and refreshes the OSCQuery tree (every 6th frame: clients poll far slower than that).
     pub fn after_frame(&mut self, instance: &SceneInstance) {
         if let Some(f) = self.feedback.as_mut() {
             f.send_changes(instance);
         }
-        if let Some(q) = self.oscquery.as_ref()
-            && self.frame_count.is_multiple_of(6)
-        {
-            q.publish(instance);
+        if let Some(q) = self.oscquery.as_mut() {
+            q.after_frame(instance, self.frame_count.is_multiple_of(6));
         }
         if self.frame_count.is_multiple_of(PRESET_RESCAN_FRAMES) {
             self.preset_names = self.presets.names();

@@ -6,9 +6,11 @@
 
 pub mod address;
 pub mod audio;
+pub mod discovery;
 pub mod feedback;
 pub mod http;
 pub mod hub;
+pub mod listen;
 pub mod midi;
 pub mod osc;
 mod osc_guard;

@@ -1,14 +1,18 @@
 //! OSCQuery: an HTTP endpoint serving the JSON address tree (FULL_PATH, CONTENTS, TYPE, RANGE,
 //! VALUE, ACCESS, DESCRIPTION, per the OSCQuery proposal by Vidvox) and HOST_INFO, so
-//! TouchOSC-style clients discover every parameter. The render loop publishes snapshots; the
-//! server thread only reads them.
+//! TouchOSC-style clients discover every parameter; the LISTEN extension over a WebSocket on the
+//! same port (see [`super::listen`]); and DNS-SD advertisement (see [`super::discovery`]). The
+//! render loop publishes snapshots and queues changes; the server threads only read them.
 
 use std::sync::{Arc, RwLock};
 
 use serde_json::{Map, Value, json};
 
 use super::address::param_address;
-use super::http::HttpServer;
+use super::discovery::Advertisement;
+use super::feedback::ParamChanges;
+use super::http::{HttpServer, Routes};
+use super::listen::Listeners;
 use crate::params::{ParamDecl, ParamType, ParamValue};
 use crate::scene::SceneInstance;
 
@@ -81,7 +85,10 @@ pub fn host_info(osc_port: u16) -> Value {
         "NAME": "indra",
         "OSC_PORT": osc_port,
         "OSC_TRANSPORT": "UDP",
-        "EXTENSIONS": { "ACCESS": true, "VALUE": true, "RANGE": true, "DESCRIPTION": true, "TYPE": true }
+        "EXTENSIONS": {
+            "ACCESS": true, "VALUE": true, "RANGE": true, "DESCRIPTION": true, "TYPE": true,
+            "LISTEN": true, "PATH_CHANGED": true
+        }
     })
 }
 
@@ -90,15 +97,23 @@ pub fn subtree<'a>(tree: &'a Value, path: &str) -> Option<&'a Value> {
     path.split('/').filter(|s| !s.is_empty()).try_fold(tree, |node, part| node.get("CONTENTS")?.get(part))
 }
 
-/// The OSCQuery endpoint: the published tree, served over HTTP.
+/// The OSCQuery endpoint: the published tree over HTTP, value changes to listening controllers
+/// over WebSockets, and its advertisement over mDNS.
 pub struct OscQueryServer {
     snapshot: Arc<RwLock<Value>>,
+    listeners: Arc<Listeners>,
+    changes: ParamChanges,
+    /// The scene changed: publish and announce it after the next frame.
+    path_changed: bool,
     server: HttpServer,
+    /// Kept for its lifetime: dropping it withdraws the advertisement.
+    _advertisement: Option<Advertisement>,
 }
 
 impl OscQueryServer {
-    /// Serves on `addr` (port 0 picks one), advertising `osc_port` in HOST_INFO. The server has
-    /// hard limits (see [`super::http`]): no request can exhaust memory or hold up the others.
+    /// Serves on `addr` (port 0 picks one), naming `osc_port` in HOST_INFO and advertising both
+    /// over mDNS unless `addr` is loopback. The server has hard limits (see [`super::http`]):
+    /// no request can exhaust memory or hold up the others. mDNS that cannot start is logged.
     pub fn start(addr: &str, osc_port: u16) -> Result<Self, String> {
         let snapshot = Arc::new(RwLock::new(json!({ "FULL_PATH": "/", "CONTENTS": {} })));
         let tree = snapshot.clone();
@@ -114,9 +129,31 @@ impl OscQueryServer {
                 None => (404, "{}".to_string()),
             }
         });
-        let server = HttpServer::start(addr, "oscquery", handler)?;
-        log::info!("OSCQuery on http://{}/", server.local_addr());
-        Ok(Self { snapshot, server })
+        let listeners = Arc::new(Listeners::default());
+        let sessions = listeners.clone();
+        let routes = Routes { get: handler, socket: Some(Arc::new(move |socket| sessions.serve(socket))) };
+        let server = HttpServer::start(addr, "oscquery", routes)?;
+        let local = server.local_addr();
+        log::info!("OSCQuery on http://{local}/");
+        let advertisement = match Advertisement::start(&format!("indra-{}", local.port()), local, osc_port) {
+            Ok(a) => Some(a),
+            Err(e) if local.ip().is_loopback() => {
+                log::info!("{e}");
+                None
+            }
+            Err(e) => {
+                log::warn!("{e}; controllers must be given the address by hand");
+                None
+            }
+        };
+        Ok(Self {
+            snapshot,
+            listeners,
+            changes: ParamChanges::default(),
+            path_changed: false,
+            server,
+            _advertisement: advertisement,
+        })
     }
 
     /// The bound address.
@@ -130,5 +167,37 @@ impl OscQueryServer {
         if let Ok(mut s) = self.snapshot.write() {
             *s = t;
         }
+    }
+
+    /// After a frame: publishes the tree when `publish` asks (or the scene changed, which is
+    /// then announced to listening controllers) and queues the values that changed for the
+    /// controllers listening to them. Returns how many messages were queued.
+    pub fn after_frame(&mut self, instance: &SceneInstance, publish: bool) -> usize {
+        if publish || self.path_changed {
+            self.publish(instance);
+        }
+        if std::mem::take(&mut self.path_changed) {
+            self.listeners.path_changed("/indra");
+        }
+        let messages = self.changes.collect(instance);
+        if messages.is_empty() || !self.listeners.any() { 0 } else { self.listeners.send(&messages) }
+    }
+
+    /// A new scene: every value counts as changed, and the namespace change is announced after
+    /// the next frame, once the new tree is published.
+    pub fn scene_changed(&mut self) {
+        self.changes.reset();
+        self.path_changed = true;
+    }
+
+    /// Changes not delivered because a controller's queue was full.
+    pub fn dropped(&self) -> u64 {
+        self.listeners.dropped()
+    }
+}
+
+impl Drop for OscQueryServer {
+    fn drop(&mut self) {
+        self.listeners.close();
     }
 }

@@ -1,0 +1,151 @@
+//! OSCQuery's LISTEN extension: controllers connected over a WebSocket name the addresses they
+//! want (`{"COMMAND": "LISTEN", "DATA": "/indra/glow/intensity"}`, `IGNORE` to stop) and receive
+//! each change of those values as a binary OSC message; a new namespace (another scene) is
+//! announced as `{"COMMAND": "PATH_CHANGED", "DATA": "/indra"}`. The render thread only queues:
+//! a session that falls [`QUEUE`] messages behind loses the overflow, never the show's time.
+
+use std::collections::HashSet;
+use std::net::TcpStream;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
+use std::sync::{Arc, Mutex};
+
+use rosc::{OscMessage, OscPacket};
+use serde_json::{Value, json};
+use tungstenite::{Message, WebSocket};
+
+/// Messages a session may have waiting.
+pub const QUEUE: usize = 1024;
+/// Addresses one session may listen to.
+pub const MAX_PATHS: usize = 4096;
+
+/// What goes out to a session.
+enum Outgoing {
+    Osc(Vec<u8>),
+    Text(String),
+}
+
+/// One connected controller: what it listens to and its queue.
+struct Session {
+    id: u64,
+    paths: Arc<Mutex<HashSet<String>>>,
+    queue: SyncSender<Outgoing>,
+}
+
+/// The connected controllers.
+#[derive(Default)]
+pub struct Listeners {
+    sessions: Mutex<Vec<Session>>,
+    dropped: AtomicU64,
+    next_id: AtomicU64,
+    closed: AtomicBool,
+}
+
+impl Listeners {
+    /// Whether any controller is connected.
+    pub fn any(&self) -> bool {
+        self.sessions.lock().is_ok_and(|s| !s.is_empty())
+    }
+
+    /// Messages not delivered because a session's queue was full.
+    pub fn dropped(&self) -> u64 {
+        self.dropped.load(Ordering::Relaxed)
+    }
+
+    /// Queues each message for every session listening to its address; returns how many were
+    /// queued. Never blocks.
+    pub fn send(&self, messages: &[OscMessage]) -> usize {
+        let Ok(sessions) = self.sessions.lock() else { return 0 };
+        let mut queued = 0;
+        for message in messages {
+            let mut bytes = None;
+            for session in sessions.iter() {
+                if !session.paths.lock().is_ok_and(|p| p.contains(&message.addr)) {
+                    continue;
+                }
+                let bytes = bytes.get_or_insert_with(|| {
+                    rosc::encoder::encode(&OscPacket::Message(message.clone())).unwrap_or_default()
+                });
+                match session.queue.try_send(Outgoing::Osc(bytes.clone())) {
+                    Ok(()) => queued += 1,
+                    Err(_) => {
+                        self.dropped.fetch_add(1, Ordering::Relaxed);
+                    }
+                }
+            }
+        }
+        queued
+    }
+
+    /// Tells every session that the namespace under `path` changed.
+    pub fn path_changed(&self, path: &str) {
+        let text = json!({ "COMMAND": "PATH_CHANGED", "DATA": path }).to_string();
+        if let Ok(sessions) = self.sessions.lock() {
+            for s in sessions.iter() {
+                let _ = s.queue.try_send(Outgoing::Text(text.clone()));
+            }
+        }
+    }
+
+    /// Ends every session (the server is going away).
+    pub fn close(&self) {
+        self.closed.store(true, Ordering::Relaxed);
+    }
+
+    /// Serves one WebSocket session until the client leaves or the server closes.
+    pub fn serve(&self, mut socket: WebSocket<TcpStream>) {
+        let (queue, outgoing) = sync_channel(QUEUE);
+        let paths = Arc::new(Mutex::new(HashSet::new()));
+        let id = self.next_id.fetch_add(1, Ordering::Relaxed);
+        if let Ok(mut sessions) = self.sessions.lock() {
+            sessions.push(Session { id, paths: paths.clone(), queue });
+        }
+        while !self.closed.load(Ordering::Relaxed) {
+            match socket.read() {
+                Ok(Message::Text(text)) => command(&text, &paths),
+                Ok(Message::Close(_)) => break,
+                Ok(_) => {}
+                Err(tungstenite::Error::Io(e))
+                    if matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut) => {}
+                Err(_) => break,
+            }
+            if deliver(&mut socket, &outgoing).is_err() {
+                break;
+            }
+        }
+        if let Ok(mut sessions) = self.sessions.lock() {
+            sessions.retain(|s| s.id != id);
+        }
+        let _ = socket.close(None);
+        let _ = socket.flush();
+    }
+}
+
+/// Applies a LISTEN or IGNORE command; anything else is ignored (the spec lets clients send
+/// commands a server does not know).
+fn command(text: &str, paths: &Mutex<HashSet<String>>) {
+    let Ok(value) = serde_json::from_str::<Value>(text) else { return };
+    let (Some(command), Some(path)) = (value["COMMAND"].as_str(), value["DATA"].as_str()) else { return };
+    let Ok(mut paths) = paths.lock() else { return };
+    match command {
+        "LISTEN" if paths.len() < MAX_PATHS => {
+            paths.insert(path.to_string());
+        }
+        "IGNORE" => {
+            paths.remove(path);
+        }
+        _ => {}
+    }
+}
+
+/// Sends what is queued for the session.
+fn deliver(socket: &mut WebSocket<TcpStream>, outgoing: &Receiver<Outgoing>) -> Result<(), tungstenite::Error> {
+    loop {
+        match outgoing.try_recv() {
+            Ok(Outgoing::Osc(bytes)) => socket.write(Message::Binary(bytes.into()))?,
+            Ok(Outgoing::Text(text)) => socket.write(Message::Text(text.into()))?,
+            Err(TryRecvError::Empty | TryRecvError::Disconnected) => break,
+        }
+    }
+    socket.flush()
+}
