@@ -66,6 +66,10 @@ pub struct RunArgs {
     /// No audio input.
     #[arg(long)]
     pub no_audio: bool,
+    /// Join the Ableton Link session on the local network: follow its tempo and phase, propose
+    /// tempo changes made here (builds with `--features link`, GPL-2.0-or-later).
+    #[arg(long)]
+    pub link: bool,
     /// Open one more output window (repeatable): source=NODE, warp=FILE.ron, monitor=N,
     /// fullscreen — e.g. `--output-window warp=wall.ron,monitor=1,fullscreen`.
     #[arg(long = "output-window", value_name = "SPEC")]
@@ -111,6 +115,7 @@ impl Default for RunArgs {
             no_midi: false,
             audio_in: None,
             no_audio: false,
+            link: false,
             list_audio: false,
             output_windows: Vec::new(),
             record_controls: None,
@@ -292,6 +297,7 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         record: args.record_controls.clone(),
         presets_dir: args.presets.clone(),
         learn_file: args.midi_learn.clone(),
+        link: args.link,
     };
     indra::app::run(assets.clone(), gpu.clone(), scene, options, control, notices)
 }

@@ -38,6 +38,8 @@ pub struct ControlOptions {
     /// Audio input: `None` none; `Some(None)` the default device when the scene maps audio;
     /// `Some(Some(name))` the first device whose name contains `name`, always.
     pub audio_in: Option<Option<String>>,
+    /// Join the Ableton Link session (builds with the `link` feature).
+    pub link: bool,
 }
 
 impl Default for ControlOptions {
@@ -52,6 +54,7 @@ impl Default for ControlOptions {
             presets_dir: "presets".into(),
             learn_file: "midi-learn.ron".into(),
             audio_in: Some(None),
+            link: false,
         }
     }
 }
@@ -84,6 +87,9 @@ pub struct ControlHub {
     audio_mapper: AudioMapper,
     /// The last analysed audio frame (the panel's meter and spectrum).
     pub audio_frame: Option<AudioFrame>,
+    /// The Ableton Link session, when joined.
+    #[cfg(feature = "link")]
+    link: Option<super::link::LinkInput>,
     frame_count: u64,
     /// Preset names, re-read on save and every [`PRESET_RESCAN_FRAMES`] frames (not per frame:
     /// the panel shows them every frame).
@@ -122,6 +128,14 @@ impl ControlHub {
         let presets = PresetStore { dir: options.presets_dir.clone() };
         let preset_names = presets.names();
         let audio = open_audio(options.audio_in.as_ref(), scene, &mut notices);
+        #[cfg(feature = "link")]
+        let link = options.link.then(|| super::link::LinkInput::join(scene.bpm));
+        #[cfg(not(feature = "link"))]
+        if options.link {
+            let message = "this build has no Ableton Link: build with `--features link` (GPL-2.0-or-later)";
+            log::warn!("{message}");
+            notices.push(message.into());
+        }
         Self {
             osc,
             router: OscRouter::new(scene),
@@ -139,6 +153,8 @@ impl ControlHub {
             audio,
             audio_mapper: AudioMapper::new(scene),
             audio_frame: None,
+            #[cfg(feature = "link")]
+            link,
             frame_count: 0,
             preset_names,
         }
@@ -198,6 +214,11 @@ impl ControlHub {
         // A running MIDI clock sets the show's tempo.
         if self.mapper.clock.playing {
             events.extend(self.tempo.follow_clock(self.mapper.clock.bpm()));
+        }
+        #[cfg(feature = "link")]
+        if let Some(link) = self.link.as_mut() {
+            let ahead = f64::from(scene.dt);
+            events.extend(link.poll(&instance.tempo(), ahead));
         }
         events
     }
@@ -313,6 +334,10 @@ impl ControlHub {
             Some(m) if !m.ports.is_empty() => parts.push(format!("MIDI: {}", m.ports.join(", "))),
             _ if !super::midi::BUILT_IN => parts.push("MIDI: not built in (--no-default-features)".into()),
             _ => parts.push("MIDI: none".into()),
+        }
+        #[cfg(feature = "link")]
+        if let Some(link) = &self.link {
+            parts.push(format!("Link: {} peers", link.peers()));
         }
         if let Some(bpm) = self.mapper.clock.bpm() {
             parts.push(format!("clock {bpm:.1} BPM{}", if self.mapper.clock.playing { " ▶" } else { "" }));

@@ -10,6 +10,8 @@ pub mod discovery;
 pub mod feedback;
 pub mod http;
 pub mod hub;
+#[cfg(feature = "link")]
+pub mod link;
 pub mod listen;
 pub mod midi;
 pub mod osc;

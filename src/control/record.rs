@@ -54,6 +54,13 @@ pub enum RecordedEvent {
         /// Whether the beat snapped to this step.
         resync: bool,
     },
+    /// The beat moved to a phase of the bar (Ableton Link).
+    Phase {
+        /// The beat within the bar.
+        phase: f64,
+        /// Beats per bar.
+        quantum: f64,
+    },
 }
 
 /// Writes events as they are applied — into a temporary file beside the target, renamed over it
@@ -142,6 +149,7 @@ fn to_recorded(event: &ControlEvent, scene: &Scene) -> Option<RecordedEvent> {
         },
         ControlEvent::ResumeTracks => RecordedEvent::ResumeTracks,
         ControlEvent::Tempo { bpm, resync } => RecordedEvent::Tempo { bpm: *bpm, resync: *resync },
+        ControlEvent::Phase { phase, quantum } => RecordedEvent::Phase { phase: *phase, quantum: *quantum },
     })
 }
 
@@ -191,5 +199,6 @@ fn from_recorded(event: &RecordedEvent, scene: &Scene) -> Result<ControlEvent, S
         },
         RecordedEvent::ResumeTracks => ControlEvent::ResumeTracks,
         RecordedEvent::Tempo { bpm, resync } => ControlEvent::Tempo { bpm: *bpm, resync: *resync },
+        RecordedEvent::Phase { phase, quantum } => ControlEvent::Phase { phase: *phase, quantum: *quantum },
     })
 }

@@ -1,11 +1,13 @@
 //! Where the show's tempo comes from besides the scene: tap tempo (key T, the panel, OSC
-//! `/indra/tempo/tap`), a set BPM (OSC `/indra/tempo/bpm f`) and MIDI clock. Each becomes a
-//! [`ControlEvent::Tempo`], applied on the fixed clock and recorded like any other event, so a
+//! `/indra/tempo/tap`), a set BPM (OSC `/indra/tempo/bpm f`), MIDI clock, and a shared session
+//! (Ableton Link, see [`SessionFollower`]). Each becomes a [`ControlEvent::Tempo`] (or
+//! [`ControlEvent::Phase`]), applied on the fixed clock and recorded like any other event, so a
 //! replay follows the same tempo.
 
 use std::time::Instant;
 
 use crate::params::ControlEvent;
+use crate::params::lfo::{TempoClock, clamp_bpm, phase_offset};
 
 /// Taps further apart than this start a new count.
 const TAP_TIMEOUT_SECONDS: f64 = 2.0;
@@ -72,6 +74,53 @@ impl TempoInput {
     }
 }
 
+/// A shared session's tempo differences smaller than this are not followed.
+const SESSION_FOLLOW_BPM: f64 = 0.005;
+/// A shared session's phase is followed once the show drifts this many beats from it (10 ms at
+/// 120 bpm): closer, the jump would be invisible and only fill the recording.
+const SESSION_FOLLOW_BEATS: f64 = 0.02;
+
+/// Keeps the show's tempo clock with a shared session (Ableton Link): the session's tempo and
+/// phase become events, and a tempo set here (a tap, OSC, MIDI clock, the scene) is proposed to
+/// the session instead of being overridden by it.
+#[derive(Debug, Default)]
+pub struct SessionFollower {
+    /// The tempo the show's clock had after the last follow.
+    known: Option<f64>,
+}
+
+/// What following the session asks for this frame.
+#[derive(Debug, Default, PartialEq)]
+pub struct Follow {
+    /// Events that bring the show's clock to the session.
+    pub events: Vec<ControlEvent>,
+    /// A tempo to propose to the session (the show's tempo was changed here).
+    pub propose: Option<f64>,
+}
+
+impl SessionFollower {
+    /// Compares the show's `clock` with the session's tempo and its phase within a bar of
+    /// `quantum` beats (taken at the moment the events will apply).
+    pub fn follow(&mut self, clock: &TempoClock, session_bpm: f64, session_phase: f64, quantum: f64) -> Follow {
+        if let Some(known) = self.known
+            && (clock.bpm - known).abs() > 1e-9
+        {
+            self.known = Some(clock.bpm);
+            return Follow { events: Vec::new(), propose: Some(clock.bpm) };
+        }
+        let mut events = Vec::new();
+        let bpm = clamp_bpm(session_bpm).unwrap_or(clock.bpm);
+        if (bpm - clock.bpm).abs() > SESSION_FOLLOW_BPM {
+            events.push(ControlEvent::Tempo { bpm, resync: false });
+        }
+        self.known = Some(if events.is_empty() { clock.bpm } else { bpm });
+        if session_phase.is_finite() && phase_offset(clock.beats, session_phase, quantum).abs() > SESSION_FOLLOW_BEATS {
+            events.push(ControlEvent::Phase { phase: session_phase, quantum });
+        }
+        Follow { events, propose: None }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -94,6 +143,32 @@ mod tests {
         // After a pause, two taps 0.4 s apart: 150 bpm, nothing of the old count.
         assert_eq!(bpm(taps.tap(20.0)), None);
         assert!((bpm(taps.tap(20.4)).unwrap() - 150.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_session_is_followed_and_a_tempo_set_here_is_proposed_to_it() {
+        let mut clock = TempoClock::new(120.0);
+        let mut follower = SessionFollower::default();
+        // Joining: the session's tempo and phase are taken.
+        let follow = follower.follow(&clock, 128.0, 1.5, 4.0);
+        assert_eq!(
+            follow.events,
+            [ControlEvent::Tempo { bpm: 128.0, resync: false }, ControlEvent::Phase { phase: 1.5, quantum: 4.0 }]
+        );
+        clock.set(128.0, false);
+        clock.align(1.5, 4.0);
+        // In step: nothing; a small drift is left alone, a larger one is followed.
+        assert_eq!(follower.follow(&clock, 128.0, 1.51, 4.0), Follow::default());
+        assert_eq!(follower.follow(&clock, 128.0, 1.6, 4.0).events, [ControlEvent::Phase { phase: 1.6, quantum: 4.0 }]);
+        // A tap here sets 100 bpm: proposed to the session, not undone by it.
+        clock.set(100.0, true);
+        assert_eq!(follower.follow(&clock, 128.0, 1.6, 4.0), Follow { events: Vec::new(), propose: Some(100.0) });
+        // A session tempo outside indra's range is followed as far as the range goes, once.
+        let out_of_range = follower.follow(&clock, 999.0, 0.0, 4.0);
+        let clamped = clamp_bpm(999.0).unwrap();
+        assert_eq!(out_of_range.events[0], ControlEvent::Tempo { bpm: clamped, resync: false });
+        clock.set(clamped, false);
+        assert_eq!(follower.follow(&clock, 999.0, clock.beats.rem_euclid(4.0), 4.0), Follow::default());
     }
 
     #[test]

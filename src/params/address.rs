@@ -41,6 +41,14 @@ pub enum ControlEvent {
         /// Snap the beat position to the nearest whole beat.
         resync: bool,
     },
+    /// Move the show's beat position to `phase` within a bar of `quantum` beats, by the shortest
+    /// way (Ableton Link's shared phase).
+    Phase {
+        /// The beat within the bar, 0 up to `quantum`.
+        phase: f64,
+        /// Beats per bar.
+        quantum: f64,
+    },
 }
 
 impl ControlEvent {
@@ -58,7 +66,7 @@ impl ControlEvent {
                 seconds: *seconds,
             }),
             ControlEvent::ResumeTracks => Some(ControlEvent::ResumeTracks),
-            ControlEvent::Tempo { .. } => Some(self.clone()),
+            ControlEvent::Tempo { .. } | ControlEvent::Phase { .. } => Some(self.clone()),
         }
     }
 }

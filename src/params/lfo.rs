@@ -129,6 +129,24 @@ impl TempoClock {
     }
 }
 
+impl TempoClock {
+    /// Moves the beat position by the shortest way (at most half a bar) to `phase` within a bar
+    /// of `quantum` beats. Anything not finite, or a bar shorter than a beat, is ignored.
+    pub fn align(&mut self, phase: f64, quantum: f64) {
+        if !(phase.is_finite() && quantum.is_finite() && quantum >= 1.0) {
+            return;
+        }
+        self.beats += phase_offset(self.beats, phase, quantum);
+    }
+}
+
+/// How far (in beats, −quantum/2 up to quantum/2) `phase` within a bar of `quantum` beats is
+/// ahead of the beat position `beats`.
+pub fn phase_offset(beats: f64, phase: f64, quantum: f64) -> f64 {
+    let half = quantum / 2.0;
+    (phase - beats.rem_euclid(quantum) + half).rem_euclid(quantum) - half
+}
+
 /// `bpm` within [`BPM_RANGE`], or None when it is not a finite number.
 pub fn clamp_bpm(bpm: f64) -> Option<f64> {
     bpm.is_finite().then(|| bpm.clamp(BPM_RANGE.0, BPM_RANGE.1))
@@ -179,6 +197,21 @@ mod tests {
         assert_eq!((clock.bpm, clock.beats), (90.0, 7.0));
         clock.set(10_000.0, false);
         assert_eq!(clock.bpm, BPM_RANGE.1);
+    }
+
+    #[test]
+    fn align_takes_the_shortest_way_to_the_phase_and_ignores_nonsense() {
+        let mut clock = TempoClock { bpm: 120.0, beats: 9.5 };
+        clock.align(3.25, 4.0);
+        assert!((clock.beats - 11.25).abs() < 1e-12, "9.5 is 1.5 in the bar: 1.75 ahead → {}", clock.beats);
+        clock.align(0.0, 4.0);
+        assert!((clock.beats - 12.0).abs() < 1e-12, "3.25 → 0 goes forward 0.75 → {}", clock.beats);
+        clock.align(3.5, 4.0);
+        assert!((clock.beats - 11.5).abs() < 1e-12, "0 → 3.5 goes back 0.5 → {}", clock.beats);
+        for (phase, quantum) in [(f64::NAN, 4.0), (1.0, 0.0), (1.0, f64::INFINITY)] {
+            clock.align(phase, quantum);
+            assert_eq!(clock.beats, 11.5);
+        }
     }
 
     #[test]

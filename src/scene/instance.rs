@@ -105,6 +105,7 @@ impl SceneInstance {
                 ControlEvent::Morph { values, seconds } => self.pending_morph = Some((values.clone(), *seconds)),
                 ControlEvent::ResumeTracks => self.overridden.clear(),
                 ControlEvent::Tempo { bpm, resync } => self.tempo.set(*bpm, *resync),
+                ControlEvent::Phase { phase, quantum } => self.tempo.align(*phase, *quantum),
             }
         }
     }
