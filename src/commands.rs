@@ -86,6 +86,9 @@ pub struct RunArgs {
     /// File of MIDI-learned mappings.
     #[arg(long, default_value = "midi-learn.ron")]
     pub midi_learn: PathBuf,
+    /// File of audio mappings learned from the panel.
+    #[arg(long, default_value = "audio-learn.ron")]
+    pub audio_learn: PathBuf,
     /// Do not watch shaders/ and scenes/ for edits.
     #[arg(long)]
     pub no_watch: bool,
@@ -121,6 +124,7 @@ impl Default for RunArgs {
             record_controls: None,
             presets: "presets".into(),
             midi_learn: "midi-learn.ron".into(),
+            audio_learn: "audio-learn.ron".into(),
             no_watch: false,
             record_video: None,
         }
@@ -297,6 +301,7 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         record: args.record_controls.clone(),
         presets_dir: args.presets.clone(),
         learn_file: args.midi_learn.clone(),
+        audio_learn_file: args.audio_learn.clone(),
         link: args.link,
     };
     indra::app::run(assets.clone(), gpu.clone(), scene, options, control, notices)

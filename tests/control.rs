@@ -48,6 +48,8 @@ fn hub(dir: &std::path::Path, scene: &Scene) -> ControlHub {
         midi: false,
         presets_dir: dir.join("presets"),
         learn_file: dir.join("midi-learn.ron"),
+        audio_learn_file: dir.join("audio-learn.ron"),
+        audio_in: None,
         ..ControlOptions::default()
     };
     ControlHub::start(&options, scene)
@@ -121,6 +123,26 @@ fn midi_learn_binds_the_next_control_and_persists() {
     assert_eq!(values(&again.midi_bytes(&[0xB3, 21, 0], &s, 0.0)), [ParamValue::Int(1)]);
     again.unlearn(0, samples, &s);
     assert!(hub(&dir, &s).midi_bytes(&[0xB3, 21, 0], &s, 0.0).is_empty(), "unlearn persists too");
+}
+
+#[test]
+fn audio_learn_maps_a_source_and_persists() {
+    let s = scene();
+    let dir = temp("audio-learn");
+    let gpu = common::gpu();
+    let inst = instance(&gpu, &s);
+    let mut h = hub(&dir, &s);
+    let scale = s.nodes[0].params.index("scale").unwrap();
+    assert_eq!(h.audio_mapped(0, scale, &s), (false, false));
+    h.learn_audio(Target { node: 0, param: scale, component: None }, indra::scene::AudioSource::Beat, &inst);
+    assert_eq!(h.audio_mapped(0, scale, &s), (true, true));
+    let saved = std::fs::read_to_string(dir.join("audio-learn.ron")).unwrap();
+    assert!(saved.contains("Beat") && saved.contains("\"k.scale\""), "{saved}");
+    // A new session has it; unlearning persists too.
+    let mut again = hub(&dir, &s);
+    assert_eq!(again.audio_mapped(0, scale, &s), (true, true));
+    again.unlearn_audio(0, scale, &s);
+    assert_eq!(hub(&dir, &s).audio_mapped(0, scale, &s), (false, false));
 }
 
 fn instance(gpu: &indra::gpu::Gpu, s: &Scene) -> SceneInstance {

@@ -4,8 +4,8 @@
 use crate::control::ControlHub;
 use crate::graph::{FrameStats, PassTiming};
 use crate::params::{ControlEvent, Target};
-use crate::params::{ParamDecl, ParamValue, ParamWrite, Source};
-use crate::scene::SceneInstance;
+use crate::params::{ParamDecl, ParamType, ParamValue, ParamWrite, Source};
+use crate::scene::{AUDIO_BANDS, AudioSource, SceneInstance};
 use crate::time::FrameTime;
 
 /// What the overlay shows besides parameters.
@@ -159,7 +159,7 @@ pub fn draw_ui(
                 ui.horizontal(|ui| {
                     // The beat within the bar of four, so the performer sees the phase.
                     let beat = tempo.beats.rem_euclid(4.0).floor() as u32 + 1;
-                    ui.label(format!("♩ {:.1} BPM  beat {beat}/4", tempo.bpm));
+                    ui.label(format!("{:.1} BPM  beat {beat}/4", tempo.bpm));
                     if ui.button("tap").on_hover_text("tap tempo (key T, OSC /indra/tempo/tap)").clicked() {
                         events.extend(hub.tap_tempo());
                     }
@@ -227,7 +227,9 @@ fn preset_panel(
 }
 
 /// The parameter panel; returns the writes the performer made this frame. Each parameter has a
-/// MIDI learn button: click it, move a control; right-click unlearns.
+/// MIDI learn button: click it, move a control; right-click unlearns. Numbers, bools and triggers
+/// also have an audio button: click it, pick a source (shown with its live value); right-click
+/// unlearns.
 fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub) -> Vec<ParamWrite> {
     let mut writes = Vec::new();
     for node in 0..instance.scene().nodes.len() {
@@ -256,6 +258,10 @@ fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub
                         if learn.secondary_clicked() {
                             hub.unlearn(node, p, instance.scene());
                         }
+                        if matches!(decl.ty(), ParamType::Float | ParamType::Int | ParamType::Bool | ParamType::Trigger)
+                        {
+                            audio_learn_button(ui, instance, hub, target);
+                        }
                         let label = ui.label(&decl.name).on_hover_text(&decl.doc);
                         if animated {
                             label.on_hover_text("driven by a track: moving it takes over until 'resume tracks'");
@@ -272,6 +278,57 @@ fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub
         });
     }
     writes
+}
+
+/// The audio learn menu of one parameter: "a", "A" when audio moves it (learned or from the
+/// scene), "A*" when the mapping was learned here.
+fn audio_learn_button(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub, target: Target) {
+    let scene = instance.scene();
+    let (mapped, learned) = hub.audio_mapped(target.node, target.param, scene);
+    let mark = match (mapped, learned) {
+        (_, true) => "A*",
+        (true, false) => "A",
+        _ => "a",
+    };
+    let frame = hub.audio_frame.clone().unwrap_or_default();
+    let mut picked = None;
+    let menu = ui.menu_button(mark, |ui| {
+        if hub.audio_frame.is_none() {
+            ui.small("no sound heard yet (an input opens once something is mapped, unless --no-audio)");
+        }
+        let pulse = |on: bool| if on { "HIT" } else { "-" };
+        let band = |b: usize| frame.bands.get(b).copied().unwrap_or(0.0);
+        let mut sources = vec![
+            (AudioSource::Level, format!("level {:.2}", frame.level)),
+            (AudioSource::Peak, format!("peak {:.2}", frame.peak)),
+            (AudioSource::Low, format!("low {:.2}", frame.low)),
+            (AudioSource::Mid, format!("mid {:.2}", frame.mid)),
+            (AudioSource::High, format!("high {:.2}", frame.high)),
+            (AudioSource::Onset, format!("onset {}", pulse(frame.onset))),
+            (AudioSource::Beat, format!("beat {}", pulse(frame.beat))),
+        ];
+        let mut choose = |ui: &mut egui::Ui, source: AudioSource, label: String| {
+            if ui.button(label).clicked() {
+                picked = Some(source);
+                ui.close();
+            }
+        };
+        for (source, label) in sources.drain(..) {
+            choose(ui, source, label);
+        }
+        ui.menu_button("bands (30 Hz - 16 kHz)", |ui| {
+            for b in 0..AUDIO_BANDS {
+                choose(ui, AudioSource::Band(b as u8), format!("band {b} {:.2}", band(b)));
+            }
+        });
+    });
+    let menu = menu.response.on_hover_text("audio learn: click, pick a source; right-click to unlearn");
+    if menu.secondary_clicked() {
+        hub.unlearn_audio(target.node, target.param, scene);
+    }
+    if let Some(source) = picked {
+        hub.learn_audio(target, source, instance);
+    }
 }
 
 /// One widget per parameter type; returns whether the value changed.

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::time::SystemTime;
 
-use super::audio::{AudioFrame, AudioMapper};
+use super::audio::{AudioFrame, AudioLearn, AudioMapper};
 use super::feedback::OscFeedback;
 use super::midi::{LearnStore, MidiInput, MidiMapper, MidiParser};
 use super::osc::{OscReceiver, OscRouter, RecordRequest, Routed};
@@ -14,7 +14,7 @@ use super::presets::PresetStore;
 use super::record::Recorder;
 use super::tempo::TempoInput;
 use crate::params::{ControlEvent, Remap, Target};
-use crate::scene::{Scene, SceneInstance};
+use crate::scene::{AudioSource, Scene, SceneInstance};
 
 /// Which control sources to open.
 #[derive(Clone, Debug)]
@@ -35,6 +35,8 @@ pub struct ControlOptions {
     pub presets_dir: PathBuf,
     /// File of learned MIDI mappings.
     pub learn_file: PathBuf,
+    /// File of audio mappings learned from the panel.
+    pub audio_learn_file: PathBuf,
     /// Audio input: `None` none; `Some(None)` the default device when the scene maps audio;
     /// `Some(Some(name))` the first device whose name contains `name`, always.
     pub audio_in: Option<Option<String>>,
@@ -53,6 +55,7 @@ impl Default for ControlOptions {
             record: None,
             presets_dir: "presets".into(),
             learn_file: "midi-learn.ron".into(),
+            audio_learn_file: "audio-learn.ron".into(),
             audio_in: Some(None),
             link: false,
         }
@@ -83,8 +86,13 @@ pub struct ControlHub {
     tempo: TempoInput,
     /// Live audio and its analysis, when an input is open.
     audio: Option<LiveSound>,
-    /// The scene's audio mappings.
+    /// Which audio input to open (see [`ControlOptions::audio_in`]), kept to open it when a
+    /// mapping is learned.
+    audio_wanted: Option<Option<String>>,
+    /// The scene's audio mappings and the learned ones.
     audio_mapper: AudioMapper,
+    /// Audio mappings learned from the panel.
+    audio_learn: AudioLearn,
     /// The last analysed audio frame (the panel's meter and spectrum).
     pub audio_frame: Option<AudioFrame>,
     /// The Ableton Link session, when joined.
@@ -127,7 +135,10 @@ impl ControlHub {
         let mapper = MidiMapper::new(scene, &learn.load());
         let presets = PresetStore { dir: options.presets_dir.clone() };
         let preset_names = presets.names();
-        let audio = open_audio(options.audio_in.as_ref(), scene, &mut notices);
+        let (audio_learn, problem) = AudioLearn::load(options.audio_learn_file.clone());
+        notices.extend(problem);
+        let audio_mapper = AudioMapper::with_learned(scene, audio_learn.bound(scene));
+        let audio = open_audio(options.audio_in.as_ref(), !audio_mapper.is_empty(), &mut notices);
         #[cfg(feature = "link")]
         let link = options.link.then(|| super::link::LinkInput::join(scene.bpm));
         #[cfg(not(feature = "link"))]
@@ -151,7 +162,9 @@ impl ControlHub {
             record_requests: Vec::new(),
             tempo: TempoInput::default(),
             audio,
-            audio_mapper: AudioMapper::new(scene),
+            audio_wanted: options.audio_in.clone(),
+            audio_mapper,
+            audio_learn,
             audio_frame: None,
             #[cfg(feature = "link")]
             link,
@@ -165,7 +178,7 @@ impl ControlHub {
     /// it left the scene.
     pub fn set_scene(&mut self, scene: &Scene, remap: Option<&Remap>) {
         self.router = OscRouter::new(scene);
-        self.audio_mapper = AudioMapper::new(scene);
+        self.rebuild_audio(scene);
         let learning = self.mapper.learning.take();
         self.mapper = MidiMapper::new(scene, &self.learn.load());
         self.mapper.learning = learning.and_then(|t| match remap {
@@ -221,6 +234,37 @@ impl ControlHub {
             events.extend(link.poll(&instance.tempo(), ahead));
         }
         events
+    }
+
+    /// Rebuilds the audio mappings (the scene's and the learned ones) and opens the input if
+    /// they now need one.
+    fn rebuild_audio(&mut self, scene: &Scene) {
+        self.audio_mapper = AudioMapper::with_learned(scene, self.audio_learn.bound(scene));
+        if self.audio.is_none() && !self.audio_mapper.is_empty() && self.audio_wanted == Some(None) {
+            self.audio = open_audio(self.audio_wanted.as_ref(), true, &mut self.notices);
+        }
+    }
+
+    /// Maps audio `source` to `target` (the panel's audio learn) and saves it.
+    pub fn learn_audio(&mut self, target: Target, source: AudioSource, instance: &SceneInstance) {
+        let now = instance.params(target.node).target_at(target.param);
+        match self.audio_learn.learn(instance.scene(), target, source, &now) {
+            Ok(()) => self.rebuild_audio(instance.scene()),
+            Err(e) => self.notice(e),
+        }
+    }
+
+    /// Removes the learned audio mapping of a parameter and saves the file.
+    pub fn unlearn_audio(&mut self, node: usize, param: usize, scene: &Scene) {
+        if let Err(e) = self.audio_learn.unlearn(scene, node, param) {
+            self.notice(e);
+        }
+        self.rebuild_audio(scene);
+    }
+
+    /// Whether audio moves a parameter (a scene or a learned mapping), and whether it was learned.
+    pub fn audio_mapped(&self, node: usize, param: usize, scene: &Scene) -> (bool, bool) {
+        (self.audio_mapper.maps(node, param), self.audio_learn.is_learned(scene, node, param))
     }
 
     /// A tap of tap tempo now (key T, the panel's button): the event that sets the tempo, from
@@ -377,12 +421,13 @@ impl LiveSound {
     }
 }
 
-/// Opens the audio input `wanted` asks for (see [`ControlOptions::audio_in`]). No device, or a
-/// build without the `audio` feature, is a logged fact (a notice when a device was named).
-fn open_audio(wanted: Option<&Option<String>>, scene: &Scene, notices: &mut Vec<String>) -> Option<LiveSound> {
+/// Opens the audio input `wanted` asks for (see [`ControlOptions::audio_in`]; the default device
+/// only when `mapped`: some mapping listens). No device, or a build without the `audio` feature,
+/// is a logged fact (a notice when a device was named).
+fn open_audio(wanted: Option<&Option<String>>, mapped: bool, notices: &mut Vec<String>) -> Option<LiveSound> {
     let filter = match wanted {
         None => return None,
-        Some(None) if scene.audio.is_empty() => return None,
+        Some(None) if !mapped => return None,
         Some(filter) => filter.as_deref(),
     };
     #[cfg(feature = "audio")]

@@ -74,6 +74,24 @@ pub struct SceneOutput {
 /// A scene's OSC aliases and MIDI mappings, resolved.
 type ControlMaps = (Vec<(String, Target)>, Vec<(MidiMapping, Target)>);
 
+/// The audio mapping `a` binds to `target` among `nodes`, or why it cannot (the target's type,
+/// a band that does not exist, a range or time that is not a number).
+pub fn check_audio(nodes: &[SceneNode], a: &super::schema::AudioFile, target: Target) -> Result<AudioMapping, String> {
+    let ty = nodes[target.node].params.decls()[target.param].ty();
+    let fits = target.component.is_some()
+        || matches!(ty, ParamType::Float | ParamType::Int | ParamType::Bool | ParamType::Trigger);
+    if !fits {
+        return Err(format!("'{}' is a {ty}: name a number, a bool, a trigger or one component", a.target));
+    }
+    if matches!(a.source, AudioSource::Band(b) if usize::from(b) >= AUDIO_BANDS) {
+        return Err(format!("there are {AUDIO_BANDS} bands, Band(0) to Band({})", AUDIO_BANDS - 1));
+    }
+    if ![a.range.0, a.range.1, a.attack, a.release].iter().all(|v| v.is_finite()) || a.attack < 0.0 || a.release < 0.0 {
+        return Err("range must be finite and attack and release 0 or more seconds".into());
+    }
+    Ok(AudioMapping { source: a.source, target, range: a.range, attack: a.attack, release: a.release })
+}
+
 /// Resolves `node.param` or `node.param.<x|y|z|w|r|g|b|a>` against validated nodes.
 pub fn resolve_target(nodes: &[SceneNode], target: &str) -> Result<Target, String> {
     let mut parts = target.split('.');
@@ -512,30 +530,9 @@ impl Validator<'_> {
                     continue;
                 }
             };
-            let ty = nodes[target.node].params.decls()[target.param].ty();
-            let fits = target.component.is_some()
-                || matches!(ty, ParamType::Float | ParamType::Int | ParamType::Bool | ParamType::Trigger);
-            let problem = if !fits {
-                Some(format!("'{}' is a {ty}: name a number, a bool, a trigger or one component", a.target))
-            } else if matches!(a.source, AudioSource::Band(b) if usize::from(b) >= AUDIO_BANDS) {
-                Some(format!("there are {AUDIO_BANDS} bands, Band(0) to Band({})", AUDIO_BANDS - 1))
-            } else if ![a.range.0, a.range.1, a.attack, a.release].iter().all(|v| v.is_finite())
-                || a.attack < 0.0
-                || a.release < 0.0
-            {
-                Some("range must be finite and attack and release 0 or more seconds".into())
-            } else {
-                None
-            };
-            match problem {
-                Some(p) => self.error(&anchors, format!("audio mapping to '{}': {p}", a.target)),
-                None => out.push(AudioMapping {
-                    source: a.source,
-                    target,
-                    range: a.range,
-                    attack: a.attack,
-                    release: a.release,
-                }),
+            match check_audio(nodes, a, target) {
+                Err(p) => self.error(&anchors, format!("audio mapping to '{}': {p}", a.target)),
+                Ok(m) => out.push(m),
             }
         }
         out

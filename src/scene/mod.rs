@@ -10,12 +10,13 @@ mod schema;
 pub use error::{SceneError, SceneErrors};
 pub use instance::SceneInstance;
 pub use load::{
-    AudioMapping, BoundTrack, Scene, SceneNode, SceneOutput, load_scene, parse_scene, parse_value_override,
-    resolve_target,
+    AudioMapping, BoundTrack, Scene, SceneNode, SceneOutput, check_audio, load_scene, parse_scene,
+    parse_value_override, resolve_target,
 };
 pub use player::{Player, SeekError};
 pub use schema::{
-    AUDIO_BANDS, AudioSource, ControlsFile, MidiCurve, MidiMapping, NodeFile, SceneFile, TrackFile, ron_options,
+    AUDIO_BANDS, AudioFile, AudioSource, ControlsFile, MidiCurve, MidiMapping, NodeFile, SceneFile, TrackFile,
+    ron_options,
 };
 // The address space lives in `params/`; re-exported for code that reaches it through scenes.
 pub use crate::params::{ControlEvent, NodeValues, RawValue, Target, raw_from_value, value_from_raw};

@@ -22,7 +22,7 @@
 
 use std::collections::BTreeMap;
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::params::{Interpolation, LfoRate, LfoShape, LoopMode, RawValue};
 
@@ -106,7 +106,7 @@ pub struct ControlsFile {
 
 /// An audio mapping: `(source: Band(0), target: "limit_set.scale", range: (1.5, 3.0),
 /// attack: 0.01, release: 0.3)`.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct AudioFile {
     /// What it follows.
@@ -128,7 +128,7 @@ pub struct AudioFile {
 pub const AUDIO_BANDS: usize = 16;
 
 /// What an audio mapping follows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
 pub enum AudioSource {
     /// RMS level (a full-scale sine is 0.707).
     Level,

@@ -18,7 +18,19 @@ pub struct AudioMapper {
 impl AudioMapper {
     /// The followers of `scene`'s `controls.audio`, at rest.
     pub fn new(scene: &Scene) -> Self {
-        Self { mappings: scene.audio.clone(), envelopes: vec![0.0; scene.audio.len()] }
+        Self::with_learned(scene, Vec::new())
+    }
+
+    /// The followers of `scene`'s mappings and then `learned` ones (applied after the scene's,
+    /// so a learned mapping wins where both write one parameter), at rest.
+    pub fn with_learned(scene: &Scene, learned: Vec<AudioMapping>) -> Self {
+        let mappings: Vec<AudioMapping> = scene.audio.iter().cloned().chain(learned).collect();
+        Self { envelopes: vec![0.0; mappings.len()], mappings }
+    }
+
+    /// Whether some mapping writes `node`'s parameter `param`.
+    pub fn maps(&self, node: usize, param: usize) -> bool {
+        self.mappings.iter().any(|m| m.target.node == node && m.target.param == param)
     }
 
     /// Whether the scene maps any audio.

@@ -4,12 +4,14 @@
 
 pub mod analysis;
 pub mod file;
+pub mod learn;
 #[cfg(feature = "audio")]
 pub mod live;
 pub mod mapping;
 
 pub use analysis::{Analyzer, AudioFrame};
 pub use file::AudioFile;
+pub use learn::AudioLearn;
 pub use mapping::AudioMapper;
 
 use crate::params::ControlEvent;
