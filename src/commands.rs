@@ -181,9 +181,10 @@ pub struct RenderArgs {
     /// windows show them (warped).
     #[arg(long, default_value_t = 0)]
     pub output: usize,
-    /// A WAV file the scene's audio mappings hear (frame n hears it up to (n + 1) × dt, so
-    /// renders are exact); with --video it is also the video's sound track.
-    #[arg(long, value_name = "FILE.wav")]
+    /// A sound file the scene's audio mappings hear (frame n hears it up to (n + 1) × dt, so
+    /// renders are exact): WAV, or any format ffmpeg decodes (MP3, FLAC, Ogg, …); with --video it
+    /// is also the video's sound track.
+    #[arg(long, value_name = "FILE")]
     pub audio: Option<PathBuf>,
 }
 

@@ -134,9 +134,37 @@ fn a_bad_audio_file_is_one_sentence() {
     let dir = temp_dir("bad");
     let not_wav = dir.join("song.wav");
     std::fs::write(&not_wav, b"ID3 this is an mp3, really").unwrap();
-    for (path, said) in [(not_wav, "is not a WAV file"), (dir.join("missing.wav"), "cannot read audio file")] {
+    for (path, said) in [
+        (not_wav, "is neither a WAV file nor audio ffmpeg can decode"),
+        (dir.join("missing.wav"), "cannot read audio file"),
+    ] {
         let o = indra(&["render", "kleinian_star_glow", "--size", "32x32", "--audio", path.to_str().unwrap()]);
         assert_eq!(o.status.code(), Some(1), "{}", text(&o));
         assert!(text(&o).contains(said) && !text(&o).contains("panicked"), "{}", text(&o));
+    }
+}
+
+#[test]
+fn other_formats_are_decoded_by_ffmpeg_to_the_same_sound() {
+    let dir = temp_dir("formats");
+    let wav = dir.join("beat.wav");
+    write_beat(&wav, 6.0);
+    let reference = AudioFile::open(&wav).unwrap();
+    for ext in ["flac", "mp3", "ogg"] {
+        let encoded = dir.join(format!("beat.{ext}"));
+        let made = Command::new("ffmpeg").args(["-v", "error", "-y", "-i"]).arg(&wav).arg(&encoded).status().unwrap();
+        assert!(made.success(), "ffmpeg could not make {ext}");
+        let file = AudioFile::open(&encoded).unwrap_or_else(|e| panic!("{ext}: {e}"));
+        assert_eq!(file.rate, RATE, "{ext}");
+        // Lossy codecs add a little padding at the start; the length stays within 0.1 s.
+        assert!((file.seconds() - 6.0).abs() < 0.1, "{ext}: {} s", file.seconds());
+        if ext == "flac" {
+            let worst = file.samples.iter().zip(&reference.samples).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+            assert!(worst < 1e-4, "flac is lossless: off by {worst}");
+        }
+        let mut analyzer = Analyzer::new(file.rate);
+        let frames: Vec<_> = (0..360).map(|f| analyzer.frame(file.hop(f, 1.0 / 60.0), (f + 1) as f64 / 60.0)).collect();
+        let bpm = frames.last().unwrap().bpm.expect("a tempo after 6 s");
+        assert!((bpm - 120.0).abs() < 1.0, "{ext}: {bpm}");
     }
 }

@@ -1,8 +1,11 @@
 //! Audio files for deterministic renders: a WAV file (8–32-bit integer or float, any channel
-//! count, mixed to mono) decoded with `hound`, cut into the hops that the fixed clock's frames
-//! cover, so frame n always hears the audio up to (n + 1) × dt.
+//! count, mixed to mono) decoded with `hound`, or any other format (MP3, FLAC, Ogg, AAC, the sound
+//! of a video) decoded by the `ffmpeg` program that video export uses and then read the same way.
+//! The samples are cut into the hops that the fixed clock's frames cover, so
+//! frame n always hears the audio up to (n + 1) × dt.
 
 use std::path::Path;
+use std::process::Command;
 
 /// A decoded file: mono samples at their own rate.
 #[derive(Clone, Debug)]
@@ -14,15 +17,15 @@ pub struct AudioFile {
 }
 
 impl AudioFile {
-    /// Reads a WAV file; every failure is one sentence naming the file.
+    /// Reads a WAV file, or has ffmpeg decode any other; every failure is one sentence naming the
+    /// file.
     pub fn open(path: &Path) -> Result<Self, String> {
         let name = path.display();
-        let reader = hound::WavReader::open(path).map_err(|e| match e {
-            hound::Error::IoError(io) => format!("cannot read audio file {name}: {io}"),
-            other => format!(
-                "{name} is not a WAV file indra can read ({other}); convert it, e.g. `ffmpeg -i in.mp3 out.wav`"
-            ),
-        })?;
+        let reader = match hound::WavReader::open(path) {
+            Ok(reader) => reader,
+            Err(hound::Error::IoError(io)) => return Err(format!("cannot read audio file {name}: {io}")),
+            Err(_) => return decode_with_ffmpeg(path),
+        };
         let spec = reader.spec();
         let channels = usize::from(spec.channels.max(1));
         let interleaved: Vec<f32> = match spec.sample_format {
@@ -48,4 +51,43 @@ impl AudioFile {
         let at = |f: u64| ((f as f64 * dt * f64::from(self.rate)).round() as usize).min(self.samples.len());
         &self.samples[at(frame)..at(frame + 1)]
     }
+}
+
+/// Decodes a file that is not WAV with ffmpeg (`INDRA_FFMPEG`, as for video export, or `ffmpeg`
+/// on the PATH) into a temporary 32-bit float WAV at the file's own rate and channels, then reads
+/// that like any WAV file (ffmpeg's own downmix would not be the plain mean the WAV path takes).
+fn decode_with_ffmpeg(path: &Path) -> Result<AudioFile, String> {
+    let name = path.display();
+    let program = std::env::var_os("INDRA_FFMPEG").unwrap_or_else(|| "ffmpeg".into());
+    let decoded = tempfile_path();
+    let output = Command::new(&program)
+        .args(["-nostdin", "-v", "error", "-y", "-i"])
+        .arg(path)
+        .args(["-vn", "-c:a", "pcm_f32le", "-f", "wav"])
+        .arg(&decoded)
+        .output();
+    let result = match output {
+        Err(e) => Err(format!(
+            "{name} is not a WAV file, and other formats are decoded by ffmpeg, which was not found ({e}): \
+             install it (`apt-get install ffmpeg`) or convert the file to WAV"
+        )),
+        Ok(o) if !o.status.success() => {
+            let said = String::from_utf8_lossy(&o.stderr);
+            let last = said.lines().rev().find(|l| !l.trim().is_empty()).unwrap_or("no audio stream");
+            Err(format!("{name} is neither a WAV file nor audio ffmpeg can decode ({})", last.trim()))
+        }
+        Ok(_) => match hound::WavReader::open(&decoded) {
+            Ok(_) => AudioFile::open(&decoded).map_err(|e| format!("{name} (decoded by ffmpeg): {e}")),
+            Err(e) => Err(format!("{name}: ffmpeg's decoding cannot be read ({e})")),
+        },
+    };
+    let _ = std::fs::remove_file(&decoded);
+    result
+}
+
+/// A fresh path in the temporary folder for a decoded file.
+fn tempfile_path() -> std::path::PathBuf {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    std::env::temp_dir().join(format!("indra-decoded-{}-{n}.wav", std::process::id()))
 }
