@@ -168,3 +168,39 @@ fn other_formats_are_decoded_by_ffmpeg_to_the_same_sound() {
         assert!((bpm - 120.0).abs() < 1.0, "{ext}: {bpm}");
     }
 }
+
+#[test]
+fn the_bundled_loop_has_its_tempo_and_drives_kleinian_audio_to_its_goldens() {
+    let wav = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/audio/demo-beat.wav");
+    let file = AudioFile::open(Path::new(wav)).unwrap();
+    let mut analyzer = Analyzer::new(file.rate);
+    let frames: Vec<_> = (0..480).map(|f| analyzer.frame(file.hop(f, 1.0 / 60.0), (f + 1) as f64 / 60.0)).collect();
+    assert!((frames[479].bpm.expect("a tempo after 8 s") - 120.0).abs() < 1.0);
+    // Once the tempo is heard: a beat every 30 frames, on the kicks.
+    let beats: Vec<usize> = (300..480).filter(|&f| frames[f].beat).collect();
+    assert_eq!(beats.len(), 6, "{beats:?}");
+    assert!(beats.iter().all(|f| f % 30 <= 2 || f % 30 >= 28), "within 2 frames of the kicks: {beats:?}");
+
+    let dir = temp_dir("golden");
+    let size = (192, 108);
+    for frame in [45u32, 100] {
+        let start = frame.to_string();
+        let o = indra(&[
+            "render",
+            "kleinian_audio",
+            "--size",
+            "192x108",
+            "--start",
+            &start,
+            "--frames",
+            "1",
+            "--audio",
+            wav,
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        let png = image::open(dir.join(format!("kleinian_audio_{frame:05}.png"))).unwrap().to_rgba8();
+        common::golden().check(&format!("kleinian_audio_f{frame:04}"), size, png.as_raw()).unwrap();
+    }
+}
