@@ -9,12 +9,9 @@
 //             Mueller 2012]: no particle farther from its pins than its rest distance, which a
 //             Jacobi sweep (one row per substep) cannot achieve on a tall hanging cloth.
 // Wind pushes along the local normal (see `wind_at`). Positions are vec4: xyz, w = inverse mass
-// (0 = pinned). Substeps go two per dispatch (temporal blocking: `verlet2`, `xpbd2`): a 16x16
-// workgroup stages a 24x24 tile (a halo of 4) in workgroup memory, runs the first substep on the
-// inner 20x20 into a second tile, then the second on its own 16x16, so each particle is read from
-// and written to memory once per two substeps and every neighbour read is local. An odd last
-// substep runs alone (`verlet`, `xpbd`: a 20x20 tile, a halo of 2). The normals for drawing run
-// one invocation per particle.
+// (0 = pinned). Each substep is one dispatch of 16x16 workgroups over the res x res grid that
+// stages a 20x20 tile (a halo of 2) in workgroup memory, so each of the 12 neighbour reads is
+// local; the normals for drawing run one invocation per particle.
 
 struct ClothUniforms {
     res: u32,            // particles per side
@@ -42,51 +39,29 @@ struct ClothUniforms {
 // Vertex normals, written once per clock step after the substeps (for drawing, and for the
 // wind of the next step's substeps).
 @group(0) @binding(5) var<storage, read_write> normals: array<vec4<f32>>;
-// The first of two substeps' positions (written by the two-substep kernels: the next previous).
-@group(0) @binding(6) var<storage, read_write> mid: array<vec4<f32>>;
 
 // The 12 neighbours: the 8-ring, then the four distance-2 diagonals (see `spring`).
 
 const TILE: u32 = 16u;
-const SPAN: u32 = 20u; // TILE + a halo of 2 on each side: one substep
-const WIDE: u32 = 24u; // TILE + a halo of 4 on each side: two substeps
-const WIDE_CELLS: u32 = 576u; // WIDE * WIDE
-// The two-substep kernels keep the wide tile at [0, 576) and the inner 20x20 after it; a single
-// substep uses [0, 400). 15.6 KiB, under WebGPU's 16 KiB default.
-var<workgroup> tile: array<vec4<f32>, 976>;
+const SPAN: u32 = 20u; // TILE + 2 halo on each side
+var<workgroup> tile: array<vec4<f32>, 400>;
 
-// A square of the grid staged in `tile`: its grid coordinate at the corner, where it starts in
-// `tile`, and its side.
-struct Region {
-    origin: vec2<i32>,
-    base: u32,
-    span: u32,
-};
-
-// The staged value at grid coordinate c (inside the region; outside the grid it holds the
-// nearest border particle).
-fn shared_at(r: Region, c: vec2<i32>) -> vec4<f32> {
-    let t = c - r.origin;
-    return tile[r.base + u32(t.y) * r.span + u32(t.x)];
-}
-
-// The grid coordinate of the k-th cell of a region, and the particle it holds (clamped).
-fn cell(r: Region, k: u32) -> vec2<i32> {
-    return r.origin + vec2<i32>(i32(k % r.span), i32(k / r.span));
-}
-
-fn clamped_index(c: vec2<i32>) -> u32 {
-    let q = clamp(c, vec2<i32>(0), vec2<i32>(i32(u.res) - 1));
-    return u32(q.y) * u.res + u32(q.x);
-}
-
-// Stages region r from `cur`. Call from uniform control flow: every invocation takes part before
-// any returns.
-fn load_region(local: u32, r: Region) {
-    for (var k = local; k < r.span * r.span; k = k + TILE * TILE) {
-        tile[r.base + k] = cur[clamped_index(cell(r, k))];
+// Loads the workgroup's tile (clamped at the grid border) from `cur`. Call from uniform control
+// flow: every invocation takes part before any returns.
+fn load_tile(local: u32, group: vec2<u32>) -> vec2<i32> {
+    let origin = vec2<i32>(group * TILE) - vec2<i32>(2);
+    let last = vec2<i32>(i32(u.res) - 1);
+    for (var k = local; k < SPAN * SPAN; k = k + TILE * TILE) {
+        let c = clamp(origin + vec2<i32>(i32(k % SPAN), i32(k / SPAN)), vec2<i32>(0), last);
+        tile[k] = cur[u32(c.y) * u.res + u32(c.x)];
     }
     workgroupBarrier();
+    return origin;
+}
+
+fn from_tile(c: vec2<i32>, origin: vec2<i32>) -> vec4<f32> {
+    let t = c - origin;
+    return tile[u32(t.y) * SPAN + u32(t.x)];
 }
 
 fn coord(i: u32) -> vec2<i32> {
@@ -107,24 +82,24 @@ const SQRT8: f32 = 2.82842712;
 // Verlet: the force of the spring to neighbour c + offset (zero outside the grid). Called once
 // per neighbour with constant arguments: a dynamically indexed constant array would be copied to
 // per-invocation memory by the SPIR-V backend.
-fn spring(x: vec3<f32>, c: vec2<i32>, r: Region, offset: vec2<i32>, factor: f32) -> vec3<f32> {
+fn spring(x: vec3<f32>, c: vec2<i32>, origin: vec2<i32>, offset: vec2<i32>, factor: f32) -> vec3<f32> {
     let nc = c + offset;
     if (!inside(nc)) {
         return vec3<f32>(0.0);
     }
-    let d = shared_at(r, nc).xyz - x;
+    let d = from_tile(nc, origin).xyz - x;
     let len = length(d);
     return u.stiffness * (len - factor * u.rest) * d / max(len, 1e-9);
 }
 
 // XPBD: this particle's correction from the constraint to neighbour c + offset (xyz), and 1 in w
 // if the constraint exists.
-fn constraint(x: vec4<f32>, c: vec2<i32>, r: Region, offset: vec2<i32>, factor: f32, alpha: f32) -> vec4<f32> {
+fn constraint(x: vec4<f32>, c: vec2<i32>, origin: vec2<i32>, offset: vec2<i32>, factor: f32, alpha: f32) -> vec4<f32> {
     let nc = c + offset;
     if (!inside(nc)) {
         return vec4<f32>(0.0);
     }
-    let other = shared_at(r, nc);
+    let other = from_tile(nc, origin);
     let d = x.xyz - other.xyz;
     let len = length(d);
     // Delta lambda from zero (one iteration per small step), applied to this particle only.
@@ -140,7 +115,7 @@ fn tether(p: vec3<f32>, anchor: vec3<f32>, limit: f32) -> vec3<f32> {
 }
 
 // Long-range attachments: the top-row pin of the same column (at j rest lengths), or the two
-// top corners (at their rest distances). Pins never move, so `cur` holds them at every substep.
+// top corners (at their rest distances).
 fn attach(p: vec3<f32>, c: vec2<i32>) -> vec3<f32> {
     let j = f32(c.y);
     if (u.attachments == 1u) {
@@ -181,161 +156,83 @@ fn check(p: vec3<f32>) {
     }
 }
 
-// One Verlet substep of particle i at c, now at x and before at `before`, its neighbours staged
-// in r: x' = 2x - x_prev + F/m dt^2, then the sphere.
-fn verlet_point(x: vec4<f32>, before: vec3<f32>, c: vec2<i32>, r: Region, i: u32) -> vec4<f32> {
-    if (x.w == 0.0) {
-        return x;
-    }
-    let v = (x.xyz - before) / u.dt;
-    var force = (u.acceleration.xyz + wind_at(i)) * u.mass - u.damping * v;
-    let p0 = x.xyz;
-    force += spring(p0, c, r, vec2<i32>(-1, -1), SQRT2) + spring(p0, c, r, vec2<i32>(0, -1), 1.0);
-    force += spring(p0, c, r, vec2<i32>(1, -1), SQRT2) + spring(p0, c, r, vec2<i32>(1, 0), 1.0);
-    force += spring(p0, c, r, vec2<i32>(1, 1), SQRT2) + spring(p0, c, r, vec2<i32>(0, 1), 1.0);
-    force += spring(p0, c, r, vec2<i32>(-1, 1), SQRT2) + spring(p0, c, r, vec2<i32>(-1, 0), 1.0);
-    force += spring(p0, c, r, vec2<i32>(-2, -2), SQRT8) + spring(p0, c, r, vec2<i32>(2, -2), SQRT8);
-    force += spring(p0, c, r, vec2<i32>(2, 2), SQRT8) + spring(p0, c, r, vec2<i32>(-2, 2), SQRT8);
-    let p = collide(2.0 * x.xyz - before + force / u.mass * u.dt * u.dt);
-    check(p);
-    return vec4<f32>(p, x.w);
-}
-
 @compute @workgroup_size(16, 16, 1)
 fn verlet(
     @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
     @builtin(workgroup_id) group: vec3<u32>,
 ) {
-    let r = Region(vec2<i32>(group.xy * TILE) - vec2<i32>(2), 0u, SPAN);
-    load_region(local, r);
+    let origin = load_tile(local, group.xy);
     let c = vec2<i32>(id.xy);
     if (any(id.xy >= vec2<u32>(u.res))) {
         return;
     }
     let i = index(c);
-    next[i] = verlet_point(shared_at(r, c), prev[i].xyz, c, r, i);
-}
-
-// Two Verlet substeps: the first over the inner 20x20 (the second's neighbours), the second over
-// the workgroup's own 16x16.
-@compute @workgroup_size(16, 16, 1)
-fn verlet2(
-    @builtin(global_invocation_id) id: vec3<u32>,
-    @builtin(local_invocation_index) local: u32,
-    @builtin(workgroup_id) group: vec3<u32>,
-) {
-    let wide = Region(vec2<i32>(group.xy * TILE) - vec2<i32>(4), 0u, WIDE);
-    load_region(local, wide);
-    let inner = Region(wide.origin + vec2<i32>(2), WIDE_CELLS, SPAN);
-    for (var k = local; k < SPAN * SPAN; k = k + TILE * TILE) {
-        let c = cell(inner, k);
-        var x1 = shared_at(wide, c);
-        if (inside(c)) {
-            let i = index(c);
-            x1 = verlet_point(x1, prev[i].xyz, c, wide, i);
-        }
-        tile[inner.base + k] = x1;
-    }
-    workgroupBarrier();
-    let c = vec2<i32>(id.xy);
-    if (any(id.xy >= vec2<u32>(u.res))) {
+    let x = from_tile(c, origin);
+    if (x.w == 0.0) {
+        next[i] = x;
         return;
     }
-    let i = index(c);
-    let x1 = shared_at(inner, c);
-    mid[i] = x1;
-    next[i] = verlet_point(x1, shared_at(wide, c).xyz, c, inner, i);
-}
-
-// XPBD's inertial prediction of a particle now at x and before at `before`, with gravity and
-// wind (pinned particles stay).
-fn predicted(x: vec4<f32>, before: vec3<f32>, i: u32) -> vec4<f32> {
-    if (x.w == 0.0) {
-        return x;
-    }
-    let keep = max(1.0 - u.damping * u.dt, 0.0);
-    let a = u.acceleration.xyz + wind_at(i);
-    return vec4<f32>(x.xyz + (x.xyz - before) * keep + a * u.dt * u.dt, x.w);
-}
-
-// Stages region r with the predicted positions (from `cur` and `prev`): a workgroup predicts its
-// own tile and halo, so no predicted buffer goes through memory. Uniform control flow.
-fn load_predicted(local: u32, r: Region) {
-    for (var k = local; k < r.span * r.span; k = k + TILE * TILE) {
-        let j = clamped_index(cell(r, k));
-        tile[r.base + k] = predicted(cur[j], prev[j].xyz, j);
-    }
-    workgroupBarrier();
-}
-
-// One Jacobi projection of the 12 distance constraints of the particle predicted at x (at c, its
-// neighbours' predictions staged in r), then the long-range attachments and the sphere.
-fn xpbd_point(x: vec4<f32>, c: vec2<i32>, r: Region) -> vec4<f32> {
-    if (x.w == 0.0) {
-        return x;
-    }
-    let alpha = u.compliance / (u.dt * u.dt);
-    var sum = constraint(x, c, r, vec2<i32>(-1, -1), SQRT2, alpha) + constraint(x, c, r, vec2<i32>(0, -1), 1.0, alpha);
-    sum += constraint(x, c, r, vec2<i32>(1, -1), SQRT2, alpha) + constraint(x, c, r, vec2<i32>(1, 0), 1.0, alpha);
-    sum += constraint(x, c, r, vec2<i32>(1, 1), SQRT2, alpha) + constraint(x, c, r, vec2<i32>(0, 1), 1.0, alpha);
-    sum += constraint(x, c, r, vec2<i32>(-1, 1), SQRT2, alpha) + constraint(x, c, r, vec2<i32>(-1, 0), 1.0, alpha);
-    sum += constraint(x, c, r, vec2<i32>(-2, -2), SQRT8, alpha) + constraint(x, c, r, vec2<i32>(2, -2), SQRT8, alpha);
-    sum += constraint(x, c, r, vec2<i32>(2, 2), SQRT8, alpha) + constraint(x, c, r, vec2<i32>(-2, 2), SQRT8, alpha);
-    // Averaging keeps the Jacobi sum from overshooting (Bridson et al. 2003 style).
-    let p = collide(attach(x.xyz + sum.xyz * (1.5 / max(sum.w, 1.0)), c));
+    let v = (x.xyz - prev[i].xyz) / u.dt;
+    var force = (u.acceleration.xyz + wind_at(i)) * u.mass - u.damping * v;
+    let p0 = x.xyz;
+    force += spring(p0, c, origin, vec2<i32>(-1, -1), SQRT2) + spring(p0, c, origin, vec2<i32>(0, -1), 1.0);
+    force += spring(p0, c, origin, vec2<i32>(1, -1), SQRT2) + spring(p0, c, origin, vec2<i32>(1, 0), 1.0);
+    force += spring(p0, c, origin, vec2<i32>(1, 1), SQRT2) + spring(p0, c, origin, vec2<i32>(0, 1), 1.0);
+    force += spring(p0, c, origin, vec2<i32>(-1, 1), SQRT2) + spring(p0, c, origin, vec2<i32>(-1, 0), 1.0);
+    force += spring(p0, c, origin, vec2<i32>(-2, -2), SQRT8) + spring(p0, c, origin, vec2<i32>(2, -2), SQRT8);
+    force += spring(p0, c, origin, vec2<i32>(2, 2), SQRT8) + spring(p0, c, origin, vec2<i32>(-2, 2), SQRT8);
+    let p = collide(2.0 * x.xyz - prev[i].xyz + force / u.mass * u.dt * u.dt);
     check(p);
-    return vec4<f32>(p, x.w);
+    next[i] = vec4<f32>(p, x.w);
 }
 
-// XPBD, one small step in one pass: prediction of the tile and halo, then one projection.
+// XPBD, one small step in one pass: inertial prediction with gravity and wind, then one Jacobi
+// projection of the 12 distance constraints of each particle, the long-range attachments and
+// the collision. The workgroup predicts its tile and halo itself, so no predicted buffer goes
+// through memory.
 @compute @workgroup_size(16, 16, 1)
 fn xpbd(
     @builtin(global_invocation_id) id: vec3<u32>,
     @builtin(local_invocation_index) local: u32,
     @builtin(workgroup_id) group: vec3<u32>,
 ) {
-    let r = Region(vec2<i32>(group.xy * TILE) - vec2<i32>(2), 0u, SPAN);
-    load_predicted(local, r);
-    let c = vec2<i32>(id.xy);
-    if (any(id.xy >= vec2<u32>(u.res))) {
-        return;
-    }
-    next[index(c)] = xpbd_point(shared_at(r, c), c, r);
-}
-
-// Two XPBD small steps: predict the wide tile, project the inner 20x20 and predict its next
-// step there, then project the workgroup's own 16x16.
-@compute @workgroup_size(16, 16, 1)
-fn xpbd2(
-    @builtin(global_invocation_id) id: vec3<u32>,
-    @builtin(local_invocation_index) local: u32,
-    @builtin(workgroup_id) group: vec3<u32>,
-) {
-    let own = vec2<i32>(group.xy * TILE);
-    let wide = Region(own - vec2<i32>(4), 0u, WIDE);
-    load_predicted(local, wide);
-    let inner = Region(wide.origin + vec2<i32>(2), WIDE_CELLS, SPAN);
+    let origin = vec2<i32>(group.xy * TILE) - vec2<i32>(2);
+    let last = vec2<i32>(i32(u.res) - 1);
+    let keep = max(1.0 - u.damping * u.dt, 0.0);
     for (var k = local; k < SPAN * SPAN; k = k + TILE * TILE) {
-        let c = cell(inner, k);
-        var next_prediction = shared_at(wide, c);
-        if (inside(c)) {
-            let i = index(c);
-            let x1 = xpbd_point(next_prediction, c, wide);
-            // The first substep's result of the workgroup's own particles is the next previous.
-            if (all(c >= own) && all(c < own + vec2<i32>(i32(TILE)))) {
-                mid[i] = x1;
-            }
-            next_prediction = predicted(x1, cur[i].xyz, i);
+        let c = clamp(origin + vec2<i32>(i32(k % SPAN), i32(k / SPAN)), vec2<i32>(0), last);
+        let j = u32(c.y) * u.res + u32(c.x);
+        let x = cur[j];
+        var p = x.xyz;
+        if (x.w != 0.0) {
+            let a = u.acceleration.xyz + wind_at(j);
+            p = x.xyz + (x.xyz - prev[j].xyz) * keep + a * u.dt * u.dt;
         }
-        tile[inner.base + k] = next_prediction;
+        tile[k] = vec4<f32>(p, x.w);
     }
     workgroupBarrier();
     let c = vec2<i32>(id.xy);
     if (any(id.xy >= vec2<u32>(u.res))) {
         return;
     }
-    next[index(c)] = xpbd_point(shared_at(inner, c), c, inner);
+    let i = index(c);
+    let x = from_tile(c, origin);
+    if (x.w == 0.0) {
+        next[i] = x;
+        return;
+    }
+    let alpha = u.compliance / (u.dt * u.dt);
+    var sum = constraint(x, c, origin, vec2<i32>(-1, -1), SQRT2, alpha) + constraint(x, c, origin, vec2<i32>(0, -1), 1.0, alpha);
+    sum += constraint(x, c, origin, vec2<i32>(1, -1), SQRT2, alpha) + constraint(x, c, origin, vec2<i32>(1, 0), 1.0, alpha);
+    sum += constraint(x, c, origin, vec2<i32>(1, 1), SQRT2, alpha) + constraint(x, c, origin, vec2<i32>(0, 1), 1.0, alpha);
+    sum += constraint(x, c, origin, vec2<i32>(-1, 1), SQRT2, alpha) + constraint(x, c, origin, vec2<i32>(-1, 0), 1.0, alpha);
+    sum += constraint(x, c, origin, vec2<i32>(-2, -2), SQRT8, alpha) + constraint(x, c, origin, vec2<i32>(2, -2), SQRT8, alpha);
+    sum += constraint(x, c, origin, vec2<i32>(2, 2), SQRT8, alpha) + constraint(x, c, origin, vec2<i32>(-2, 2), SQRT8, alpha);
+    // Averaging keeps the Jacobi sum from overshooting (Bridson et al. 2003 style).
+    let p = collide(attach(x.xyz + sum.xyz * (1.5 / max(sum.w, 1.0)), c));
+    check(p);
+    next[i] = vec4<f32>(p, x.w);
 }
 
 // Vertex normals from central differences of the grid (one-sided at the borders), oriented

@@ -236,32 +236,3 @@ fn every_spring_kind_shows_in_the_debug_view() {
     let ratio = green as f64 / red.max(1) as f64;
     assert!(ratio > 0.85, "green : red light = {ratio:.3}");
 }
-
-#[test]
-fn two_substeps_per_dispatch_match_one_substep_per_dispatch() {
-    // 21 particles a side: two workgroups each way, the second cut by the grid's edge.
-    for solver in ["Verlet", "XPBD"] {
-        let settings = [
-            ("resolution", "21"),
-            ("substeps", "3"),
-            ("solver", solver),
-            ("sphere_center", "0,-0.6,0.1"),
-            ("sphere_radius", "0.5"),
-            ("wind_strength", "2"),
-        ];
-        let (mut paired, mut single) = (rig(&settings, 0.006), rig(&settings, 0.006));
-        single.node.pair_substeps(false);
-        for _ in 0..6 {
-            paired.run(5);
-            single.run(5);
-            let pairs = [(paired.node.positions(), single.node.positions())];
-            let previous = [(paired.node.previous_positions(), single.node.previous_positions())];
-            for (a, b) in pairs.iter().chain(&previous) {
-                for (i, (p, q)) in a.iter().zip(b).enumerate() {
-                    assert!(distance(*p, *q) < 1e-5, "{solver}, particle {i}: paired {p:?}, single {q:?}");
-                }
-            }
-        }
-        assert!(top_row_strain(&paired.node.positions(), 21, 0.1).is_finite());
-    }
-}

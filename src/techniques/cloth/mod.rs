@@ -41,9 +41,7 @@ pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// The simulation pipelines and the layout they share.
 struct Kernels {
     verlet: ComputeKernel,
-    verlet2: ComputeKernel,
     xpbd: ComputeKernel,
-    xpbd2: ComputeKernel,
     normals: ComputeKernel,
     layout: wgpu::BindGroupLayout,
 }
@@ -57,8 +55,6 @@ pub struct Cloth {
     /// One uniform buffer per clock step a frame may run.
     uniforms: Vec<wgpu::Buffer>,
     state: Option<State>,
-    /// Two substeps per dispatch (see [`Cloth::pair_substeps`]).
-    paired: bool,
     /// Steps queued by `step`, recorded by the next `add_passes`.
     pending: Vec<ClothUniforms>,
     messages: Vec<String>,
@@ -82,21 +78,14 @@ impl Cloth {
                 storage(3, false),
                 storage(4, false),
                 storage(5, false),
-                storage(6, false),
             ],
         });
         // Binding order = the order of `State::bind_group`'s entries and of the layout above.
-        let bindings = [("u", 0), ("prev", 1), ("cur", 2), ("next", 3), ("status", 4), ("normals", 5), ("mid", 6)];
+        let bindings = [("u", 0), ("prev", 1), ("cur", 2), ("next", 3), ("status", 4), ("normals", 5)];
         let (origin, source) = setup.shader_source("cloth.wgsl", &bindings)?;
         let kernel = |entry| ComputeKernel::new(device, &origin, &source, entry, &[&layout]);
-        let kernels = Kernels {
-            verlet: kernel("verlet")?,
-            verlet2: kernel("verlet2")?,
-            xpbd: kernel("xpbd")?,
-            xpbd2: kernel("xpbd2")?,
-            normals: kernel("compute_normals")?,
-            layout,
-        };
+        let kernels =
+            Kernels { verlet: kernel("verlet")?, xpbd: kernel("xpbd")?, normals: kernel("compute_normals")?, layout };
         let renderer = Renderer::new(setup)?;
         let uniforms = (0..MAX_CATCH_UP_STEPS.max(1))
             .map(|_| crate::gpu::uniform_buffer::<ClothUniforms>(device, "cloth_uniforms"))
@@ -108,7 +97,6 @@ impl Cloth {
             renderer,
             uniforms,
             state: None,
-            paired: true,
             pending: Vec::new(),
             messages: Vec::new(),
         })
@@ -117,14 +105,6 @@ impl Cloth {
     /// Reads the current particle positions back (blocking; for tests and tools).
     pub fn positions(&self) -> Vec<[f32; 4]> {
         self.state.as_ref().map(|s| s.read_positions(&self.device, &self.queue)).unwrap_or_default()
-    }
-
-    /// Runs every substep in its own dispatch instead of two per dispatch (tests compare the two).
-    pub fn pair_substeps(&mut self, paired: bool) {
-        self.paired = paired;
-        if let Some(s) = self.state.as_mut() {
-            s.paired = paired;
-        }
     }
 
     /// Reads the previous positions back (blocking; for tests and tools).
@@ -143,9 +123,7 @@ impl Cloth {
         let pin = p.choice("pin");
         let fresh = self.state.as_ref().is_none_or(|s| s.res != res || s.pin != pin);
         if fresh {
-            let mut state = State::new(&self.device, &self.renderer, res, pin);
-            state.paired = self.paired;
-            self.state = Some(state);
+            self.state = Some(State::new(&self.device, &self.renderer, res, pin));
         }
         if fresh || p.fired("reset") {
             let pose = rest_pose(res, p.float("rest_length"), p.float("mass"), pin);
@@ -211,14 +189,12 @@ impl Technique for Cloth {
                 label: Some("cloth/simulate"),
                 timestamp_writes: None,
             });
-            // Both solvers run one tiled dispatch per two substeps over the 2-D grid.
+            // Both solvers run one tiled dispatch per substep over the 2-D grid.
             let grid = [state.res, state.res, 1];
             for d in &dispatches {
                 let kernel = match d.kernel {
                     state::Kernel::Verlet => &this.kernels.verlet,
-                    state::Kernel::Verlet2 => &this.kernels.verlet2,
                     state::Kernel::Xpbd => &this.kernels.xpbd,
-                    state::Kernel::Xpbd2 => &this.kernels.xpbd2,
                 };
                 kernel.dispatch(&mut pass, &[&state.bind_groups[&d.key]], grid);
             }

@@ -1,7 +1,6 @@
-//! The cloth's GPU state at one resolution: four particle buffers that rotate through the roles
-//! previous / current / middle / next (so no step copies; a two-substep dispatch writes both the
-//! middle and the next), normals, the NaN flag, and the plan of one frame's dispatches with their
-//! bind groups made ahead of time.
+//! The cloth's GPU state at one resolution: three particle buffers that rotate through the roles
+//! previous / current / next (so no step copies), normals, the NaN flag, and the plan of one
+//! frame's dispatches with their bind groups made ahead of time.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
@@ -11,20 +10,16 @@ use super::render::Renderer;
 use crate::gpu::BindGroupCache;
 use crate::graph::{BufferHandle, FrameGraph};
 
-/// (uniform slot, previous, current, middle, next): which buffers a simulation dispatch binds.
-pub type Key = (usize, usize, usize, usize, usize);
+/// (uniform slot, previous, current, next): which buffers a simulation dispatch binds.
+pub type Key = (usize, usize, usize, usize);
 
 /// Which simulation kernel a dispatch runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kernel {
     /// One explicit Verlet substep.
     Verlet,
-    /// Two Verlet substeps in one dispatch (the first's result goes to the middle buffer).
-    Verlet2,
     /// One XPBD small step (prediction and one Jacobi projection).
     Xpbd,
-    /// Two XPBD small steps in one dispatch.
-    Xpbd2,
 }
 
 /// One dispatch of a frame's simulation.
@@ -87,8 +82,8 @@ pub struct State {
     pub res: u32,
     /// Pin mode index.
     pub pin: u32,
-    particles: [wgpu::Buffer; 4],
-    ids: [u64; 4],
+    particles: [wgpu::Buffer; 3],
+    ids: [u64; 3],
     /// Index of the previous-positions buffer.
     pub prev: usize,
     /// Index of the current-positions buffer.
@@ -103,8 +98,6 @@ pub struct State {
     pub status_readback: wgpu::Buffer,
     /// Simulation bind groups by key.
     pub bind_groups: BindGroupCache<Key>,
-    /// Whether substeps go two per dispatch (off only to test the pairs against single steps).
-    pub paired: bool,
     /// The NaN watch.
     pub nan: NanWatch,
     /// Surface triangle indices (particle numbers).
@@ -151,7 +144,6 @@ impl State {
             status,
             status_readback,
             bind_groups: BindGroupCache::default(),
-            paired: true,
             nan: NanWatch::new(),
             surface_indices,
             surface_count,
@@ -161,7 +153,7 @@ impl State {
     }
 
     /// The particle buffers.
-    pub fn particles(&self) -> &[wgpu::Buffer; 4] {
+    pub fn particles(&self) -> &[wgpu::Buffer; 3] {
         &self.particles
     }
 
@@ -176,15 +168,13 @@ impl State {
         queue.write_buffer(&self.status, 0, &[0; 4]);
     }
 
-    /// The two lowest buffer indices other than `prev` and `cur`.
-    fn free(prev: usize, cur: usize) -> (usize, usize) {
-        let mut others = (0..4).filter(|i| *i != prev && *i != cur);
-        (others.next().expect("four buffers"), others.next().expect("four buffers"))
+    /// The lowest buffer index not among `used`.
+    fn free(used: &[usize]) -> usize {
+        (0..3).find(|i| !used.contains(i)).expect("three buffers, at most two in use")
     }
 
-    /// Plans one frame: `substeps` substeps for each queued step, two per dispatch (an odd last
-    /// one alone), rotating buffer roles, with every bind group created now. Leaves `prev`/`cur`
-    /// as they will be after the frame.
+    /// Plans one frame: `substeps` substeps for each queued step, rotating buffer roles, with
+    /// every bind group created now. Leaves `prev`/`cur` as they will be after the frame.
     pub fn plan(
         &mut self,
         device: &wgpu::Device,
@@ -197,22 +187,11 @@ impl State {
         self.draw_groups.begin_frame();
         let mut out = Vec::new();
         for (slot, u) in steps.iter().enumerate() {
-            let (single, double) =
-                if u.solver == 0 { (Kernel::Verlet, Kernel::Verlet2) } else { (Kernel::Xpbd, Kernel::Xpbd2) };
-            let mut left = substeps;
-            while left > 0 {
-                let (a, b) = Self::free(self.prev, self.cur);
-                if left >= 2 && self.paired {
-                    // Middle a, next b: the middle becomes the previous.
-                    out.push(Dispatch { kernel: double, key: (slot, self.prev, self.cur, a, b) });
-                    (self.prev, self.cur) = (a, b);
-                    left -= 2;
-                } else {
-                    // Next a; b is bound as an unused middle.
-                    out.push(Dispatch { kernel: single, key: (slot, self.prev, self.cur, b, a) });
-                    (self.prev, self.cur) = (self.cur, a);
-                    left -= 1;
-                }
+            for _ in 0..substeps {
+                let kernel = if u.solver == 0 { Kernel::Verlet } else { Kernel::Xpbd };
+                let next = Self::free(&[self.prev, self.cur]);
+                out.push(Dispatch { kernel, key: (slot, self.prev, self.cur, next) });
+                (self.prev, self.cur) = (self.cur, next);
             }
         }
         let keys: Vec<Key> = out.iter().map(|d| d.key).chain([self.normals_key()]).collect();
@@ -224,8 +203,7 @@ impl State {
 
     /// The key the normals pass binds (current positions; the other roles are placeholders).
     pub fn normals_key(&self) -> Key {
-        let (a, b) = Self::free(self.prev, self.cur);
-        (0, self.prev, self.cur, b, a)
+        (0, self.prev, self.cur, Self::free(&[self.prev, self.cur]))
     }
 
     fn bind_group(
@@ -235,7 +213,7 @@ impl State {
         uniforms: &[wgpu::Buffer],
         key: Key,
     ) {
-        let (slot, prev, cur, mid, next) = key;
+        let (slot, prev, cur, next) = key;
         let particles = &self.particles;
         let (status, normals) = (&self.status, &self.normals);
         self.bind_groups.get_or_create(key, || {
@@ -246,7 +224,6 @@ impl State {
                 particles[next].as_entire_binding(),
                 status.as_entire_binding(),
                 normals.as_entire_binding(),
-                particles[mid].as_entire_binding(),
             ]
             .into_iter()
             .enumerate()
@@ -261,7 +238,7 @@ impl State {
     }
 
     /// Imports the particle buffers into this frame's graph.
-    pub fn import(&self, graph: &mut FrameGraph<'_>) -> [BufferHandle; 4] {
+    pub fn import(&self, graph: &mut FrameGraph<'_>) -> [BufferHandle; 3] {
         std::array::from_fn(|i| graph.import_buffer(format!("cloth/particles{i}"), &self.particles[i], self.ids[i]))
     }
 
