@@ -13,7 +13,9 @@
 //   draw    the vertex shader finds its patch by binary search and evaluates its lattice point:
 //           a point on a patch edge is snapped to that edge's own subdivision, from the same
 //           integers and endpoints in the edge's canonical direction, so neighbours with
-//           different levels meet exactly (crack-free); interior points are barycentric. The
+//           different levels meet exactly (crack-free); interior points are barycentric. Points
+//           are geomorphed by the fractional factors (see `morphed`): levels are integers, but
+//           vertices glide between them instead of popping. The
 //           height is sampled at the point's UV, the surface displaced along the normal, and the
 //           normal recomputed from the height field's gradient.
 
@@ -234,7 +236,29 @@ fn height_at(uv: vec2<f32>) -> f32 {
     return select(c.r, dot(c.rgb, vec3<f32>(0.2126, 0.7152, 0.0722)), u.luminance != 0u);
 }
 
-// UV of lattice point (i, j) of a patch of level n: snapped to its edge's level on an edge.
+// Geomorphing: how far a factor is into its level, 0 just past level − 1 to 1 at the level.
+fn morph_fraction(factor: f32, level: u32) -> f32 {
+    return clamp(factor - f32(level) + 1.0, 0.0, 1.0);
+}
+
+// Where point m of `level` equal parts lies (0–1) when the factor is `phi` into that level: at
+// phi = 1 at m / level; at phi = 0 on the level − 1 points, those up to the middle keeping their
+// number and those past it taking the one before, so the two middle points start as one — the
+// vertices glide instead of popping as the factor grows, and the new triangles start with no
+// area. Edges are always walked from their lower vertex, so both patches agree. Mirrored by
+// `reference::morphed`.
+fn morphed(m: u32, level: u32, phi: f32) -> f32 {
+    let exact = f32(m) / f32(level);
+    if level <= 1u {
+        return exact;
+    }
+    let coarse = f32(level - 1u);
+    let parent = select(f32(m - 1u), f32(m), 2u * m <= level) / coarse;
+    return mix(parent, exact, phi);
+}
+
+// UV of lattice point (i, j) of a patch of level n: snapped to its edge's level on an edge, and
+// geomorphed by the edge's (or, inside, the patch's) fractional factor.
 fn lattice_uv(t: Patch, n: u32, i: u32, j: u32) -> vec2<f32> {
     // Corners are the patch's vertices, exactly.
     if i == 0u && j == 0u {
@@ -262,7 +286,8 @@ fn lattice_uv(t: Patch, n: u32, i: u32, j: u32) -> vec2<f32> {
     if k < 3u {
         let start = t.v[k];
         let end = t.v[(k + 1u) % 3u];
-        let e = level_of(factors_in[t.e[k]]);
+        let f = factors_in[t.e[k]];
+        let e = level_of(f);
         // The canonical direction (lower vertex first), then the edge's own subdivision:
         // m = round(along · e / n) in integers, the same from both patches of the edge.
         var s = along;
@@ -274,10 +299,14 @@ fn lattice_uv(t: Patch, n: u32, i: u32, j: u32) -> vec2<f32> {
             b = start;
         }
         let m = (2u * s * e + n) / (2u * n);
-        return mix(base_uv(a), base_uv(b), f32(m) / f32(e));
+        return mix(base_uv(a), base_uv(b), morphed(m, e, morph_fraction(f, e)));
     }
-    let w1 = f32(i) / f32(n);
-    let w2 = f32(j) / f32(n);
+    // The patch's own factor: the larger of the mean (the book's inside factor) and the edges,
+    // whose ceiling is n.
+    let f = vec3<f32>(factors_in[t.e[0]], factors_in[t.e[1]], factors_in[t.e[2]]);
+    let phi = morph_fraction(max((f.x + f.y + f.z) / 3.0, max(f.x, max(f.y, f.z))), n);
+    let w1 = morphed(i, n, phi);
+    let w2 = morphed(j, n, phi);
     return base_uv(t.v[0]) * (1.0 - w1 - w2) + base_uv(t.v[1]) * w1 + base_uv(t.v[2]) * w2;
 }
 

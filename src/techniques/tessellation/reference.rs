@@ -87,3 +87,57 @@ pub fn patch_level(u: &TessUniforms, factors: &[f32], p: u32) -> u32 {
     let inside = ((f[0] + f[1] + f[2]) / 3.0).ceil() as u32;
     f.iter().map(|x| x.ceil() as u32).fold(inside, u32::max)
 }
+
+/// Where point `m` of `level` equal parts lies (0–1) when the factor is `phi` (0–1) into that
+/// level — the geomorph of `shaders/tessellation.wgsl`'s `morphed`: at `phi` = 1 the even
+/// subdivision, at 0 the points of `level` − 1 parts (up to the middle they keep their number,
+/// past it they take the one before: the two middle points start as one).
+pub fn morphed(m: u32, level: u32, phi: f32) -> f32 {
+    let exact = m as f32 / level as f32;
+    if level <= 1 {
+        return exact;
+    }
+    let coarse = (level - 1) as f32;
+    let parent = if 2 * m <= level { m as f32 } else { (m - 1) as f32 } / coarse;
+    parent + (exact - parent) * phi
+}
+
+/// How far `factor` is into its level (`level` = ⌈factor⌉), 0–1.
+pub fn morph_fraction(factor: f32, level: u32) -> f32 {
+    (factor - level as f32 + 1.0).clamp(0.0, 1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The points of an edge at `factor`, sorted.
+    fn points(factor: f32) -> Vec<f32> {
+        let level = factor.ceil() as u32;
+        let phi = morph_fraction(factor, level);
+        let mut p: Vec<f32> = (0..=level).map(|m| morphed(m, level, phi)).collect();
+        p.sort_by(f32::total_cmp);
+        p
+    }
+
+    #[test]
+    fn geomorphed_points_glide_across_every_level_change_and_stay_ordered() {
+        for level in 1..64u32 {
+            let just_past = points(level as f32 + 1e-4);
+            let at = points(level as f32);
+            // Crossing the level adds one point, on top of an old one: nothing jumps.
+            assert_eq!(just_past.len(), at.len() + 1);
+            for q in &just_past {
+                let nearest = at.iter().map(|a| (a - q).abs()).fold(f32::MAX, f32::min);
+                assert!(nearest < 1e-3, "level {level}: {q} appeared from nowhere ({just_past:?} vs {at:?})");
+            }
+            // At any fraction: from 0 to 1 and in order (no triangle folds over).
+            for phi in [0.0, 0.3, 0.7, 1.0] {
+                let n = level + 1;
+                let p: Vec<f32> = (0..=n).map(|m| morphed(m, n, phi)).collect();
+                assert_eq!((p[0], p[n as usize]), (0.0, 1.0));
+                assert!(p.windows(2).all(|w| w[0] <= w[1]), "level {n}, phi {phi}: {p:?}");
+            }
+        }
+    }
+}
