@@ -9,7 +9,7 @@ use std::process::Command;
 
 use common::{indra, text};
 
-use indra::control::audio::{Analyzer, AudioFile};
+use indra::control::audio::{AudioFile, analyse_file};
 
 const RATE: u32 = 48_000;
 
@@ -47,12 +47,9 @@ fn a_beat_gives_onsets_on_the_beat_bass_in_the_low_band_and_its_tempo() {
     let file = AudioFile::open(&path).unwrap();
     assert_eq!(file.rate, RATE);
     assert!((file.seconds() - 10.0).abs() < 1e-3);
-    let mut analyzer = Analyzer::new(file.rate);
-    let dt = 1.0 / 60.0;
+    let frames = analyse_file(&file, 600, 1.0 / 60.0);
     let mut onsets = Vec::new();
-    let mut last = None;
-    for f in 0..600u64 {
-        let frame = analyzer.frame(file.hop(f, dt), (f + 1) as f64 * dt);
+    for (f, frame) in (0u64..).zip(&frames) {
         if frame.onset {
             onsets.push(f);
         }
@@ -64,14 +61,13 @@ fn a_beat_gives_onsets_on_the_beat_bass_in_the_low_band_and_its_tempo() {
                 frame.high
             );
         }
-        last = Some(frame);
     }
     // A kick every 30 frames, found within a frame of where it starts.
     assert!((19..=20).contains(&onsets.len()), "{onsets:?}");
     for f in &onsets {
         assert!(f % 30 <= 1 || f % 30 == 29, "onset at frame {f}: {onsets:?}");
     }
-    let bpm = last.unwrap().bpm.expect("a tempo after 10 s");
+    let bpm = frames.last().unwrap().bpm.expect("a tempo after 10 s");
     assert!((bpm - 120.0).abs() < 1.0, "{bpm}");
 }
 
@@ -162,8 +158,7 @@ fn other_formats_are_decoded_by_ffmpeg_to_the_same_sound() {
             let worst = file.samples.iter().zip(&reference.samples).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
             assert!(worst < 1e-4, "flac is lossless: off by {worst}");
         }
-        let mut analyzer = Analyzer::new(file.rate);
-        let frames: Vec<_> = (0..360).map(|f| analyzer.frame(file.hop(f, 1.0 / 60.0), (f + 1) as f64 / 60.0)).collect();
+        let frames = analyse_file(&file, 360, 1.0 / 60.0);
         let bpm = frames.last().unwrap().bpm.expect("a tempo after 6 s");
         assert!((bpm - 120.0).abs() < 1.0, "{ext}: {bpm}");
     }
@@ -173,8 +168,7 @@ fn other_formats_are_decoded_by_ffmpeg_to_the_same_sound() {
 fn the_bundled_loop_has_its_tempo_and_drives_kleinian_audio_to_its_goldens() {
     let wav = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/audio/demo-beat.wav");
     let file = AudioFile::open(Path::new(wav)).unwrap();
-    let mut analyzer = Analyzer::new(file.rate);
-    let frames: Vec<_> = (0..480).map(|f| analyzer.frame(file.hop(f, 1.0 / 60.0), (f + 1) as f64 / 60.0)).collect();
+    let frames = analyse_file(&file, 480, 1.0 / 60.0);
     assert!((frames[479].bpm.expect("a tempo after 8 s") - 120.0).abs() < 1.0);
     // Once the tempo is heard: a beat every 30 frames, on the kicks.
     let beats: Vec<usize> = (300..480).filter(|&f| frames[f].beat).collect();

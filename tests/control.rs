@@ -133,16 +133,16 @@ fn audio_learn_maps_a_source_and_persists() {
     let inst = instance(&gpu, &s);
     let mut h = hub(&dir, &s);
     let scale = s.nodes[0].params.index("scale").unwrap();
-    assert_eq!(h.audio_mapped(0, scale, &s), (false, false));
+    assert_eq!(h.audio_mapped(0, scale), (false, false));
     h.learn_audio(Target { node: 0, param: scale, component: None }, indra::scene::AudioSource::Beat, &inst);
-    assert_eq!(h.audio_mapped(0, scale, &s), (true, true));
+    assert_eq!(h.audio_mapped(0, scale), (true, true));
     let saved = std::fs::read_to_string(dir.join("audio-learn.ron")).unwrap();
     assert!(saved.contains("Beat") && saved.contains("\"k.scale\""), "{saved}");
     // A new session has it; unlearning persists too.
     let mut again = hub(&dir, &s);
-    assert_eq!(again.audio_mapped(0, scale, &s), (true, true));
+    assert_eq!(again.audio_mapped(0, scale), (true, true));
     again.unlearn_audio(0, scale, &s);
-    assert_eq!(hub(&dir, &s).audio_mapped(0, scale, &s), (false, false));
+    assert_eq!(hub(&dir, &s).audio_mapped(0, scale), (false, false));
 }
 
 fn instance(gpu: &indra::gpu::Gpu, s: &Scene) -> SceneInstance {

@@ -7,7 +7,7 @@ mod common;
 use std::net::UdpSocket;
 use std::time::{Duration, Instant, SystemTime};
 
-use indra::control::feedback::OscFeedback;
+use indra::control::feedback::{OscFeedback, ParamChanges};
 use indra::control::osc::{OscReceiver, OscRouter, Routed, decode};
 use indra::control::oscquery::OscQueryServer;
 use indra::params::ParamValue;
@@ -305,9 +305,10 @@ fn feedback_sends_changed_values_to_the_controller() {
     let mut instance = SceneInstance::new(&gpu, &common::assets(), scene("kleinian"), (32, 32)).unwrap();
     let listener = UdpSocket::bind("127.0.0.1:0").unwrap();
     listener.set_read_timeout(Some(Duration::from_secs(2))).unwrap();
-    let mut feedback = OscFeedback::connect(&listener.local_addr().unwrap().to_string()).unwrap();
-    assert_eq!(feedback.send_changes(&instance), 10, "everything once at first");
-    assert_eq!(feedback.send_changes(&instance), 0, "nothing changed");
+    let feedback = OscFeedback::connect(&listener.local_addr().unwrap().to_string()).unwrap();
+    let mut changes = ParamChanges::default();
+    assert_eq!(feedback.send(&changes.collect(&instance)), 10, "everything once at first");
+    assert_eq!(feedback.send(&changes.collect(&instance)), 0, "nothing changed");
     let mut buf = [0u8; 1024];
     for _ in 0..10 {
         listener.recv(&mut buf).unwrap();
@@ -321,7 +322,7 @@ fn feedback_sends_changed_values_to_the_controller() {
         source: indra::params::Source::Midi,
     };
     instance.apply(&[ControlEvent::Write(write)]);
-    assert_eq!(feedback.send_changes(&instance), 1);
+    assert_eq!(feedback.send(&changes.collect(&instance)), 1);
     let n = listener.recv(&mut buf).unwrap();
     let (_, packet) = rosc::decoder::decode_udp(&buf[..n]).unwrap();
     assert_eq!(
@@ -554,6 +555,7 @@ fn oscquery_listen_sends_changes_of_listened_values_over_a_websocket() {
     let gpu = common::gpu();
     let mut instance = SceneInstance::new(&gpu, &common::assets(), scene("kleinian"), (32, 32)).unwrap();
     let mut server = OscQueryServer::start("127.0.0.1:0", 9000).unwrap();
+    let mut changes = ParamChanges::default();
     let (_, info) = http_get(server.local_addr(), "/?HOST_INFO");
     assert_eq!(info["EXTENSIONS"]["LISTEN"], true);
     let (mut socket, _) = tungstenite::connect(format!("ws://{}/", server.local_addr())).unwrap();
@@ -563,7 +565,7 @@ fn oscquery_listen_sends_changes_of_listened_values_over_a_websocket() {
     let heard = loop {
         assert!(started.elapsed() < Duration::from_secs(5), "no change arrived");
         set(&mut instance, "scale", ParamValue::Float(2.0 + started.elapsed().as_secs_f32()));
-        server.after_frame(&instance, false);
+        server.after_frame(&instance, false, &changes.collect(&instance));
         if let Some(Message::Binary(bytes)) = next_message(&mut socket, Duration::from_millis(50)) {
             break rosc::decoder::decode_udp(&bytes).unwrap().1;
         }
@@ -574,16 +576,20 @@ fn oscquery_listen_sends_changes_of_listened_values_over_a_websocket() {
     // A value nobody listens to is not sent.
     while next_message(&mut socket, Duration::from_millis(100)).is_some() {}
     set(&mut instance, "iterations", ParamValue::Int(7));
-    assert_eq!(server.after_frame(&instance, false), 0, "iterations changed, but nobody listens to it");
+    assert_eq!(
+        server.after_frame(&instance, false, &changes.collect(&instance)),
+        0,
+        "iterations changed, but nobody listens to it"
+    );
     // After IGNORE, nothing more.
     socket.send(Message::text(r#"{"COMMAND":"IGNORE","DATA":"/indra/limit_set/scale"}"#)).unwrap();
     std::thread::sleep(Duration::from_millis(300));
     set(&mut instance, "scale", ParamValue::Float(1.5));
-    assert_eq!(server.after_frame(&instance, false), 0, "ignored");
+    assert_eq!(server.after_frame(&instance, false, &changes.collect(&instance)), 0, "ignored");
     assert!(next_message(&mut socket, Duration::from_millis(200)).is_none());
     // A new scene is announced once its tree is published.
     server.scene_changed();
-    server.after_frame(&instance, false);
+    server.after_frame(&instance, false, &changes.collect(&instance));
     let Some(Message::Text(text)) = next_message(&mut socket, Duration::from_secs(2)) else {
         panic!("no PATH_CHANGED")
     };

@@ -4,7 +4,7 @@
 use crate::control::ControlHub;
 use crate::graph::{FrameStats, PassTiming};
 use crate::params::{ControlEvent, Target};
-use crate::params::{ParamDecl, ParamType, ParamValue, ParamWrite, Source};
+use crate::params::{ParamDecl, ParamValue, ParamWrite, Source};
 use crate::scene::{AUDIO_BANDS, AudioSource, SceneInstance};
 use crate::time::FrameTime;
 
@@ -258,8 +258,7 @@ fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub
                         if learn.secondary_clicked() {
                             hub.unlearn(node, p, instance.scene());
                         }
-                        if matches!(decl.ty(), ParamType::Float | ParamType::Int | ParamType::Bool | ParamType::Trigger)
-                        {
+                        if decl.ty().is_scalar() {
                             audio_learn_button(ui, instance, hub, target);
                         }
                         let label = ui.label(&decl.name).on_hover_text(&decl.doc);
@@ -284,18 +283,19 @@ fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub
 /// scene), "A*" when the mapping was learned here.
 fn audio_learn_button(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub, target: Target) {
     let scene = instance.scene();
-    let (mapped, learned) = hub.audio_mapped(target.node, target.param, scene);
+    let (mapped, learned) = hub.audio_mapped(target.node, target.param);
     let mark = match (mapped, learned) {
         (_, true) => "A*",
         (true, false) => "A",
         _ => "a",
     };
-    let frame = hub.audio_frame.clone().unwrap_or_default();
     let mut picked = None;
     let menu = ui.menu_button(mark, |ui| {
+        // Read only while the menu is open: this button is drawn for every parameter each frame.
         if hub.audio_frame.is_none() {
             ui.small("no sound heard yet (an input opens once something is mapped, unless --no-audio)");
         }
+        let frame = hub.audio_frame.clone().unwrap_or_default();
         let pulse = |on: bool| if on { "HIT" } else { "-" };
         let band = |b: usize| frame.bands.get(b).copied().unwrap_or(0.0);
         let mut sources = vec![

@@ -28,13 +28,15 @@ impl Advertisement {
         }
         let daemon = ServiceDaemon::new().map_err(|e| format!("cannot start mDNS: {e}"))?;
         let host = format!("{}.local.", host_name());
+        // Bound to all addresses: every interface's, found by mdns-sd; else the one bound.
+        let every = http.ip().is_unspecified();
+        let ip = if every { String::new() } else { http.ip().to_string() };
         let mut names = Vec::new();
         let mut services = vec![(OSCQUERY_SERVICE, http.port())];
         if osc_port != 0 {
             services.push((OSC_SERVICE, osc_port));
         }
         for (service, port) in services {
-            let ip = if http.ip().is_unspecified() { String::new() } else { http.ip().to_string() };
             let info = ServiceInfo::new(
                 service,
                 name,
@@ -44,7 +46,7 @@ impl Advertisement {
                 None::<std::collections::HashMap<String, String>>,
             )
             .map_err(|e| format!("cannot describe {service} for mDNS: {e}"))?;
-            let info = if http.ip().is_unspecified() { info.enable_addr_auto() } else { info };
+            let info = if every { info.enable_addr_auto() } else { info };
             names.push(info.get_fullname().to_string());
             daemon.register(info).map_err(|e| format!("cannot advertise {service} over mDNS: {e}"))?;
         }

@@ -1,5 +1,6 @@
 //! OSC out: after each frame, every parameter whose value changed (from any source — UI, MIDI,
-//! tracks, presets) is sent to the controller, so its faders follow.
+//! tracks, presets) is sent to the controller, so its faders follow. [`ParamChanges`] finds the
+//! changes once per frame for every receiver (this, and OSCQuery's LISTEN).
 
 use std::collections::HashMap;
 use std::net::{SocketAddr, ToSocketAddrs, UdpSocket};
@@ -11,7 +12,7 @@ use crate::params::ParamValue;
 use crate::scene::SceneInstance;
 
 /// Which parameter values changed since they were last seen, as the OSC messages that carry
-/// them (triggers have no value and never appear). Shared by OSC feedback and OSCQuery LISTEN.
+/// them (triggers have no value and never appear).
 #[derive(Default)]
 pub struct ParamChanges {
     last: HashMap<(usize, usize), ParamValue>,
@@ -52,7 +53,6 @@ impl ParamChanges {
 pub struct OscFeedback {
     socket: UdpSocket,
     target: SocketAddr,
-    changes: ParamChanges,
 }
 
 impl OscFeedback {
@@ -65,19 +65,14 @@ impl OscFeedback {
             .ok_or_else(|| format!("OSC output {target} resolves to no address"))?;
         let bind = if target.is_ipv4() { "0.0.0.0:0" } else { "[::]:0" };
         let socket = UdpSocket::bind(bind).map_err(|e| format!("cannot open a UDP socket for OSC output: {e}"))?;
-        Ok(Self { socket, target, changes: ParamChanges::default() })
+        Ok(Self { socket, target })
     }
 
-    /// Forgets what was sent (after a scene change: everything is sent again).
-    pub fn reset(&mut self) {
-        self.changes.reset();
-    }
-
-    /// Sends every parameter whose value differs from the last one sent; returns how many.
-    pub fn send_changes(&mut self, instance: &SceneInstance) -> usize {
+    /// Sends `messages` (a frame's changes); returns how many went out.
+    pub fn send(&self, messages: &[OscMessage]) -> usize {
         let mut sent = 0;
-        for message in self.changes.collect(instance) {
-            if let Ok(bytes) = rosc::encoder::encode(&OscPacket::Message(message))
+        for message in messages {
+            if let Ok(bytes) = rosc::encoder::encode(&OscPacket::Message(message.clone()))
                 && self.socket.send_to(&bytes, self.target).is_ok()
             {
                 sent += 1;

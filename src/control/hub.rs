@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::SystemTime;
 
 use super::audio::{AudioFrame, AudioLearn, AudioMapper};
-use super::feedback::OscFeedback;
+use super::feedback::{OscFeedback, ParamChanges};
 use super::midi::{LearnStore, MidiInput, MidiMapper, MidiParser};
 use super::osc::{OscReceiver, OscRouter, RecordRequest, Routed};
 use super::oscquery::OscQueryServer;
@@ -68,6 +68,8 @@ pub struct ControlHub {
     pub osc: Option<OscReceiver>,
     router: OscRouter,
     feedback: Option<OscFeedback>,
+    /// What changed since the last frame, for feedback and OSCQuery LISTEN.
+    changes: ParamChanges,
     /// OSCQuery server, if open.
     pub oscquery: Option<OscQueryServer>,
     midi: Option<MidiInput>,
@@ -151,6 +153,7 @@ impl ControlHub {
             osc,
             router: OscRouter::new(scene),
             feedback,
+            changes: ParamChanges::default(),
             oscquery,
             midi,
             parser: MidiParser::default(),
@@ -185,9 +188,8 @@ impl ControlHub {
             Some(remap) => remap.target(t),
             None => scene.nodes.get(t.node).filter(|n| t.param < n.params.decls().len()).map(|_| t),
         });
-        if let Some(f) = self.feedback.as_mut() {
-            f.reset();
-        }
+        // Everything counts as changed: controllers get the new scene's values.
+        self.changes.reset();
         if let Some(q) = self.oscquery.as_mut() {
             q.scene_changed();
         }
@@ -263,8 +265,8 @@ impl ControlHub {
     }
 
     /// Whether audio moves a parameter (a scene or a learned mapping), and whether it was learned.
-    pub fn audio_mapped(&self, node: usize, param: usize, scene: &Scene) -> (bool, bool) {
-        (self.audio_mapper.maps(node, param), self.audio_learn.is_learned(scene, node, param))
+    pub fn audio_mapped(&self, node: usize, param: usize) -> (bool, bool) {
+        self.audio_mapper.maps(node, param)
     }
 
     /// A tap of tap tempo now (key T, the panel's button): the event that sets the tempo, from
@@ -352,11 +354,14 @@ impl ControlHub {
     /// After a frame: sends changed values to the OSC feedback target and to OSCQuery listeners,
     /// and refreshes the OSCQuery tree (every 6th frame: clients poll far slower than that).
     pub fn after_frame(&mut self, instance: &SceneInstance) {
-        if let Some(f) = self.feedback.as_mut() {
-            f.send_changes(instance);
+        // The changes are found once, and only when someone receives them.
+        let listening = self.oscquery.as_ref().is_some_and(OscQueryServer::listening);
+        let changes = if self.feedback.is_some() || listening { self.changes.collect(instance) } else { Vec::new() };
+        if let Some(f) = self.feedback.as_ref() {
+            f.send(&changes);
         }
         if let Some(q) = self.oscquery.as_mut() {
-            q.after_frame(instance, self.frame_count.is_multiple_of(6));
+            q.after_frame(instance, self.frame_count.is_multiple_of(6), &changes);
         }
         if self.frame_count.is_multiple_of(PRESET_RESCAN_FRAMES) {
             self.preset_names = self.presets.names();
@@ -378,6 +383,9 @@ impl ControlHub {
             Some(m) if !m.ports.is_empty() => parts.push(format!("MIDI: {}", m.ports.join(", "))),
             _ if !super::midi::BUILT_IN => parts.push("MIDI: not built in (--no-default-features)".into()),
             _ => parts.push("MIDI: none".into()),
+        }
+        if let Some(dropped) = self.oscquery.as_ref().map(OscQueryServer::dropped).filter(|&d| d > 0) {
+            parts.push(format!("OSCQuery LISTEN: {dropped} changes dropped (a controller fell behind)"));
         }
         #[cfg(feature = "link")]
         if let Some(link) = &self.link {

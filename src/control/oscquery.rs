@@ -6,11 +6,11 @@
 
 use std::sync::{Arc, RwLock};
 
+use rosc::OscMessage;
 use serde_json::{Map, Value, json};
 
 use super::address::param_address;
 use super::discovery::Advertisement;
-use super::feedback::ParamChanges;
 use super::http::{HttpServer, Routes};
 use super::listen::Listeners;
 use crate::params::{ParamDecl, ParamType, ParamValue};
@@ -102,7 +102,6 @@ pub fn subtree<'a>(tree: &'a Value, path: &str) -> Option<&'a Value> {
 pub struct OscQueryServer {
     snapshot: Arc<RwLock<Value>>,
     listeners: Arc<Listeners>,
-    changes: ParamChanges,
     /// The scene changed: publish and announce it after the next frame.
     path_changed: bool,
     server: HttpServer,
@@ -146,14 +145,7 @@ impl OscQueryServer {
                 None
             }
         };
-        Ok(Self {
-            snapshot,
-            listeners,
-            changes: ParamChanges::default(),
-            path_changed: false,
-            server,
-            _advertisement: advertisement,
-        })
+        Ok(Self { snapshot, listeners, path_changed: false, server, _advertisement: advertisement })
     }
 
     /// The bound address.
@@ -169,24 +161,28 @@ impl OscQueryServer {
         }
     }
 
+    /// Whether a controller is connected for LISTEN.
+    pub fn listening(&self) -> bool {
+        self.listeners.any()
+    }
+
     /// After a frame: publishes the tree when `publish` asks (or the scene changed, which is
-    /// then announced to listening controllers) and queues the values that changed for the
-    /// controllers listening to them. Returns how many messages were queued.
-    pub fn after_frame(&mut self, instance: &SceneInstance, publish: bool) -> usize {
+    /// then announced to listening controllers) and queues `changes` (the frame's, see
+    /// [`super::feedback::ParamChanges`]) for the controllers listening to them. Returns how many
+    /// messages were queued.
+    pub fn after_frame(&mut self, instance: &SceneInstance, publish: bool, changes: &[OscMessage]) -> usize {
         if publish || self.path_changed {
             self.publish(instance);
         }
         if std::mem::take(&mut self.path_changed) {
             self.listeners.path_changed("/indra");
         }
-        let messages = self.changes.collect(instance);
-        if messages.is_empty() || !self.listeners.any() { 0 } else { self.listeners.send(&messages) }
+        if changes.is_empty() { 0 } else { self.listeners.send(changes) }
     }
 
-    /// A new scene: every value counts as changed, and the namespace change is announced after
-    /// the next frame, once the new tree is published.
+    /// A new scene: the namespace change is announced after the next frame, once the new tree is
+    /// published.
     pub fn scene_changed(&mut self) {
-        self.changes.reset();
         self.path_changed = true;
     }
 

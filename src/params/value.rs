@@ -28,6 +28,12 @@ pub enum ParamType {
 }
 
 impl ParamType {
+    /// A number, a bool or a trigger: one value a level can drive (an audio mapping's whole
+    /// target; enums and text are not).
+    pub fn is_scalar(self) -> bool {
+        matches!(self, ParamType::Float | ParamType::Int | ParamType::Bool | ParamType::Trigger)
+    }
+
     /// Number of float components.
     pub fn components(self) -> usize {
         match self {

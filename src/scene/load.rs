@@ -78,9 +78,7 @@ type ControlMaps = (Vec<(String, Target)>, Vec<(MidiMapping, Target)>);
 /// a band that does not exist, a range or time that is not a number).
 pub fn check_audio(nodes: &[SceneNode], a: &super::schema::AudioFile, target: Target) -> Result<AudioMapping, String> {
     let ty = nodes[target.node].params.decls()[target.param].ty();
-    let fits = target.component.is_some()
-        || matches!(ty, ParamType::Float | ParamType::Int | ParamType::Bool | ParamType::Trigger);
-    if !fits {
+    if !(target.component.is_some() || ty.is_scalar()) {
         return Err(format!("'{}' is a {ty}: name a number, a bool, a trigger or one component", a.target));
     }
     if matches!(a.source, AudioSource::Band(b) if usize::from(b) >= AUDIO_BANDS) {

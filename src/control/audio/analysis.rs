@@ -228,11 +228,14 @@ impl Analyzer {
             }
             values.iter().zip(&values[lag..]).map(|(a, b)| a * b).sum::<f32>() / (n - lag) as f32
         };
-        // A period that is not a whole number of frames splits its match over two lags.
-        let near = |lag: usize| matched(lag.saturating_sub(1)).max(matched(lag)).max(matched(lag + 1));
         // Beat periods from 1/3 s (180 bpm) to 1 s (60 bpm), in frames.
         let (min_lag, max_lag) =
             ((60.0 / TEMPO_BPM.1 / frame).ceil() as usize, (60.0 / TEMPO_BPM.0 / frame).floor() as usize);
+        // Every lag the search below looks at, matched once (this runs every frame).
+        let table: Vec<f32> = (0..=max_lag + 2).map(matched).collect();
+        let at = |lag: usize| table.get(lag).copied().unwrap_or_else(|| matched(lag));
+        // A period that is not a whole number of frames splits its match over two lags.
+        let near = |lag: usize| at(lag.saturating_sub(1)).max(at(lag)).max(at(lag + 1));
         // A pulse matches itself at every multiple of its period too. A tempo prior (an
         // octave-wide log-normal around 120 bpm, as in Ellis's beat tracker) leans to the middle,
         // and a lag whose half matches well is taken at its half.
@@ -241,12 +244,14 @@ impl Analyzer {
             (-0.5 * octaves * octaves).exp() as f32
         };
         let best = (min_lag.max(1)..=max_lag.min(n - 1))
-            .max_by(|&a, &b| (near(a) * prior(a)).total_cmp(&(near(b) * prior(b))))?;
+            .map(|lag| (lag, near(lag) * prior(lag)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))?
+            .0;
         if near(best) <= 0.0 {
             return None;
         }
         // The prior must not pull the period off its own peak within the tolerance.
-        let best = (best.saturating_sub(1).max(1)..=best + 1).max_by(|&a, &b| matched(a).total_cmp(&matched(b)))?;
+        let best = (best.saturating_sub(1).max(1)..=best + 1).max_by(|&a, &b| at(a).total_cmp(&at(b)))?;
         let half = best / 2;
         let mut period = best as f64;
         if half + 1 >= min_lag && near(half).max(near(half + 1)) >= 0.5 * near(best) {
@@ -258,8 +263,10 @@ impl Analyzer {
         let around = (k * period).round() as usize;
         let reach = (k / 2.0).ceil() as usize + 1;
         let peak = (around.saturating_sub(reach).max(1)..=(around + reach).min(n - 2))
-            .max_by(|&a, &b| matched(a).total_cmp(&matched(b)))?;
-        let (l, c, r) = (matched(peak - 1), matched(peak), matched(peak + 1));
+            .map(|lag| (lag, at(lag)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))?
+            .0;
+        let (l, c, r) = (at(peak - 1), at(peak), at(peak + 1));
         let curvature = l - 2.0 * c + r;
         let offset = if curvature < 0.0 { (0.5 * (l - r) / curvature).clamp(-0.5, 0.5) } else { 0.0 };
         let refined = (peak as f64 + f64::from(offset)) / k;

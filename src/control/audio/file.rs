@@ -20,24 +20,11 @@ impl AudioFile {
     /// Reads a WAV file, or has ffmpeg decode any other; every failure is one sentence naming the
     /// file.
     pub fn open(path: &Path) -> Result<Self, String> {
-        let name = path.display();
-        let reader = match hound::WavReader::open(path) {
-            Ok(reader) => reader,
-            Err(hound::Error::IoError(io)) => return Err(format!("cannot read audio file {name}: {io}")),
-            Err(_) => return decode_with_ffmpeg(path),
-        };
-        let spec = reader.spec();
-        let channels = usize::from(spec.channels.max(1));
-        let interleaved: Vec<f32> = match spec.sample_format {
-            hound::SampleFormat::Float => reader.into_samples::<f32>().collect::<Result<_, _>>(),
-            hound::SampleFormat::Int => {
-                let scale = 1.0 / (1i64 << (spec.bits_per_sample.clamp(1, 32) - 1)) as f32;
-                reader.into_samples::<i32>().map(|s| s.map(|v| v as f32 * scale)).collect::<Result<_, _>>()
-            }
+        match hound::WavReader::open(path) {
+            Ok(reader) => read_wav(reader).map_err(|e| format!("{}: {e}", path.display())),
+            Err(hound::Error::IoError(io)) => Err(format!("cannot read audio file {}: {io}", path.display())),
+            Err(_) => decode_with_ffmpeg(path),
         }
-        .map_err(|e| format!("{name}: damaged audio data ({e})"))?;
-        let samples = interleaved.chunks(channels).map(|c| c.iter().sum::<f32>() / channels as f32).collect();
-        Ok(Self { rate: spec.sample_rate, samples })
     }
 
     /// Seconds of audio.
@@ -51,6 +38,23 @@ impl AudioFile {
         let at = |f: u64| ((f as f64 * dt * f64::from(self.rate)).round() as usize).min(self.samples.len());
         &self.samples[at(frame)..at(frame + 1)]
     }
+}
+
+/// The samples of an open WAV file (8–32-bit integer or float), mixed to mono by the mean of
+/// the channels; a damaged file says why.
+fn read_wav<R: std::io::Read>(reader: hound::WavReader<R>) -> Result<AudioFile, String> {
+    let spec = reader.spec();
+    let channels = usize::from(spec.channels.max(1));
+    let interleaved: Vec<f32> = match spec.sample_format {
+        hound::SampleFormat::Float => reader.into_samples::<f32>().collect::<Result<_, _>>(),
+        hound::SampleFormat::Int => {
+            let scale = 1.0 / (1i64 << (spec.bits_per_sample.clamp(1, 32) - 1)) as f32;
+            reader.into_samples::<i32>().map(|s| s.map(|v| v as f32 * scale)).collect::<Result<_, _>>()
+        }
+    }
+    .map_err(|e| format!("damaged audio data ({e})"))?;
+    let samples = interleaved.chunks(channels).map(|c| c.iter().sum::<f32>() / channels as f32).collect();
+    Ok(AudioFile { rate: spec.sample_rate, samples })
 }
 
 /// Decodes a file that is not WAV with ffmpeg (`INDRA_FFMPEG`, as for video export, or `ffmpeg`
@@ -76,10 +80,10 @@ fn decode_with_ffmpeg(path: &Path) -> Result<AudioFile, String> {
             let last = said.lines().rev().find(|l| !l.trim().is_empty()).unwrap_or("no audio stream");
             Err(format!("{name} is neither a WAV file nor audio ffmpeg can decode ({})", last.trim()))
         }
-        Ok(_) => match hound::WavReader::open(&decoded) {
-            Ok(_) => AudioFile::open(&decoded).map_err(|e| format!("{name} (decoded by ffmpeg): {e}")),
-            Err(e) => Err(format!("{name}: ffmpeg's decoding cannot be read ({e})")),
-        },
+        Ok(_) => hound::WavReader::open(&decoded)
+            .map_err(|e| e.to_string())
+            .and_then(read_wav)
+            .map_err(|e| format!("{name}: ffmpeg's decoding cannot be read ({e})")),
     };
     let _ = std::fs::remove_file(&decoded);
     result

@@ -58,12 +58,6 @@ impl AudioLearn {
         out
     }
 
-    /// Whether `node`'s parameter `param` has a learned mapping in `scene`.
-    pub fn is_learned(&self, scene: &Scene, node: usize, param: usize) -> bool {
-        let name = target_name(scene, node, param);
-        self.entries.iter().any(|e| e.target == name)
-    }
-
     /// Maps `source` to the whole parameter `target` (replacing a learned mapping it had) and
     /// saves the file. A number sweeps from its value `now` up a quarter of its range (down, if it
     /// is at the top): silence leaves it where the performer set it. Edit the file for others.
@@ -147,7 +141,7 @@ mod tests {
         let bound = learn.bound(&fluid);
         assert_eq!(bound.len(), 1);
         assert_eq!((bound[0].source, bound[0].range), (AudioSource::Band(3), (4.0, 16.5)));
-        assert!(learn.is_learned(&fluid, 0, param));
+        assert_eq!((bound[0].target.node, bound[0].target.param), (0, param), "learned for that parameter");
         assert!(learn.bound(&other).is_empty(), "another scene's nodes are not touched");
         // A broken file is one sentence and no mappings.
         std::fs::write(&path, "[(source: Nope").unwrap();

@@ -13,6 +13,8 @@ pub use crate::scene::{AudioMapping, AudioSource};
 pub struct AudioMapper {
     mappings: Vec<AudioMapping>,
     envelopes: Vec<f32>,
+    /// Mappings from here on were learned (the scene's come first).
+    learned_from: usize,
 }
 
 impl AudioMapper {
@@ -25,12 +27,13 @@ impl AudioMapper {
     /// so a learned mapping wins where both write one parameter), at rest.
     pub fn with_learned(scene: &Scene, learned: Vec<AudioMapping>) -> Self {
         let mappings: Vec<AudioMapping> = scene.audio.iter().cloned().chain(learned).collect();
-        Self { envelopes: vec![0.0; mappings.len()], mappings }
+        Self { envelopes: vec![0.0; mappings.len()], mappings, learned_from: scene.audio.len() }
     }
 
-    /// Whether some mapping writes `node`'s parameter `param`.
-    pub fn maps(&self, node: usize, param: usize) -> bool {
-        self.mappings.iter().any(|m| m.target.node == node && m.target.param == param)
+    /// Whether some mapping writes `node`'s parameter `param`, and whether a learned one does.
+    pub fn maps(&self, node: usize, param: usize) -> (bool, bool) {
+        let writes = |m: &AudioMapping| m.target.node == node && m.target.param == param;
+        (self.mappings.iter().any(writes), self.mappings[self.learned_from..].iter().any(writes))
     }
 
     /// Whether the scene maps any audio.
