@@ -1,5 +1,5 @@
 //! earcut's fixture polygons (`tests/fixtures/earcut/`, ISC, see its NOTICE.md), read as rings
-//! or in earcut's flat layout. Shared by `tests/triangulate.rs` and `benches/triangulate.rs`.
+//! or in earcut's flat layout. Shared by `tests/suite/triangulate.rs` and `benches/triangulate.rs`.
 #![allow(dead_code)]
 
 /// One ring of [x, y] points.

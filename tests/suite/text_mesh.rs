@@ -1,7 +1,7 @@
 //! Glyph-outline scene: golden render of the default text, and a new text sent as an OSC string
 //! (`/indra/text/text`, routed by the real router) re-meshes the next frame.
 
-mod common;
+use crate::common;
 
 use indra::control::osc::{OscReceiver, OscRouter, Routed};
 use indra::offscreen::OffscreenRenderer;

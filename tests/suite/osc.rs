@@ -2,7 +2,7 @@
 //! future time tags, an external client (liblo's `oscsend`), 100,000 hostile packets, feedback
 //! out, the OSCQuery tree, its LISTEN WebSocket and its mDNS advertisement.
 
-mod common;
+use crate::common;
 
 use std::net::UdpSocket;
 use std::time::{Duration, Instant, SystemTime};

@@ -3,7 +3,7 @@
 //! rendered as the second half of a split render. Also: replayed triggers fire once each across a
 //! seek, and a trigger fires for exactly one fixed step.
 
-mod common;
+use crate::common;
 
 use indra::assets::AssetKind;
 use indra::offscreen::OffscreenRenderer;

@@ -3,7 +3,7 @@
 //! (The sampler's own invariants — minimum distance, maximality, coverage, the annulus law — are
 //! tested in `src/geometry/poisson.rs`.)
 
-mod common;
+use crate::common;
 
 use indra::offscreen::OffscreenRenderer;
 use indra::params::{ParamValue, ParamWrite, Source};

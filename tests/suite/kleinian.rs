@@ -1,9 +1,7 @@
 //! Chapter 2, Kleinian limit sets: golden renders of every scene at two times, determinism,
 //! the limit set's own symmetries, and agreement with the CPU version of the algorithm.
 
-mod common;
-
-use common::{bright, golden, render_named, render_text};
+use crate::common::{bright, golden, render_named, render_text};
 use indra::techniques::kleinian::reference::{in_limit_set, pixel_to_plane};
 
 const SIZE: (u32, u32) = (256, 256);

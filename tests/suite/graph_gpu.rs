@@ -2,7 +2,7 @@
 //! last reader has run, steady-state frames create nothing, culled passes never record, and
 //! per-pass timestamps arrive when the adapter has them.
 
-mod common;
+use crate::common;
 
 use std::cell::Cell;
 

@@ -2,7 +2,7 @@
 //! MIDI learn with its file, presets and morphs, who wins when sources collide, and a recorded
 //! control session replayed off-screen frame-exactly.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 

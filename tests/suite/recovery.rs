@@ -2,7 +2,7 @@
 //! notice it, the shader reload that caused it is rolled back, and every node moves to a new
 //! device with its parameters — through the same `live::recover` the window uses.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};

@@ -3,7 +3,7 @@
 //! a square with a square hole and a triangle island in the hole — checked by golden renders and
 //! by pixels: fill where the polygon is, black in the hole, the island filled, gone after undo.
 
-mod common;
+use crate::common;
 
 use indra::control::osc::{OscReceiver, OscRouter, Routed};
 use indra::offscreen::{OffscreenRenderer, RenderedFrame};

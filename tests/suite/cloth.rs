@@ -2,7 +2,7 @@
 //! stays rest, symmetry), one GPU substep against the CPU reference, XPBD stiffness, blow-up
 //! detection and reset, determinism, and golden renders of the three scenes.
 
-mod common;
+use crate::common;
 
 use indra::params::{ParamSet, ParamValue};
 use indra::scene::{load_scene, parse_value_override};

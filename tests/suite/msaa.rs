@@ -3,7 +3,7 @@
 //! different), `msaa: 1` turns it off, and a sample count other than 1, 2, 4 or 8 is a located
 //! scene error.
 
-mod common;
+use crate::common;
 
 use indra::scene::load_scene;
 

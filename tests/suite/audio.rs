@@ -2,12 +2,12 @@
 //! hear a WAV file exactly (twice the same bytes, sought or played), the file as a video's sound
 //! track, and bad files as one sentence.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{indra, text};
+use crate::common::{indra, text};
 
 use indra::control::audio::{AudioFile, analyse_file};
 

@@ -2,7 +2,7 @@
 //! in a closed box without sources keeps the density, diffusion keeps it exactly, and a stir
 //! along the box's midline gives a mirror-symmetric field.
 
-mod common;
+use crate::common;
 
 use indra::params::{ParamSet, ParamValue};
 use indra::techniques::grid_fluid::{self, Field, GridFluid};

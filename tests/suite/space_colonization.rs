@@ -4,7 +4,7 @@
 //! distance and no live attraction within the kill distance; the pool never overflows; two
 //! renders are the same bytes; golden renders of the scenes at two times.
 
-mod common;
+use crate::common;
 
 use indra::offscreen::OffscreenRenderer;
 use indra::params::{ParamSet, ParamValue};

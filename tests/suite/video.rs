@@ -2,11 +2,11 @@
 //! scene's frame rate, and a missing ffmpeg is one sentence. Needs `ffmpeg` and `ffprobe`
 //! (tools/setup-system installs them).
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 
-use common::text;
+use crate::common::text;
 use std::process::{Command, Output};
 
 fn indra(args: &[&str]) -> Command {

@@ -2,7 +2,7 @@
 //! keeps the last good image (the golden) and reports the error with its line; the fix brings
 //! the new version in.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};

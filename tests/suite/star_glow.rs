@@ -1,9 +1,9 @@
 //! Chapter 4, StarGlow: the streak cascade's analytic weights, the composite formulas on known
 //! pixels, book vs fused layouts, transient reuse in the frame graph, and golden renders.
 
-mod common;
+use crate::common;
 
-use common::{assets, golden, gpu, render_scene};
+use crate::common::{assets, golden, gpu, render_scene};
 use indra::gpu::Gpu;
 use indra::graph::{FrameGraph, GraphRuntime};
 use indra::params::ParamSet;

@@ -2,7 +2,7 @@
 //! device during a render, a `--set` value written as in a scene file. (A surface offering no
 //! formats is tested in `app::surface`; the window needs a display.)
 
-mod common;
+use crate::common;
 
 use indra::control::midi::LearnStore;
 use indra::control::{ControlHub, ControlOptions};

@@ -5,7 +5,7 @@
 use indra::geometry::triangulate::{Mesh2D, triangulate, triangulate_flat};
 use proptest::prelude::*;
 
-#[path = "common/earcut_fixtures.rs"]
+#[path = "../common/earcut_fixtures.rs"]
 mod earcut_fixtures;
 
 use earcut_fixtures::{Ring, fixture, flat};

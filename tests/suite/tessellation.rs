@@ -3,7 +3,7 @@
 //! patches gets exactly the same displaced points from both sides, also where their levels
 //! differ); golden renders of the three scenes at two times; a bad image path keeps the show.
 
-mod common;
+use crate::common;
 
 use std::collections::{BTreeMap, BTreeSet};
 

@@ -2,9 +2,9 @@
 //! homography says, complementary soft edges sum to the source in linear light, warp files load,
 //! save and survive a broken edit, and the bundled scene matches its golden.
 
-mod common;
+use crate::common;
 
-use common::{assets, golden, gpu, render_named};
+use crate::common::{assets, golden, gpu, render_named};
 use indra::geometry::warp::{Corners, MeshWarp, WarpFile};
 use indra::gpu::Gpu;
 use indra::graph::{FrameGraph, GraphRuntime};

@@ -1,0 +1,29 @@
+//! The integration tests, one binary: each module was its own test binary once, but every binary
+//! links all of indra, wgpu and naga (~50 MB and ~2 s of linking each), which on CI cost a gigabyte
+//! of disk and most of a minute. `cargo test --test suite kleinian::` runs one module. `cli.rs` stays
+//! apart: it also runs against the build without default features (tools/test-render-node).
+
+mod audio;
+mod cloth;
+#[path = "../common/mod.rs"]
+mod common;
+mod control;
+mod errors;
+mod graph_gpu;
+mod grid_fluid;
+mod kleinian;
+mod live;
+mod msaa;
+mod osc;
+mod poisson;
+mod polygon_draw;
+mod recovery;
+mod seek;
+mod space_colonization;
+mod star_glow;
+mod tessellation;
+mod text_mesh;
+mod triangulate;
+mod video;
+mod warp;
+mod window;
