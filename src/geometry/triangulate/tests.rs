@@ -206,6 +206,23 @@ fn a_pentagram_is_filled_whole_by_non_zero_winding() {
     assert_ccw(&mesh);
 }
 
+/// Panics if a vertex of the mesh lies strictly inside one of its triangles: for a simple ring,
+/// the sign of an ear clipped past a point that blocked it (all triangles counter-clockwise and
+/// the area exact say nothing then: signed areas always add up).
+fn assert_no_vertex_inside_a_triangle(mesh: &Mesh2D) {
+    let mut by_x: Vec<[f64; 2]> = mesh.positions.clone();
+    by_x.sort_by(|a, b| a[0].total_cmp(&b[0]));
+    for t in mesh.indices.chunks_exact(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| mesh.positions[i as usize]);
+        let (x0, x1) = (a[0].min(b[0]).min(c[0]), a[0].max(b[0]).max(c[0]));
+        let first = by_x.partition_point(|p| p[0] <= x0);
+        for &p in by_x[first..].iter().take_while(|p| p[0] < x1) {
+            let side = |u: [f64; 2], v: [f64; 2]| (v[0] - u[0]) * (p[1] - u[1]) - (v[1] - u[1]) * (p[0] - u[0]);
+            assert!(!(side(a, b) > 0.0 && side(b, c) > 0.0 && side(c, a) > 0.0), "{p:?} inside triangle {t:?}");
+        }
+    }
+}
+
 /// A star of `n` points whose spikes reach twice the inner radius: every spike's ear is long and
 /// thin, and once the spikes are cut the rest is one large convex ring.
 fn spiky_star(n: usize) -> Vec<[f64; 2]> {
@@ -225,6 +242,44 @@ fn long_spikes_and_the_convex_rest_triangulate_exactly() {
     assert_eq!(mesh.triangle_count(), 19_998);
     assert!(mesh.report.area_deviation() < 1e-12, "{}", mesh.report.area_deviation());
     assert_ccw(&mesh);
+}
+
+#[test]
+fn a_wavy_ring_whose_late_ears_pass_long_stretches_triangulates_exactly() {
+    // The late ears of a wavy ring are large, and their boxes hold long reflex stretches beside
+    // the triangle: the ear test passes over whole z-order cells of them. A cell passed over
+    // that held a blocking point would let an ear overlap the rest: the area would not match.
+    let n = 30_000;
+    let ring: Vec<[f64; 2]> = (0..n)
+        .map(|i| {
+            let t = std::f64::consts::TAU * i as f64 / n as f64;
+            let r = 1000.0 * (1.0 + 0.08 * (37.0 * t).sin() + 0.03 * (211.0 * t).cos());
+            [r * t.cos(), r * t.sin()]
+        })
+        .collect();
+    let mesh = triangulate(&[ring]).unwrap();
+    assert_eq!(mesh.triangle_count(), n - 2);
+    assert!(mesh.report.area_deviation() < 1e-12, "{}", mesh.report.area_deviation());
+    assert_ccw(&mesh);
+    assert_no_vertex_inside_a_triangle(&mesh);
+    // Rings of random radii: ears there are blocked often, by points far along the z-order.
+    let mut seed = 11u64;
+    let mut random = || {
+        seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for n in [3_000, 10_000] {
+        let ring: Vec<[f64; 2]> = (0..n)
+            .map(|i| {
+                let (t, r) = (std::f64::consts::TAU * i as f64 / n as f64, 300.0 + 700.0 * random());
+                [r * t.cos(), r * t.sin()]
+            })
+            .collect();
+        let mesh = triangulate(&[ring]).unwrap();
+        assert!(mesh.report.area_deviation() < 1e-12, "n = {n}: {}", mesh.report.area_deviation());
+        assert_ccw(&mesh);
+        assert_no_vertex_inside_a_triangle(&mesh);
+    }
 }
 
 #[test]

@@ -20,6 +20,24 @@ impl ZHash {
         Self { min_x: min[0], min_y: min[1], inv_size: if size > 0.0 { 32767.0 / size } else { 0.0 } }
     }
 
+    /// The aligned cell of 2^k × 2^k grid steps that holds code `z`, as the box of positions
+    /// whose codes fall in it (widened by one grid step each way against rounding), and the last
+    /// code of the cell. `None` for a cell on the grid's border, where positions from outside the
+    /// box are clamped to, and for a hash of no size.
+    #[inline]
+    pub fn cell(&self, z: u32, k: u32) -> Option<([f64; 2], [f64; 2], u32)> {
+        let side = 1u32 << k;
+        let (qx, qy) = (compact(z) & !(side - 1), compact(z >> 1) & !(side - 1));
+        if self.inv_size == 0.0 || qx == 0 || qy == 0 || qx + side > 32767 || qy + side > 32767 {
+            return None;
+        }
+        let step = 1.0 / self.inv_size;
+        let at = |q: u32, min: f64| min + f64::from(q) * step;
+        let lo = [at(qx - 1, self.min_x), at(qy - 1, self.min_y)];
+        let hi = [at(qx + side + 1, self.min_x), at(qy + side + 1, self.min_y)];
+        Some((lo, hi, z | ((1u32 << (2 * k)) - 1)))
+    }
+
     /// Morton code of a position (clamped, so points outside the box still order monotonically).
     #[inline]
     pub fn z(&self, x: f64, y: f64) -> u32 {
@@ -110,6 +128,16 @@ fn spread(mut v: u32) -> u32 {
     v = (v | (v << 4)) & 0x0F0F_0F0F;
     v = (v | (v << 2)) & 0x3333_3333;
     (v | (v << 1)) & 0x5555_5555
+}
+
+/// Gathers the even bits of `v` into the low 16 bits (the inverse of [`spread`]).
+#[inline]
+fn compact(mut v: u32) -> u32 {
+    v &= 0x5555_5555;
+    v = (v | (v >> 1)) & 0x3333_3333;
+    v = (v | (v >> 2)) & 0x0F0F_0F0F;
+    v = (v | (v >> 4)) & 0x00FF_00FF;
+    (v | (v >> 8)) & 0x0000_FFFF
 }
 
 /// The bits of one axis (x: even bits, y: odd bits) below `bit`, same axis as `bit`.
@@ -206,6 +234,26 @@ mod tests {
         }
         let live: Vec<usize> = (0..=10).map(|at| index.live_from(at)).collect();
         assert_eq!(live, [0, 1, 5, 5, 5, 5, 6, 8, 8, 10, 10]);
+    }
+
+    #[test]
+    fn a_cell_holds_every_position_whose_code_it_spans() {
+        let hash = ZHash::new([-3.0, 2.0], [7.0, 9.0]);
+        let mut seed = 7u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..2000 {
+            let [x, y] = [-3.0 + 10.0 * next(), 2.0 + 10.0 * next()];
+            let z = hash.z(x, y);
+            assert_eq!(spread(compact(z)) | (spread(compact(z >> 1)) << 1), z, "compact undoes spread");
+            for k in 1..15 {
+                let Some((lo, hi, end)) = hash.cell(z, k) else { continue };
+                assert!(lo[0] <= x && x <= hi[0] && lo[1] <= y && y <= hi[1], "({x}, {y}) outside its cell at k = {k}");
+                assert!(end >= z && end - z < 1 << (2 * k), "cell end {end} for code {z} at k = {k}");
+            }
+        }
     }
 
     #[test]
