@@ -112,10 +112,12 @@ impl Slicer<'_> {
         if start == NIL {
             return;
         }
-        if self.hash.is_some() {
-            // Every pass: the fallbacks' cuts can turn convex corners reflex again.
-            self.index_curve(start);
+        if self.hash.is_none() {
+            self.walk(start, pass, jobs);
+            return;
         }
+        // Every pass: the fallbacks' cuts can turn convex corners reflex again.
+        self.index_curve(start);
         let mut queue = std::mem::take(self.queue);
         queue.clear();
         let mut size = self.enqueue_ring(start, &mut queue);
@@ -152,6 +154,32 @@ impl Slicer<'_> {
             }
         }
         *self.queue = queue;
+    }
+
+    /// [`Self::slice`] for a small ring (no z-order hash), as earcut does it: round the ring from
+    /// `start`, clipping each ear met and going on two nodes further (not clipping from the same
+    /// spot again, which makes fans of slivers); a whole round without a clip hands the ring to
+    /// the fallbacks. On a few dozen nodes the queue's bookkeeping cost more than the rounds.
+    fn walk(&mut self, start: u32, pass: Pass, jobs: &mut Vec<(u32, Pass)>) {
+        let (mut ear, mut stop) = (start, start);
+        loop {
+            let (prev, next) = (self.rings.prev(ear), self.rings.next(ear));
+            if prev == next {
+                return;
+            }
+            if self.is_ear(ear) {
+                self.emit(prev, ear, next);
+                self.rings.remove(ear);
+                ear = self.rings.next(next);
+                stop = ear;
+                continue;
+            }
+            ear = next;
+            if ear == stop {
+                self.fall_back(ear, pass, jobs);
+                return;
+            }
+        }
     }
 
     /// Queues every node of the ring of `start`, in ring order; returns the ring's size.
