@@ -352,7 +352,8 @@ impl Slicer<'_> {
         self.index.build(|p| [nodes[p as usize].x, nodes[p as usize].y]);
     }
 
-    /// Where a ring crosses itself locally (a–p and p.next–b cross), cuts off triangle
+    /// Where a ring crosses itself locally (a–p and p.next–b cross properly: merely touching
+    /// edges are no crossing to cure, and cutting there made overlaps), cuts off triangle
     /// (a, p, b) and drops p and p.next. Returns a node of the ring and whether anything changed.
     fn cure_local_intersections(&mut self, start: u32) -> (u32, bool) {
         if start == NIL {
@@ -366,7 +367,7 @@ impl Slicer<'_> {
             let (a, pn) = (r.prev(p), r.next(p));
             let b = r.next(pn);
             if !r.equals(a, b)
-                && super::linked::intersects(r.get(a), r.get(p), r.get(pn), r.get(b))
+                && super::linked::crosses(r.get(a), r.get(p), r.get(pn), r.get(b))
                 && r.locally_inside(a, b)
                 && r.locally_inside(b, a)
             {

@@ -72,6 +72,13 @@ pub(super) fn intersects(p1: &Node, q1: &Node, p2: &Node, q2: &Node) -> bool {
         || (o4 == 0 && on_segment(p2, q1, q2))
 }
 
+/// Whether segments p1–q1 and p2–q2 cross at a point inside both (touching does not count).
+pub(super) fn crosses(p1: &Node, q1: &Node, p2: &Node, q2: &Node) -> bool {
+    let (o1, o2) = (sign(area(p1, q1, p2)), sign(area(p1, q1, q2)));
+    let (o3, o4) = (sign(area(p2, q2, p1)), sign(area(p2, q2, q1)));
+    o1 * o2 < 0 && o3 * o4 < 0
+}
+
 impl Rings {
     /// Forgets every node (keeps the allocation).
     pub fn clear(&mut self) {
