@@ -418,11 +418,8 @@ mod tests {
     #[test]
     fn a_cell_passed_over_holds_no_point_of_the_ear() {
         let hash = ZHash::new([0.0, 0.0], [1000.0, 1000.0]);
-        let mut seed = 5u64;
-        let mut random = || {
-            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::geometry::rng::SplitMix64::new(5);
+        let mut random = || rng.unit();
         let mut passed_over = 0;
         for _ in 0..300 {
             let mut point = || [1000.0 * random(), 1000.0 * random()];

@@ -263,11 +263,8 @@ fn a_wavy_ring_whose_late_ears_pass_long_stretches_triangulates_exactly() {
     assert_ccw(&mesh);
     assert_no_vertex_inside_a_triangle(&mesh);
     // Rings of random radii: ears there are blocked often, by points far along the z-order.
-    let mut seed = 11u64;
-    let mut random = || {
-        seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = crate::geometry::rng::SplitMix64::new(11);
+    let mut random = || rng.unit();
     for n in [3_000, 10_000] {
         let ring: Vec<[f64; 2]> = (0..n)
             .map(|i| {

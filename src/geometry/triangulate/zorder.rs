@@ -239,11 +239,8 @@ mod tests {
     #[test]
     fn a_cell_holds_every_position_whose_code_it_spans() {
         let hash = ZHash::new([-3.0, 2.0], [7.0, 9.0]);
-        let mut seed = 7u64;
-        let mut next = || {
-            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::geometry::rng::SplitMix64::new(7);
+        let mut next = || rng.unit();
         for _ in 0..2000 {
             let [x, y] = [-3.0 + 10.0 * next(), 2.0 + 10.0 * next()];
             let z = hash.z(x, y);
