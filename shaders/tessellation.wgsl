@@ -151,6 +151,12 @@ fn level_of(factor: f32) -> u32 {
     return u32(ceil(factor));
 }
 
+// A patch's factor: the larger of the mean of its edges' (the book's inside factor) and the
+// edges' own, so that its level (the ceiling) holds every edge's subdivision.
+fn patch_factor(f: vec3<f32>) -> f32 {
+    return max((f.x + f.y + f.z) / 3.0, max(f.x, max(f.y, f.z)));
+}
+
 fn outside(planes_index: u32, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, margin: f32) -> bool {
     let p = u.planes[planes_index];
     return dot(p.xyz, a) + p.w < -margin && dot(p.xyz, b) + p.w < -margin && dot(p.xyz, c) + p.w < -margin;
@@ -172,9 +178,7 @@ fn patches(@builtin(global_invocation_id) id: vec3<u32>) {
         culled = culled || outside(i, a, b, c, margin);
     }
     let f = vec3<f32>(edge_factors[t.e[0]], edge_factors[t.e[1]], edge_factors[t.e[2]]);
-    let inside = level_of((f.x + f.y + f.z) / 3.0);
-    let n = max(inside, max(level_of(f.x), max(level_of(f.y), level_of(f.z))));
-    patch_levels[p] = select(n, 0u, culled);
+    patch_levels[p] = select(level_of(patch_factor(f)), 0u, culled);
 }
 
 const SCAN_THREADS: u32 = 256u;
@@ -301,10 +305,9 @@ fn lattice_uv(t: Patch, n: u32, i: u32, j: u32) -> vec2<f32> {
         let m = (2u * s * e + n) / (2u * n);
         return mix(base_uv(a), base_uv(b), morphed(m, e, morph_fraction(f, e)));
     }
-    // The patch's own factor: the larger of the mean (the book's inside factor) and the edges,
-    // whose ceiling is n.
+    // Inside, the patch's own factor, whose level is n.
     let f = vec3<f32>(factors_in[t.e[0]], factors_in[t.e[1]], factors_in[t.e[2]]);
-    let phi = morph_fraction(max((f.x + f.y + f.z) / 3.0, max(f.x, max(f.y, f.z))), n);
+    let phi = morph_fraction(patch_factor(f), n);
     let w1 = morphed(i, n, phi);
     let w2 = morphed(j, n, phi);
     return base_uv(t.v[0]) * (1.0 - w1 - w2) + base_uv(t.v[1]) * w1 + base_uv(t.v[2]) * w2;

@@ -12,20 +12,6 @@ use std::collections::VecDeque;
 use super::linked::{NIL, Rings, area, point_in_triangle};
 use super::zorder::{ZHash, ZIndex, bigmin, code, in_box};
 
-/// The last code of the largest aligned cell (2 × 2 grid steps or more) that holds code `z` and
-/// lies wholly outside the ear, if any. Cells nest, so the first that touches the ear ends the
-/// search.
-fn outside_cell(corner: &Corner, hash: &ZHash, z: u32) -> Option<u32> {
-    let mut end = None;
-    for k in 1..15 {
-        match hash.cell(z, k) {
-            Some((lo, hi, last)) if corner.misses_box(lo, hi) => end = Some(last),
-            _ => break,
-        }
-    }
-    end
-}
-
 /// Rings with more vertices than this use the z-order hash (below it, a plain walk is faster).
 pub(super) const HASH_THRESHOLD: usize = 80;
 
@@ -51,9 +37,7 @@ impl Corner {
             && !(x == self.a[0] && y == self.a[1])
             && point_in_triangle(self.a, self.b, self.c, [x, y])
     }
-}
 
-impl Corner {
     /// Whether the whole box lies strictly outside the triangle, beyond one of its edges (the
     /// corner is counter-clockwise: inside is left of every edge).
     #[inline]
@@ -65,6 +49,20 @@ impl Corner {
             ex * (y - p[1]) - ey * (x - p[0]) < 0.0
         };
         beyond(self.a, self.b) || beyond(self.b, self.c) || beyond(self.c, self.a)
+    }
+
+    /// The last code of the largest aligned cell (2 × 2 grid steps or more) that holds code `z`
+    /// and lies wholly outside the ear, if any. Cells nest, so the first that touches the ear
+    /// ends the search.
+    fn outside_cell(&self, hash: &ZHash, z: u32) -> Option<u32> {
+        let mut end = None;
+        for k in 1..15 {
+            match hash.cell(z, k) {
+                Some((lo, hi, last)) if self.misses_box(lo, hi) => end = Some(last),
+                _ => break,
+            }
+        }
+        end
     }
 }
 
@@ -317,7 +315,7 @@ impl Slicer<'_> {
                     // the triangle: past a few such codes, a cell of them wholly outside it is
                     // passed over at once (tried for every code, cells cost small ears 10–35%).
                     if passed >= 32
-                        && let Some(end) = outside_cell(&corner, &hash, z)
+                        && let Some(end) = corner.outside_cell(&hash, z)
                     {
                         let Some(target) = (end < max_z).then(|| bigmin(end, min_z, max_z)).flatten() else {
                             return true;
@@ -454,7 +452,7 @@ mod tests {
                         "the cell holds its point"
                     );
                 }
-                let skipped = outside_cell(&corner, &hash, z);
+                let skipped = corner.outside_cell(&hash, z);
                 assert_eq!(skipped.is_some(), hash.cell(z, 1).is_some_and(|(lo, hi, _)| corner.misses_box(lo, hi)));
             }
         }
