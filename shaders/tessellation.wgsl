@@ -49,7 +49,8 @@ struct Tess {
 @group(0) @binding(1) var<storage, read_write> edge_factors: array<f32>;
 @group(0) @binding(2) var<storage, read_write> patch_levels: array<u32>;
 @group(0) @binding(3) var<storage, read_write> offsets: array<u32>;
-// vertex_count, instance_count, first_vertex, first_instance, then the triangle total.
+// vertex_count, instance_count, first_vertex, first_instance, then the triangle total, then the
+// compute rasterizer's dispatch (see `scan` and tessellation_raster.wgsl).
 @group(0) @binding(4) var<storage, read_write> draw_args: array<u32>;
 
 const MAX_LEVEL: f32 = 64.0;
@@ -222,6 +223,11 @@ fn scan(@builtin(local_invocation_id) lid: vec3<u32>) {
         draw_args[2] = 0u;
         draw_args[3] = 0u;
         draw_args[4] = total;
+        // The compute rasterizer's dispatch: 64 triangles a workgroup, at most 32768 a row.
+        let groups = (total + 63u) / 64u;
+        draw_args[5] = min(groups, 32768u);
+        draw_args[6] = (groups + 32767u) / 32768u;
+        draw_args[7] = 1u;
     }
 }
 
@@ -326,13 +332,23 @@ fn surface_at(uv: vec2<f32>) -> Surface {
     let h = height_at(uv);
     let h_u = (height_at(uv + vec2<f32>(du, 0.0)) - height_at(uv - vec2<f32>(du, 0.0))) / (2.0 * du);
     let h_v = (height_at(uv + vec2<f32>(0.0, dv)) - height_at(uv - vec2<f32>(0.0, dv))) / (2.0 * dv);
-    let n = normalize((u.model * vec4<f32>(0.0, 1.0, 0.0, 0.0)).xyz);
+    let n = plane_normal();
     let tu = (u.model * vec4<f32>(u.plane_size, 0.0, 0.0, 0.0)).xyz + n * (u.displacement * h_u);
     let tv = (u.model * vec4<f32>(0.0, 0.0, u.plane_size, 0.0)).xyz + n * (u.displacement * h_v);
     var s: Surface;
-    s.position = world_position(uv) + n * (u.displacement * h);
+    s.position = displaced(uv, h);
     s.normal = normalize(cross(tv, tu));
     return s;
+}
+
+fn plane_normal() -> vec3<f32> {
+    return normalize((u.model * vec4<f32>(0.0, 1.0, 0.0, 0.0)).xyz);
+}
+
+// The displaced position at `uv` with height h (one expression, so the compute rasterizer's
+// positions are those the vertex shader and the crack test place).
+fn displaced(uv: vec2<f32>, h: f32) -> vec3<f32> {
+    return world_position(uv) + plane_normal() * (u.displacement * h);
 }
 
 // Patch p with offsets[p] ≤ triangle < offsets[p + 1] (binary search; culled patches are empty).
@@ -361,6 +377,26 @@ fn lattice_point(q: u32, n: u32, corner: u32) -> vec2<u32> {
     let i = n - 1u - a;
     let j = n - 1u - b;
     return array<vec2<u32>, 3>(vec2<u32>(i + 1u, j), vec2<u32>(i + 1u, j + 1u), vec2<u32>(i, j + 1u))[corner];
+}
+
+// A triangle of the refined mesh: its corners' UVs and its patch's level.
+struct RefinedTriangle {
+    uv: array<vec2<f32>, 3>,
+    level: u32,
+}
+
+fn refined_triangle(triangle: u32) -> RefinedTriangle {
+    let p = find_patch(triangle);
+    let t = patch_of(p);
+    let n = levels_in[p];
+    let q = triangle - offsets_in[p];
+    var out: RefinedTriangle;
+    out.level = n;
+    for (var k = 0u; k < 3u; k++) {
+        let ij = lattice_point(q, n, k);
+        out.uv[k] = lattice_uv(t, n, ij.x, ij.y);
+    }
+    return out;
 }
 
 // ---- the crack test: every patch's boundary points, as the vertex shader places them ----
@@ -428,10 +464,12 @@ fn level_colour(level: u32) -> vec3<f32> {
     return clamp(vec3<f32>(2.0 * x - 0.5, 1.0 - abs(2.0 * x - 1.0), 1.5 - 2.0 * x), vec3<f32>(0.0), vec3<f32>(1.0));
 }
 
-@fragment
-fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
-    let view = normalize(u.camera.xyz - in.world);
-    var n = normalize(in.normal);
+// The lit colour of a surface point; `edge` is the smallest barycentric coordinate and `width`
+// its change over a pixel (the wireframe view draws a line where edge < width). Shared by the
+// fragment shader and the compute rasterizer's resolve.
+fn shade(world: vec3<f32>, normal: vec3<f32>, level: u32, edge: f32, width: f32) -> vec3<f32> {
+    let view = normalize(u.camera.xyz - world);
+    var n = normalize(normal);
     // Two-sided: a back face is lit as seen from the camera.
     if dot(n, view) < 0.0 {
         n = -n;
@@ -441,15 +479,20 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     // The book's Blinn-Phong: exponent = specular × 128, scaled by gloss; light colour white.
     var albedo = u.albedo.rgb;
     if u.view_mode == 2u {
-        albedo = level_colour(in.level);
+        albedo = level_colour(level);
     }
     let diffuse = albedo * max(dot(n, l), 0.0);
     let spec = pow(max(dot(n, h), 0.0), u.specular * 128.0) * u.gloss;
     var colour = u.light_intensity * (diffuse + u.spec_color.rgb * spec);
     if u.view_mode == 1u {
-        let edge = min(in.barycentric.x, min(in.barycentric.y, in.barycentric.z));
-        let line = 1.0 - smoothstep(0.0, 1.5 * fwidth(edge), edge);
+        let line = 1.0 - smoothstep(0.0, 1.5 * width, edge);
         colour = mix(colour, vec3<f32>(0.1, 0.55, 1.0), line);
     }
-    return vec4<f32>(colour, 1.0);
+    return colour;
+}
+
+@fragment
+fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    let edge = min(in.barycentric.x, min(in.barycentric.y, in.barycentric.z));
+    return vec4<f32>(shade(in.world, in.normal, in.level, edge, fwidth(edge)), 1.0);
 }

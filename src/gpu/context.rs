@@ -88,8 +88,14 @@ impl Gpu {
     ) -> Result<Self, GpuError> {
         let adapter = pick_adapter(&instance, options, surface).await?;
         let info = adapter.get_info();
-        // Timestamps are optional: used for per-pass timing when the adapter has them.
-        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        // Optional, used where the adapter has them: timestamps for per-pass timing; the
+        // adapter's own sample counts (8× MSAA; WebGPU guarantees only 1 and 4); 64-bit atomics
+        // for drawing in compute (the tessellation's visibility buffer).
+        let wanted = wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+            | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+            | wgpu::Features::SHADER_INT64
+            | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX;
         let required_features = adapter.features() & wanted;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {

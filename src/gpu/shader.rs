@@ -76,6 +76,45 @@ pub fn compile_wgsl(
     Ok((module, reflection))
 }
 
+/// Several shader files joined into one module's source (a shader that builds on another's
+/// functions), remembering where each file starts so that an error is reported in its own file.
+#[derive(Clone, Debug)]
+pub struct JoinedSource {
+    /// The joined text.
+    pub source: String,
+    /// Each file's origin and the joined line its first line became (1-based), in order.
+    parts: Vec<(String, u32)>,
+}
+
+impl JoinedSource {
+    /// Joins `(origin, source)` files in order.
+    pub fn new(files: &[(String, String)]) -> Self {
+        let (mut source, mut parts) = (String::new(), Vec::new());
+        for (origin, text) in files {
+            parts.push((origin.clone(), source.lines().count() as u32 + 1));
+            source.push_str(text);
+            if !text.ends_with('\n') {
+                source.push('\n');
+            }
+        }
+        Self { source, parts }
+    }
+
+    /// The origin to build with: the last file's (the one that adds the entry points).
+    pub fn origin(&self) -> &str {
+        self.parts.last().map_or("<joined>", |(origin, _)| origin)
+    }
+
+    /// `error`, located in the joined text, moved to the file and line it came from.
+    pub fn relocate(&self, mut error: ShaderError) -> ShaderError {
+        if let Some((origin, first)) = self.parts.iter().rev().find(|(_, first)| *first <= error.line) {
+            error.origin.clone_from(origin);
+            error.line = error.line - first + 1;
+        }
+        error
+    }
+}
+
 /// Runs `build` (creating modules or pipelines) inside a validation error scope: what naga
 /// accepted but wgpu did not (e.g. bindings that differ from the layout) becomes a
 /// [`ShaderError`] at `origin` instead of a panic.
@@ -91,6 +130,18 @@ pub fn validated<R>(device: &wgpu::Device, origin: &str, build: impl FnOnce() ->
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_error_in_a_joined_source_is_located_in_its_own_file() {
+        let base = ("base.wgsl".to_string(), "fn one() -> f32 {\n    return 1.0;\n}".to_string());
+        let top = ("top.wgsl".to_string(), "fn two() -> f32 {\n    return one() + 1.0\n}\n".to_string());
+        let joined = JoinedSource::new(&[base, top]);
+        assert_eq!(joined.origin(), "top.wgsl");
+        let error = joined.relocate(validate_wgsl(joined.origin(), &joined.source).unwrap_err());
+        assert_eq!((error.origin.as_str(), error.line), ("top.wgsl", 3), "{error}");
+        let early = joined.relocate(ShaderError { origin: "x".into(), line: 2, column: 5, message: String::new() });
+        assert_eq!((early.origin.as_str(), early.line, early.column), ("base.wgsl", 2, 5));
+    }
 
     #[test]
     fn syntax_error_is_located() {

@@ -82,13 +82,16 @@ impl NodeSetup<'_> {
     /// The scene's sample count, lowered to the largest this adapter can render and resolve for
     /// every format in `formats` (colour targets and depth), at least 1.
     pub fn samples_for(&self, formats: &[wgpu::TextureFormat]) -> u32 {
+        // Without the adapter-specific feature the device allows WebGPU's guaranteed counts only.
+        let specific = self.gpu.device.features().contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
         let supported = |n: u32| {
-            formats.iter().all(|f| {
-                let features = self.gpu.adapter.get_texture_format_features(*f);
-                let resolvable = f.is_depth_stencil_format()
-                    || features.flags.contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE);
-                features.flags.sample_count_supported(n) && resolvable
-            })
+            (specific || n == 4)
+                && formats.iter().all(|f| {
+                    let features = self.gpu.adapter.get_texture_format_features(*f);
+                    let resolvable = f.is_depth_stencil_format()
+                        || features.flags.contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE);
+                    features.flags.sample_count_supported(n) && resolvable
+                })
         };
         [8, 4, 2].into_iter().find(|&n| n <= self.msaa && supported(n)).unwrap_or(1)
     }
@@ -98,13 +101,31 @@ impl NodeSetup<'_> {
     /// declares it (naga reflection): layouts and shaders cannot drift apart, also when a shader
     /// is edited live — a mismatch is a located error and the last good version keeps running.
     pub fn shader_source(&self, file: &str, bindings: &[(&str, u32)]) -> Result<(String, String), ShaderError> {
-        let (origin, source) = self
-            .assets
-            .load(AssetKind::Shader, file)
-            .map(|a| (a.origin, a.source))
-            .map_err(|message| ShaderError { origin: file.into(), line: 1, column: 1, message })?;
+        let (origin, source) = self.load_shader(file)?;
         crate::gpu::check_bindings(&origin, &source, bindings)?;
         Ok((origin, source))
+    }
+
+    /// `files` joined into one module's source (a shader that builds on another's functions),
+    /// checked like [`Self::shader_source`]; errors are located in the file they come from.
+    pub fn joined_shader_source(
+        &self,
+        files: &[&str],
+        bindings: &[(&str, u32)],
+    ) -> Result<crate::gpu::JoinedSource, ShaderError> {
+        let loaded = files.iter().map(|f| self.load_shader(f)).collect::<Result<Vec<_>, _>>()?;
+        let joined = crate::gpu::JoinedSource::new(&loaded);
+        crate::gpu::check_bindings(joined.origin(), &joined.source, bindings).map_err(|e| joined.relocate(e))?;
+        Ok(joined)
+    }
+
+    fn load_shader(&self, file: &str) -> Result<(String, String), ShaderError> {
+        self.assets.load(AssetKind::Shader, file).map(|a| (a.origin, a.source)).map_err(|message| ShaderError {
+            origin: file.into(),
+            line: 1,
+            column: 1,
+            message,
+        })
     }
 }
 

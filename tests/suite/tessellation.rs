@@ -216,3 +216,82 @@ fn a_drag_stirs_the_fluid_under_the_pointer_on_the_plane() {
     assert!((at[0] - expected[0]).abs() < 1e-5 && (at[1] - expected[1]).abs() < 1e-5, "{at:?} vs {expected:?}");
     assert!((at[0] - view[0]).abs() > 0.01 || (at[1] - view[1]).abs() > 0.01, "mapped, not the raw screen position");
 }
+
+/// Renders frame 0 of `tessellation_image` at `size` with `settings` (`node.param=value`), once
+/// drawn in compute and once by the raster pipeline.
+fn both_draws(settings: &[String], size: (u32, u32)) -> [Vec<u8>; 2] {
+    ["compute", "pipeline"].map(|rasterizer| {
+        let mut scene = load_scene(&common::assets(), "tessellation_image").unwrap();
+        for s in settings.iter().map(String::as_str).chain([format!("surface.rasterizer={rasterizer}").as_str()]) {
+            scene.set_from_str(s).unwrap_or_else(|e| panic!("{s}: {e}"));
+        }
+        common::render_scene(scene, size, 0).rgba
+    })
+}
+
+#[test]
+fn the_compute_draw_matches_the_pipeline_draw() {
+    let size = (203, 117);
+    // (settings, largest mean FLIP): the wireframe's lines are placed from derivatives, which
+    // the pipeline takes over 2×2 pixel quads and the compute draw per pixel.
+    let cases: &[(&[&str], f32)] = &[
+        (&[], 0.01),
+        (&["surface.view=shaded", "surface.msaa=off"], 0.01),
+        // Too many possible triangles to keep their corners: the resolve evaluates them again.
+        (&["surface.grid=40", "surface.edge_length=12"], 0.01),
+        (&["surface.view=wireframe", "surface.edge_length=12"], 0.08),
+        // Large triangles (the queue) and a camera inside the relief (near-plane clipping).
+        (&["surface.grid=1", "surface.edge_length=50", "surface.view=wireframe"], 0.04),
+        (&["surface.camera_distance=5", "surface.camera_pitch=0", "surface.view=shaded"], 0.01),
+        (&["surface.camera_distance=5.5", "surface.camera_pitch=0", "surface.displacement=2"], 0.01),
+    ];
+    for (case, bound) in cases {
+        let settings: Vec<String> =
+            case.iter().map(|s| s.to_string()).chain(["surface.background=[1.0, 1.0, 1.0, 1.0]".into()]).collect();
+        let [compute, pipeline] = both_draws(&settings, size);
+        let drawn = pipeline.chunks(4).filter(|p| p[..3] != [255, 255, 255]).count();
+        assert!(drawn > (size.0 * size.1 / 5) as usize, "{case:?}: only {drawn} pixels drawn");
+        let (score, _) = indra::offscreen::flip_score(&pipeline, &compute, size, 0.99);
+        assert!(score.mean < *bound, "{case:?}: mean FLIP {} (bound {bound})", score.mean);
+    }
+}
+
+#[test]
+fn the_compute_draw_leaves_no_crack_between_triangles() {
+    // Magenta behind a rough, strongly displaced relief seen from random cameras without
+    // multisampling: every pixel the pipeline covers, away from the silhouette, must be covered
+    // in compute too (a crack or a dropped edge shows the background).
+    let size = (160, 96);
+    let mut rng = SplitMix64::new(0xc4ac);
+    let (mut inner, mut cases) = (0, 0);
+    for _ in 0..6 {
+        let settings: Vec<String> = [
+            "surface.msaa=off".to_string(),
+            "surface.background=[1.0, 0.0, 1.0, 1.0]".to_string(),
+            format!("surface.grid={}", 2 + (rng.unit() * 10.0) as u32),
+            format!("surface.edge_length={}", 1.0 + rng.unit() * 20.0),
+            format!("surface.displacement={}", rng.unit() * 3.0),
+            format!("surface.camera_yaw={}", rng.unit() * 120.0 - 60.0),
+            format!("surface.camera_pitch={}", rng.unit() * 60.0),
+            format!("surface.camera_distance={}", 3.0 + rng.unit() * 8.0),
+        ]
+        .to_vec();
+        let [compute, pipeline] = both_draws(&settings, size);
+        let background = |image: &[u8], x: i64, y: i64| {
+            let (x, y) = (x.clamp(0, size.0 as i64 - 1), y.clamp(0, size.1 as i64 - 1));
+            let i = 4 * (y as usize * size.0 as usize + x as usize);
+            image[i] > 250 && image[i + 1] < 5 && image[i + 2] > 250
+        };
+        for y in 0..size.1 as i64 {
+            for x in 0..size.0 as i64 {
+                let interior = (-1..=1).all(|dy| (-1..=1).all(|dx| !background(&pipeline, x + dx, y + dy)));
+                if interior {
+                    inner += 1;
+                    assert!(!background(&compute, x, y), "{settings:?}: a crack at ({x}, {y})");
+                }
+            }
+        }
+        cases += 1;
+    }
+    assert!(inner > cases * 2000, "only {inner} interior pixels in {cases} views");
+}

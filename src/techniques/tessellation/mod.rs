@@ -13,21 +13,24 @@
 //!
 //! Book: [UGP4 ch.6] "Tessellation & Displacement" (sakota). Shader: `shaders/tessellation.wgsl`.
 
+mod compute_raster;
 mod params;
 pub mod reference;
 
 pub use params::{
-    CHANNELS, MSAA_MODES, PLANE_SIZE, TessUniforms, VIEWS, camera, edge_count, frustum_planes, model, params,
+    CHANNELS, MSAA_MODES, PLANE_SIZE, RASTERIZERS, TessUniforms, VIEWS, camera, edge_count, frustum_planes, model,
+    params,
 };
 
 use std::cell::RefCell;
 
 use crate::gpu::{BindGroupCache, ComputeKernel, ShaderError, storage_entry as storage};
-use crate::graph::{BufferHandle, FrameGraph, PassContext, RasterTargets, TextureHandle};
+use crate::graph::{BufferHandle, FrameGraph, PassContext, RasterTargets, TextureDesc, TextureHandle};
 use crate::params::ParamSet;
 use crate::time::FrameTime;
 
 use super::{NodeSetup, Technique, TechniqueInfo};
+use compute_raster::{ComputeRaster, DrawBindings};
 
 /// The registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -36,7 +39,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "a plane tessellated on the GPU by screen-space edge length and displaced by an input texture",
     params,
     inputs: &["height"],
-    shaders: &["tessellation.wgsl"],
+    shaders: &["tessellation.wgsl", "tessellation_raster.wgsl"],
     create,
 };
 
@@ -80,6 +83,10 @@ pub struct Tessellation {
     output_size: (u32, u32),
     /// Draw bind groups by height texture id.
     draw_groups: RefCell<BindGroupCache<u64>>,
+    /// The draw in compute, where the adapter has 64-bit atomics.
+    compute_raster: Option<RefCell<ComputeRaster>>,
+    /// Whether the last frame was drawn in compute.
+    drew_in_compute: bool,
     /// The last frame's uniforms (tests compare against the CPU reference with them).
     last: Option<TessUniforms>,
 }
@@ -128,6 +135,12 @@ impl Tessellation {
         let patches = kernel("patches", &[&compute_layout])?;
         let scan = kernel("scan", &[&compute_layout])?;
         let boundaries = kernel("evaluate_boundaries", &[&uniform_layout, &draw_layout, &boundary_layout])?;
+        let compute_raster = if device.features().contains(compute_raster::FEATURES) {
+            let joined = setup.joined_shader_source(&["tessellation.wgsl", "tessellation_raster.wgsl"], &bindings)?;
+            Some(RefCell::new(ComputeRaster::new(device, &joined, [&uniform_layout, &draw_layout])?))
+        } else {
+            None
+        };
         let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
         let pipeline = |samples: u32| {
             crate::gpu::validated(device, &origin, || {
@@ -197,6 +210,8 @@ impl Tessellation {
             buffers: None,
             output_size: (0, 0),
             draw_groups: RefCell::default(),
+            compute_raster,
+            drew_in_compute: false,
             last: None,
         })
     }
@@ -278,7 +293,8 @@ impl Tessellation {
         let factors = make("tessellation_edge_factors", u64::from(edge_count(grid)) * 4, none);
         let levels = make("tessellation_patch_levels", patches * 4, none);
         let offsets = make("tessellation_offsets", (patches + 1) * 4, none);
-        let args = make("tessellation_draw_args", 5 * 4, wgpu::BufferUsages::INDIRECT);
+        // The draw, the triangle total and the compute rasterizer's dispatch.
+        let args = make("tessellation_draw_args", 8 * 4, wgpu::BufferUsages::INDIRECT);
         let compute_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("tessellation_compute_group"),
             layout: &self.compute_layout,
@@ -309,20 +325,39 @@ impl Tessellation {
         })
     }
 
+    /// Group 1 of the draw for the height texture `height`.
+    fn draw_group(&self, ctx: &PassContext<'_>, height: TextureHandle, b: &Buffers) -> wgpu::BindGroup {
+        self.draw_groups
+            .borrow_mut()
+            .get_or_create(ctx.texture_id(height), || self.make_draw_group(ctx.view(height), b))
+            .clone()
+    }
+
     /// Records the draw into `targets`: multisampled and resolved, or directly.
     fn record_draw(&self, ctx: &mut PassContext<'_>, height: TextureHandle, targets: &RasterTargets, clear: [f32; 4]) {
         let Some(b) = &self.buffers else { return };
-        let group = self
-            .draw_groups
-            .borrow_mut()
-            .get_or_create(ctx.texture_id(height), || self.make_draw_group(ctx.view(height), b))
-            .clone();
+        let group = self.draw_group(ctx, height, b);
         let clear = wgpu::Color { r: f64::from(clear[0]), g: f64::from(clear[1]), b: f64::from(clear[2]), a: 1.0 };
         let mut pass = ctx.begin_draw(targets, clear);
         pass.set_pipeline(&self.draw[usize::from(targets.msaa.is_some())]);
         pass.set_bind_group(0, &self.uniform_group, &[]);
         pass.set_bind_group(1, &group, &[]);
         pass.draw_indirect(&b.args.0, 0);
+    }
+
+    /// Records the compute draw's coverage (`resolve` false) or its shading into `image`.
+    fn record_compute_draw(&self, ctx: &mut PassContext<'_>, height: TextureHandle, image: Option<TextureHandle>) {
+        let (Some(b), Some(raster)) = (&self.buffers, &self.compute_raster) else { return };
+        let mesh = self.draw_group(ctx, height, b);
+        let bindings = DrawBindings { uniforms: &self.uniform_group, mesh: &mesh, args: &b.args.0 };
+        match image {
+            None => raster.borrow_mut().record_raster(ctx.encoder, &bindings),
+            Some(image) => {
+                // Views are shared handles: a clone frees the context for the encoder.
+                let (view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
+                raster.borrow_mut().record_resolve(ctx.encoder, &bindings, (&view, id));
+            }
+        }
     }
 }
 
@@ -346,6 +381,9 @@ impl Technique for Tessellation {
         self.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
         self.last = Some(u);
         self.draw_groups.get_mut().begin_frame();
+        let samples = if params.choice("msaa") == 1 { self.samples } else { 1 };
+        self.drew_in_compute = params.choice("rasterizer") == 0
+            && self.compute_raster.as_mut().is_some_and(|r| r.get_mut().prepare(&self.queue, size, samples, u.grid));
 
         let this: &'r Tessellation = self;
         let b = this.buffers.as_ref().expect("ensured");
@@ -372,6 +410,29 @@ impl Technique for Tessellation {
                 this.patches.dispatch(&mut pass, &[&b.compute_group], [patches, 1, 1]);
                 this.scan.dispatch(&mut pass, &[&b.compute_group], [256, 1, 1]);
             });
+        if this.drew_in_compute {
+            let raster = this.compute_raster.as_ref().expect("drawn in compute").borrow();
+            let (buffer, id) = raster.visibility().expect("prepared");
+            let visibility = graph.import_buffer("tessellation/visibility", buffer, id);
+            drop(raster);
+            let image = graph.create_texture("tessellation/image", TextureDesc::full(FORMAT));
+            graph
+                .add_pass("tessellation/raster")
+                .read(height)
+                .read_buffer(factors)
+                .read_buffer(levels)
+                .read_buffer(offsets)
+                .read_buffer(args)
+                .write_buffer(visibility)
+                .record(move |ctx| this.record_compute_draw(ctx, height, None));
+            graph
+                .add_pass("tessellation/resolve")
+                .read(height)
+                .read_buffer(visibility)
+                .write(image)
+                .record(move |ctx| this.record_compute_draw(ctx, height, Some(image)));
+            return image;
+        }
         let samples = if params.choice("msaa") == 1 { this.samples } else { 1 };
         let targets = graph.create_raster_targets("tessellation", FORMAT, Some(DEPTH), samples);
         let clear = u.background;
@@ -394,13 +455,14 @@ impl Technique for Tessellation {
     fn bench_report(&mut self) -> Vec<String> {
         let Some(u) = self.last else { return Vec::new() };
         vec![format!(
-            "{} triangles from {} patches (grid {}, edge target {} px, {}×{} output)",
+            "{} triangles from {} patches (grid {}, edge target {} px, {}×{} output), drawn by {}",
             self.read_triangles(),
             u.patch_count,
             u.grid,
             u.edge_px,
             self.output_size.0,
-            u.screen_height
+            u.screen_height,
+            if self.drew_in_compute { "compute (visibility buffer)" } else { "the raster pipeline" }
         )]
     }
 }

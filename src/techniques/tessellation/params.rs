@@ -13,6 +13,8 @@ pub const PLANE_SIZE: f32 = 10.0;
 pub const VIEWS: &[&str] = &["shaded", "wireframe", "level"];
 /// Multisampling choices (index 1 = 4×).
 pub const MSAA_MODES: &[&str] = &["off", "on"];
+/// How the surface is drawn (index 0: in compute, where the adapter allows).
+pub const RASTERIZERS: &[&str] = &["compute", "pipeline"];
 /// Which channel of the input is the height.
 pub const CHANNELS: &[&str] = &["red", "luminance"];
 
@@ -31,6 +33,13 @@ pub fn params() -> Vec<ParamDecl> {
             MSAA_MODES,
             1,
             "multisampling: on uses the scene's msaa (4 samples by default); off is faster where fill is slow",
+        ),
+        ParamDecl::choice(
+            "rasterizer",
+            RASTERIZERS,
+            0,
+            "compute: a visibility buffer filled in compute (fast where the raster path is narrow, as on \
+             the H100/H200; needs 64-bit atomics, else pipeline); pipeline: the hardware rasterizer",
         ),
         ParamDecl::new("camera_distance", Float(10.0), Some((1.0, 100.0)), "camera distance from the origin"),
         ParamDecl::new("camera_yaw", Float(0.0), Some((-180.0, 180.0)), "camera orbit about y").with_unit("°"),

@@ -1,0 +1,305 @@
+//! The surface drawn in compute (`shaders/tessellation_raster.wgsl`): a visibility buffer of
+//! one 64-bit word per sample (inverted depth, triangle), filled by one thread per refined
+//! triangle with `atomicMax` and shaded once per pixel and triangle. On GPUs whose raster path is
+//! narrow (the H100/H200, where clearing and resolving a 4× multisampled 4K target alone takes
+//! ~6 ms) this replaces the draw; the pipeline draw stays for adapters without 64-bit atomics.
+
+use crate::gpu::{BindGroupCache, ComputeKernel, JoinedSource, ShaderError, storage_entry as storage};
+
+use super::FORMAT;
+
+/// Features the compute draw needs.
+pub const FEATURES: wgpu::Features = wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
+
+/// Large triangles the queue holds per frame; more are covered by their own thread.
+const BIG_CAPACITY: u32 = 16384;
+/// Bytes of one queued triangle (`BigTriangle`).
+const BIG_TRIANGLE_BYTES: u64 = 48;
+/// Bytes of one triangle's kept corners (six vec4).
+const CORNER_BYTES: u64 = 96;
+/// The most memory kept corners may take (grid 10 at level 64 everywhere: 79 MB; grid 36: 1 GiB);
+/// beyond it the resolve evaluates corners again.
+const CORNER_BUDGET: u64 = 1 << 30;
+
+/// `Raster` in the shader.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+struct RasterUniforms {
+    width: u32,
+    height: u32,
+    samples: u32,
+    big_capacity: u32,
+    cached: u32,
+    _pad: [u32; 3],
+}
+
+/// Room for every triangle's corners at one grid size (or a stand-in when over the budget).
+struct Corners {
+    grid: u32,
+    buffer: wgpu::Buffer,
+    cached: bool,
+}
+
+/// The visibility buffer for one output size and sample count.
+struct Visibility {
+    key: (u32, u32, u32),
+    buffer: wgpu::Buffer,
+    /// Its id in the frame graph.
+    id: u64,
+}
+
+/// The kernels and buffers of the compute draw.
+pub struct ComputeRaster {
+    device: wgpu::Device,
+    raster: ComputeKernel,
+    raster_big: ComputeKernel,
+    resolve: ComputeKernel,
+    raster_layout: wgpu::BindGroupLayout,
+    big_layout: wgpu::BindGroupLayout,
+    resolve_layout: wgpu::BindGroupLayout,
+    uniforms: wgpu::Buffer,
+    big_triangles: wgpu::Buffer,
+    /// The queue's dispatch arguments and length (x, y, z, count).
+    big_args: wgpu::Buffer,
+    visibility: Option<Visibility>,
+    corners: Option<Corners>,
+    /// Group 2 of the raster kernels (with and without the queue's arguments, which the second
+    /// reads as its dispatch); made with the visibility buffer.
+    raster_groups: Option<[wgpu::BindGroup; 2]>,
+    /// Group 2 of the resolve: output texture id → group; cleared with the visibility.
+    resolve_groups: BindGroupCache<u64>,
+}
+
+/// What one frame's compute draw binds.
+pub struct DrawBindings<'a> {
+    /// Group 0: the tessellation uniforms.
+    pub uniforms: &'a wgpu::BindGroup,
+    /// Group 1: the height map and the refined mesh's tables.
+    pub mesh: &'a wgpu::BindGroup,
+    /// The draw arguments, with the raster dispatch at byte 20.
+    pub args: &'a wgpu::Buffer,
+}
+
+impl ComputeRaster {
+    /// Builds the kernels from `tessellation.wgsl` joined with `tessellation_raster.wgsl`;
+    /// `layouts` are groups 0 and 1 as the pipeline draw binds them.
+    pub fn new(
+        device: &wgpu::Device,
+        shader: &JoinedSource,
+        layouts: [&wgpu::BindGroupLayout; 2],
+    ) -> Result<Self, ShaderError> {
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let raster_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("tessellation_raster_layout"),
+            entries: &[
+                crate::gpu::uniform_entry::<RasterUniforms>(0, compute),
+                storage(1, compute, false),
+                storage(2, compute, false),
+                storage(3, compute, false),
+                storage(6, compute, false),
+            ],
+        });
+        // The queue's kernel reads big_args as its dispatch, so it may not bind them too.
+        let big_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("tessellation_raster_big_layout"),
+            entries: &[
+                crate::gpu::uniform_entry::<RasterUniforms>(0, compute),
+                storage(1, compute, false),
+                storage(2, compute, false),
+            ],
+        });
+        let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("tessellation_resolve_layout"),
+            entries: &[
+                crate::gpu::uniform_entry::<RasterUniforms>(0, compute),
+                storage(4, compute, true),
+                storage(7, compute, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: compute,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: FORMAT,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let kernel = |entry, group: &wgpu::BindGroupLayout| {
+            ComputeKernel::new(device, shader.origin(), &shader.source, entry, &[layouts[0], layouts[1], group])
+                .map_err(|e| shader.relocate(e))
+        };
+        let raster = kernel("raster", &raster_layout)?;
+        let raster_big = kernel("raster_big", &big_layout)?;
+        let resolve = kernel("resolve", &resolve_layout)?;
+        let big_triangles = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("tessellation_big_triangles"),
+            size: u64::from(BIG_CAPACITY) * BIG_TRIANGLE_BYTES,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let big_args = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("tessellation_big_args"),
+            size: 16,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Self {
+            device: device.clone(),
+            raster,
+            raster_big,
+            resolve,
+            raster_layout,
+            big_layout,
+            resolve_layout,
+            uniforms: crate::gpu::uniform_buffer::<RasterUniforms>(device, "tessellation_raster_uniforms"),
+            big_triangles,
+            big_args,
+            visibility: None,
+            corners: None,
+            raster_groups: None,
+            resolve_groups: BindGroupCache::default(),
+        })
+    }
+
+    /// Readies the visibility buffer for `size` × `samples` and the corners for `grid`, and
+    /// writes the uniforms; false when the visibility buffer would exceed the device's limits
+    /// (the caller draws with the pipeline then).
+    pub fn prepare(&mut self, queue: &wgpu::Queue, size: (u32, u32), samples: u32, grid: u32) -> bool {
+        let key = (size.0, size.1, samples);
+        if self.visibility.as_ref().is_none_or(|v| v.key != key) {
+            let bytes = u64::from(size.0) * u64::from(size.1) * u64::from(samples) * 8;
+            let limits = self.device.limits();
+            if bytes > limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) {
+                return false;
+            }
+            let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("tessellation_visibility"),
+                size: bytes.max(8),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            self.visibility = Some(Visibility { key, buffer, id: crate::graph::next_resource_id() });
+            // Old groups bind the old buffer.
+            self.raster_groups = None;
+            self.resolve_groups = BindGroupCache::default();
+        }
+        if self.corners.as_ref().is_none_or(|c| c.grid != grid) {
+            // At most level 64 (4,096 triangles) in each of the 2 grid² patches.
+            let bytes = 2 * u64::from(grid * grid) * 4096 * CORNER_BYTES;
+            let limits = self.device.limits();
+            let cached = bytes <= CORNER_BUDGET.min(limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);
+            let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("tessellation_corners"),
+                size: if cached { bytes } else { CORNER_BYTES },
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            });
+            self.corners = Some(Corners { grid, buffer, cached });
+            self.raster_groups = None;
+            self.resolve_groups = BindGroupCache::default();
+        }
+        self.resolve_groups.begin_frame();
+        let cached = u32::from(self.corners.as_ref().is_some_and(|c| c.cached));
+        let u =
+            RasterUniforms { width: size.0, height: size.1, samples, big_capacity: BIG_CAPACITY, cached, _pad: [0; 3] };
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
+        true
+    }
+
+    /// Group 2 of `raster` and of `raster_big` (which reads the queue's arguments as its
+    /// dispatch, so it may not bind them too).
+    fn make_raster_groups(&self, visibility: &wgpu::Buffer, corners: &wgpu::Buffer) -> [wgpu::BindGroup; 2] {
+        let group = |layout, first_only: Option<&wgpu::Buffer>| {
+            let mut entries = vec![
+                wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: visibility.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: self.big_triangles.as_entire_binding() },
+            ];
+            if let Some(args) = first_only {
+                entries.push(wgpu::BindGroupEntry { binding: 3, resource: args.as_entire_binding() });
+                entries.push(wgpu::BindGroupEntry { binding: 6, resource: corners.as_entire_binding() });
+            }
+            self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("tessellation_raster_group"),
+                layout,
+                entries: &entries,
+            })
+        };
+        [group(&self.raster_layout, Some(&self.big_args)), group(&self.big_layout, None)]
+    }
+
+    /// The visibility buffer and its graph id (after a successful [`Self::prepare`]).
+    pub fn visibility(&self) -> Option<(&wgpu::Buffer, u64)> {
+        self.visibility.as_ref().map(|v| (&v.buffer, v.id))
+    }
+
+    /// Records the coverage: clear the visibility buffer, then cover every refined triangle
+    /// (the dispatch the scan wrote) and the queued large ones.
+    pub fn record_raster(&mut self, encoder: &mut wgpu::CommandEncoder, b: &DrawBindings<'_>) {
+        let (Some(visibility), Some(corners)) = (&self.visibility, &self.corners) else { return };
+        if self.raster_groups.is_none() {
+            self.raster_groups = Some(self.make_raster_groups(&visibility.buffer, &corners.buffer));
+        }
+        let groups = self.raster_groups.as_ref().expect("made above");
+        encoder.clear_buffer(&visibility.buffer, 0, None);
+        encoder.clear_buffer(&self.big_args, 0, None);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("tessellation/raster"),
+            timestamp_writes: None,
+        });
+        pass.set_bind_group(0, b.uniforms, &[]);
+        pass.set_bind_group(1, b.mesh, &[]);
+        pass.set_bind_group(2, &groups[0], &[]);
+        pass.set_pipeline(&self.raster.pipeline);
+        pass.dispatch_workgroups_indirect(b.args, 20);
+        pass.set_bind_group(2, &groups[1], &[]);
+        pass.set_pipeline(&self.raster_big.pipeline);
+        pass.dispatch_workgroups_indirect(&self.big_args, 0);
+    }
+
+    /// Records the shading: each pixel's distinct triangles shaded and averaged into `image`.
+    pub fn record_resolve(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        b: &DrawBindings<'_>,
+        image: (&wgpu::TextureView, u64),
+    ) {
+        let (Some(visibility), Some(corners)) = (&self.visibility, &self.corners) else { return };
+        let (device, uniforms) = (&self.device, &self.uniforms);
+        let entry = |binding, resource| wgpu::BindGroupEntry { binding, resource };
+        let group = self.resolve_groups.get_or_create(image.1, || {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("tessellation_resolve_group"),
+                layout: &self.resolve_layout,
+                entries: &[
+                    entry(0, uniforms.as_entire_binding()),
+                    entry(4, visibility.buffer.as_entire_binding()),
+                    entry(7, corners.buffer.as_entire_binding()),
+                    entry(5, wgpu::BindingResource::TextureView(image.0)),
+                ],
+            })
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("tessellation/resolve"),
+            timestamp_writes: None,
+        });
+        let (width, height, _) = visibility.key;
+        self.resolve.dispatch(&mut pass, &[b.uniforms, b.mesh, group], [width, height, 1]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_uniform_block_matches_the_wgsl_struct() {
+        let source = [
+            include_str!("../../../shaders/tessellation.wgsl"),
+            include_str!("../../../shaders/tessellation_raster.wgsl"),
+        ]
+        .join("\n");
+        assert_eq!(crate::gpu::wgsl_struct_size(&source, "Raster"), Some(size_of::<super::RasterUniforms>() as u32));
+        assert_eq!(crate::gpu::wgsl_struct_size(&source, "BigTriangle"), Some(super::BIG_TRIANGLE_BYTES as u32));
+    }
+}
