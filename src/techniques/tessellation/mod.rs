@@ -9,7 +9,11 @@
 //! parameter; normals come from the height field's gradient (the flat normal is wrong once
 //! displaced); the height is sampled with filtering in the plane's own UV.
 //!
-//! Integer spacing: levels change by whole steps (no geomorphing yet).
+//! Integer spacing with geomorphing: levels change by whole steps, vertices glide between them.
+//!
+//! The draw: in compute where the adapter has 64-bit atomics (a visibility buffer, see
+//! `compute_raster`; the `rasterizer` parameter), else by the raster pipeline (`draw_indirect`).
+//! Both give the same image within multisampling's differences (a test compares them).
 //!
 //! Book: [UGP4 ch.6] "Tessellation & Displacement" (sakota). Shader: `shaders/tessellation.wgsl`.
 
