@@ -1,7 +1,9 @@
 // Chapter 6's draw in compute: a visibility buffer, for GPUs whose raster path is narrow (the
 // H100/H200 clear and resolve a 4× multisampled 4K target in ~6 ms before drawing anything).
-// Appended to tessellation.wgsl (it uses the lattice, the surface and the shading from there);
-// needs 64-bit atomics (wgpu's SHADER_INT64_ATOMIC_MIN_MAX), so it is a module of its own.
+// Built after tessellation.wgsl (the lattice, the surface and the shading come from there; the
+// line below joins them); needs 64-bit atomics (SHADER_INT64_ATOMIC_MIN_MAX), so it is a module
+// of its own.
+// extends: tessellation.wgsl
 //   raster      one thread per refined triangle: evaluates its three corners as the vertex shader
 //               does, clips it at the near plane, snaps it to 1/16 px and tests the standard
 //               sample positions of each pixel it may cover; a covered sample keeps the nearest

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use clap::Args;
 use indra::assets::{AssetKind, Assets};
-use indra::gpu::{Gpu, GpuOptions, validate_wgsl};
+use indra::gpu::{Gpu, GpuOptions, JoinedSource};
 use indra::offscreen::{OffscreenRenderer, RenderedFrame, VideoSettings, VideoWriter, write_png};
 use indra::scene::{Scene, load_scene};
 
@@ -444,8 +444,14 @@ pub fn check(assets: &Assets, files: &[PathBuf]) -> Result<(), String> {
     for (kind, name) in &targets {
         let result = match kind {
             AssetKind::Scene => load_scene(assets, name).map(|_| ()).map_err(|e| e.to_string()),
-            AssetKind::Shader => read_shader(assets, name)
-                .and_then(|(origin, source)| validate_wgsl(&origin, &source).map(|_| ()).map_err(|e| e.to_string())),
+            AssetKind::Shader => read_shader(assets, name).and_then(|(origin, source)| {
+                // A base is looked for beside the file first, then among the project's shaders.
+                let beside = |base: &str| Path::new(name).with_file_name(base).display().to_string();
+                let joined = JoinedSource::with_bases(&origin, &source, |base| {
+                    read_shader(assets, &beside(base)).or_else(|_| read_shader(assets, base))
+                })?;
+                joined.validate().map(|_| ()).map_err(|e| e.to_string())
+            }),
         };
         match result {
             Ok(()) => say!("ok     {name}"),

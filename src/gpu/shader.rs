@@ -100,6 +100,30 @@ impl JoinedSource {
         Self { source, parts }
     }
 
+    /// `source` (read from `origin`) after the files it builds on, named by `// extends: NAME`
+    /// lines at its top (each may extend another), base first; `load` reads a file by name as
+    /// `(origin, source)`. A shader without such a line stands alone.
+    pub fn with_bases(
+        origin: &str,
+        source: &str,
+        load: impl Fn(&str) -> Result<(String, String), String>,
+    ) -> Result<Self, String> {
+        let mut files = vec![(origin.to_string(), source.to_string())];
+        while let Some(base) = extended_file(&files[0].1) {
+            if files.len() > 4 || files.iter().any(|(o, _)| o.ends_with(base)) {
+                return Err(format!("{origin}: `// extends: {base}` goes round in a circle"));
+            }
+            let loaded = load(base).map_err(|e| format!("{}: extends {base}: {e}", files[0].0))?;
+            files.insert(0, loaded);
+        }
+        Ok(Self::new(&files))
+    }
+
+    /// Parses and validates the joined text, errors located in their own file.
+    pub fn validate(&self) -> Result<naga::Module, ShaderError> {
+        validate_wgsl(self.origin(), &self.source).map_err(|e| self.relocate(e))
+    }
+
     /// The origin to build with: the last file's (the one that adds the entry points).
     pub fn origin(&self) -> &str {
         self.parts.last().map_or("<joined>", |(origin, _)| origin)
@@ -113,6 +137,16 @@ impl JoinedSource {
         }
         error
     }
+}
+
+/// The file a shader builds on: `NAME` of a `// extends: NAME` line among its leading comments.
+fn extended_file(source: &str) -> Option<&str> {
+    source
+        .lines()
+        .map(str::trim)
+        .take_while(|l| l.is_empty() || l.starts_with("//"))
+        .find_map(|l| l.strip_prefix("// extends:"))
+        .map(str::trim)
 }
 
 /// Runs `build` (creating modules or pipelines) inside a validation error scope: what naga
@@ -141,6 +175,23 @@ mod tests {
         assert_eq!((error.origin.as_str(), error.line), ("top.wgsl", 3), "{error}");
         let early = joined.relocate(ShaderError { origin: "x".into(), line: 2, column: 5, message: String::new() });
         assert_eq!((early.origin.as_str(), early.line, early.column), ("base.wgsl", 2, 5));
+    }
+
+    #[test]
+    fn a_shader_that_extends_another_is_validated_after_it() {
+        let files = |name: &str| match name {
+            "base.wgsl" => Ok(("lib/base.wgsl".to_string(), "fn one() -> f32 {\n    return 1.0;\n}\n".to_string())),
+            other => Err(format!("no {other}")),
+        };
+        let top = "// Adds two.\n// extends: base.wgsl\n\nfn two() -> f32 {\n    return one() + 1.0;\n}\n";
+        let joined = JoinedSource::with_bases("top.wgsl", top, files).unwrap();
+        assert!(joined.validate().is_ok());
+        let broken = top.replace("one() + 1.0", "one() + true");
+        let error = JoinedSource::with_bases("top.wgsl", &broken, files).unwrap().validate().unwrap_err();
+        assert_eq!((error.origin.as_str(), error.line), ("top.wgsl", 5), "{error}");
+        let missing = JoinedSource::with_bases("top.wgsl", &top.replace("base.wgsl", "gone.wgsl"), files);
+        assert!(missing.unwrap_err().contains("extends gone.wgsl: no gone.wgsl"));
+        assert!(JoinedSource::with_bases("top.wgsl", "fn alone() {}", files).unwrap().validate().is_ok());
     }
 
     #[test]

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use super::watcher::{Watcher, read_stable};
 use crate::assets::{Asset, AssetKind, Assets};
-use crate::gpu::{Gpu, validate_wgsl};
+use crate::gpu::{Gpu, JoinedSource};
 use crate::params::Remap;
 use crate::scene::{Player, SceneInstance, parse_scene};
 
@@ -153,7 +153,12 @@ impl LiveReload {
         }
         self.stalled.remove(path);
         let origin = path.display().to_string();
-        validate_wgsl(&origin, &source).map_err(|e| e.to_string())?;
+        let running = &self.running;
+        JoinedSource::with_bases(&origin, &source, |base| {
+            running.load(AssetKind::Shader, base).map(|a| (a.origin, a.source))
+        })?
+        .validate()
+        .map_err(|e| e.to_string())?;
         let next = self.running.with_shader(Asset { name: name.clone(), origin, source: source.clone() });
         let used = instance.rebuild_nodes_using(&name, gpu, &next, size).map_err(|e| e.to_string())?;
         let previous = self.running.load(AssetKind::Shader, &name).ok();

@@ -106,15 +106,18 @@ impl NodeSetup<'_> {
         Ok((origin, source))
     }
 
-    /// `files` joined into one module's source (a shader that builds on another's functions),
-    /// checked like [`Self::shader_source`]; errors are located in the file they come from.
+    /// A shader joined after the files it extends (`// extends: NAME` at its top), checked like
+    /// [`Self::shader_source`]; errors are located in the file they come from.
     pub fn joined_shader_source(
         &self,
-        files: &[&str],
+        file: &str,
         bindings: &[(&str, u32)],
     ) -> Result<crate::gpu::JoinedSource, ShaderError> {
-        let loaded = files.iter().map(|f| self.load_shader(f)).collect::<Result<Vec<_>, _>>()?;
-        let joined = crate::gpu::JoinedSource::new(&loaded);
+        let (origin, source) = self.load_shader(file)?;
+        let joined = crate::gpu::JoinedSource::with_bases(&origin, &source, |base| {
+            self.load_shader(base).map_err(|e| e.message)
+        })
+        .map_err(|message| ShaderError { origin: origin.clone(), line: 1, column: 1, message })?;
         crate::gpu::check_bindings(joined.origin(), &joined.source, bindings).map_err(|e| joined.relocate(e))?;
         Ok(joined)
     }

@@ -238,3 +238,28 @@ fn a_reload_that_drops_a_node_while_its_events_are_queued_learned_and_recorded()
     assert!(lines[2].contains("frame:1") && lines[2].contains("\"k\"") && lines[2].contains("scale"), "{}", lines[2]);
     std::fs::remove_dir_all(root).unwrap();
 }
+
+#[test]
+fn a_shader_that_extends_another_reloads_live_and_its_errors_point_into_it() {
+    let root = sandbox("extends");
+    let assets = Assets::new(Some(root.clone()));
+    let scene = load_scene(&assets, "tessellation_image").unwrap();
+    let mut live = LiveReload::new(&assets).unwrap();
+    let mut r = OffscreenRenderer::new(common::gpu(), &assets, scene, Some((96, 54)), None, None).unwrap();
+    let green = |frame: &RenderedFrame| frame.rgba.chunks(4).filter(|p| p[1] > 200 && p[0] < 60 && p[2] < 60).count();
+    assert_eq!(green(&shown(&mut r)), 0);
+
+    // tessellation_raster.wgsl uses tessellation.wgsl's functions: alone it would not validate.
+    let shader = root.join("shaders/tessellation_raster.wgsl");
+    edit(&shader, "        var colour = u.background.rgb;", "        var colour = vec3<f32>(0.0, 1.0, 0.0);");
+    let report = wait_for_reload(&mut r, &mut live);
+    assert!(report.errors.is_empty() && !report.applied.is_empty(), "{report:?}");
+    assert!(green(&shown(&mut r)) > 500, "the edited background shows");
+
+    edit(&shader, "vec3<f32>(0.0, 1.0, 0.0);", "vec3<f32>(0.0, 1.0, true);");
+    let line = std::fs::read_to_string(&shader).unwrap().lines().position(|l| l.contains("1.0, true")).unwrap() + 1;
+    let report = wait_for_reload(&mut r, &mut live);
+    assert_eq!(report.errors.len(), 1, "{report:?}");
+    assert!(report.errors[0].contains(&format!("tessellation_raster.wgsl:{line}:")), "{}", report.errors[0]);
+    assert!(green(&shown(&mut r)) > 500, "the last good shader still runs");
+}

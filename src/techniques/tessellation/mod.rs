@@ -140,7 +140,7 @@ impl Tessellation {
         let scan = kernel("scan", &[&compute_layout])?;
         let boundaries = kernel("evaluate_boundaries", &[&uniform_layout, &draw_layout, &boundary_layout])?;
         let compute_raster = if device.features().contains(compute_raster::FEATURES) {
-            let joined = setup.joined_shader_source(&["tessellation.wgsl", "tessellation_raster.wgsl"], &bindings)?;
+            let joined = setup.joined_shader_source("tessellation_raster.wgsl", &bindings)?;
             Some(RefCell::new(ComputeRaster::new(device, &joined, [&uniform_layout, &draw_layout])?))
         } else {
             None
