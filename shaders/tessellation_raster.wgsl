@@ -57,26 +57,34 @@ const SNAP_LIMIT: f32 = 16777216.0;
 // A triangle whose box holds more pixels than this goes to the queue.
 const INLINE_PIXELS: i32 = 256;
 
-// Sample s of `count` in sixteenths of a pixel from its centre (Vulkan's standard locations).
+// Sample s of `count` in sixteenths of a pixel from its centre (Vulkan's standard locations). A
+// switch, not an indexed array: the SPIR-V backend would copy an array to per-invocation memory.
 fn sample_offset(count: u32, s: u32) -> vec2<i32> {
-    if count == 2u {
-        return array<vec2<i32>, 2>(vec2<i32>(4, 4), vec2<i32>(-4, -4))[s];
+    switch count * 8u + s {
+        case 16u: { return vec2<i32>(4, 4); }
+        case 17u: { return vec2<i32>(-4, -4); }
+        case 32u: { return vec2<i32>(-2, -6); }
+        case 33u: { return vec2<i32>(6, -2); }
+        case 34u: { return vec2<i32>(-6, 2); }
+        case 35u: { return vec2<i32>(2, 6); }
+        case 64u: { return vec2<i32>(1, -3); }
+        case 65u: { return vec2<i32>(-1, 3); }
+        case 66u: { return vec2<i32>(5, 1); }
+        case 67u: { return vec2<i32>(-3, -5); }
+        case 68u: { return vec2<i32>(-5, 5); }
+        case 69u: { return vec2<i32>(-7, -1); }
+        case 70u: { return vec2<i32>(3, 7); }
+        case 71u: { return vec2<i32>(7, -7); }
+        default: { return vec2<i32>(0, 0); }
     }
-    if count == 4u {
-        return array<vec2<i32>, 4>(vec2<i32>(-2, -6), vec2<i32>(6, -2), vec2<i32>(-6, 2), vec2<i32>(2, 6))[s];
-    }
-    if count == 8u {
-        return array<vec2<i32>, 8>(
-            vec2<i32>(1, -3), vec2<i32>(-1, 3), vec2<i32>(5, 1), vec2<i32>(-3, -5),
-            vec2<i32>(-5, 5), vec2<i32>(-7, -1), vec2<i32>(3, 7), vec2<i32>(7, -7),
-        )[s];
-    }
-    return vec2<i32>(0, 0);
 }
 
-// A triangle ready for coverage: corners in sixteenths of a pixel (y down), counter-clockwise in
-// that frame (positive area), NDC depths, and 1 + its index in the refined mesh.
+// A triangle ready for coverage: corners in sixteenths of a pixel (y down) relative to `origin`,
+// counter-clockwise in that frame (positive area), NDC depths, and 1 + its index in the mesh.
+// Edge functions are translation-invariant in integers, so a triangle measured from its own
+// corner gets exactly the values it would get from the image's corner — in i32 when it is small.
 struct Setup {
+    origin: vec2<i32>,
     v0: vec2<i32>,
     v1: vec2<i32>,
     v2: vec2<i32>,
@@ -96,47 +104,77 @@ fn edge(a: vec2<i32>, b: vec2<i32>, p: vec2<i32>) -> i64 {
     return i64(b.x - a.x) * i64(p.y - a.y) - i64(b.y - a.y) * i64(p.x - a.x);
 }
 
-// Whether p is inside edge a → b: strictly, or on it when the edge points down or, level,
-// left. An edge shared by two triangles runs opposite ways in each, so exactly one takes it.
-fn within(a: vec2<i32>, b: vec2<i32>, e: i64) -> bool {
+// The same for a triangle spanning at most 2^14 sixteenths (1,024 px) measured from its corner:
+// every product stays below 2^29.
+fn edge32(a: vec2<i32>, b: vec2<i32>, p: vec2<i32>) -> i32 {
+    return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
+}
+
+// Whether an edge a → b takes the points on it: when it points down or, level, left. An edge
+// shared by two triangles runs opposite ways in each, so exactly one of them takes its samples.
+fn takes_ties(a: vec2<i32>, b: vec2<i32>) -> bool {
     let d = b - a;
-    return e > 0li || (e == 0li && (d.y > 0 || (d.y == 0 && d.x < 0)));
+    return d.y > 0 || (d.y == 0 && d.x < 0);
 }
 
 // The pixel box [min, max] of a setup, clamped to the image (empty: min > max).
 fn pixel_box(s: Setup) -> vec4<i32> {
-    let lo = min(s.v0, min(s.v1, s.v2));
-    let hi = max(s.v0, max(s.v1, s.v2));
+    let lo = s.origin + min(s.v0, min(s.v1, s.v2));
+    let hi = s.origin + max(s.v0, max(s.v1, s.v2));
     // Sample x = 16 px + 8 + offset with |offset| ≤ 8: pixels from (lo − 16) / 16 to hi / 16.
     let first = max((lo - vec2<i32>(16)) >> vec2<u32>(4u), vec2<i32>(0));
     let last = min(hi >> vec2<u32>(4u), vec2<i32>(i32(r.width) - 1, i32(r.height) - 1));
     return vec4<i32>(first, last);
 }
 
-// Tests every sample of pixel (x, y) against s and keeps the nearest triangle per sample.
-fn cover_pixel(s: Setup, x: i32, y: i32) {
+// Keeps the nearest triangle at sample word `index`: e are the three edge values at the sample.
+fn keep(s: Setup, index: u32, e: vec3<f32>) {
+    let depth = dot(e, s.z) / s.area;
+    if depth <= 1.0 {
+        let inverted = ~bitcast<u32>(max(depth, 0.0));
+        atomicMax(&visibility[index], (u64(inverted) << 32u) | u64(s.key));
+    }
+}
+
+// The sample k of pixel (x, y) relative to the setup's origin.
+fn sample_at(s: Setup, x: i32, y: i32, k: u32) -> vec2<i32> {
+    return vec2<i32>(x * 16 + 8, y * 16 + 8) + sample_offset(r.samples, k) - s.origin;
+}
+
+// Tests every sample of pixel (x, y) against a small setup (i32 edge values).
+fn cover_pixel32(s: Setup, x: i32, y: i32) {
     let base = (u32(y) * r.width + u32(x)) * r.samples;
+    let ties = vec3<bool>(takes_ties(s.v1, s.v2), takes_ties(s.v2, s.v0), takes_ties(s.v0, s.v1));
     for (var k = 0u; k < r.samples; k++) {
-        let p = vec2<i32>(x * 16 + 8, y * 16 + 8) + sample_offset(r.samples, k);
+        let p = sample_at(s, x, y, k);
+        let e = vec3<i32>(edge32(s.v1, s.v2, p), edge32(s.v2, s.v0, p), edge32(s.v0, s.v1, p));
+        if all((e > vec3<i32>(0)) | ((e == vec3<i32>(0)) & ties)) {
+            keep(s, base + k, vec3<f32>(e));
+        }
+    }
+}
+
+// Tests every sample of pixel (x, y) against any setup (i64 edge values).
+fn cover_pixel64(s: Setup, x: i32, y: i32) {
+    let base = (u32(y) * r.width + u32(x)) * r.samples;
+    let ties = vec3<bool>(takes_ties(s.v1, s.v2), takes_ties(s.v2, s.v0), takes_ties(s.v0, s.v1));
+    for (var k = 0u; k < r.samples; k++) {
+        let p = sample_at(s, x, y, k);
         let e0 = edge(s.v1, s.v2, p);
         let e1 = edge(s.v2, s.v0, p);
         let e2 = edge(s.v0, s.v1, p);
-        if !(within(s.v1, s.v2, e0) && within(s.v2, s.v0, e1) && within(s.v0, s.v1, e2)) {
-            continue;
+        let positive = vec3<bool>(e0 > 0li, e1 > 0li, e2 > 0li);
+        let zero = vec3<bool>(e0 == 0li, e1 == 0li, e2 == 0li);
+        if all(positive | (zero & ties)) {
+            keep(s, base + k, vec3<f32>(f32(e0), f32(e1), f32(e2)));
         }
-        let depth = dot(vec3<f32>(f32(e0), f32(e1), f32(e2)), s.z) / s.area;
-        if depth > 1.0 {
-            continue;
-        }
-        let inverted = ~bitcast<u32>(max(depth, 0.0));
-        atomicMax(&visibility[base + k], (u64(inverted) << 32u) | u64(s.key));
     }
 }
 
 fn cover_box(s: Setup, box: vec4<i32>, first: vec2<i32>, step: i32) {
     for (var y = box.y + first.y; y <= box.w; y += step) {
         for (var x = box.x + first.x; x <= box.z; x += step) {
-            cover_pixel(s, x, y);
+            cover_pixel64(s, x, y);
         }
     }
 }
@@ -165,17 +203,30 @@ fn cover(key: u32, a: vec4<f32>, b: vec4<f32>, c: vec4<f32>) {
     if box.x > box.z || box.y > box.w {
         return;
     }
-    if (box.z - box.x + 1) * (box.w - box.y + 1) > INLINE_PIXELS {
-        let slot = atomicAdd(&big_args[3], 1u);
-        if slot < r.big_capacity {
-            atomicMax(&big_args[0], slot + 1u);
-            big_triangles[slot] = BigTriangle(
-                vec4<i32>(s.v0, s.v1),
-                vec4<i32>(s.v2, bitcast<i32>(key), 0),
-                vec4<f32>(s.z, s.area),
-            );
-            return;
+    let span = max(s.v0, max(s.v1, s.v2)) - min(s.v0, min(s.v1, s.v2));
+    let small = max(span.x, span.y) <= 16384;
+    if small && (box.z - box.x + 1) * (box.w - box.y + 1) <= INLINE_PIXELS {
+        // Measured from its first corner.
+        s.origin = s.v0;
+        s.v1 -= s.origin;
+        s.v2 -= s.origin;
+        s.v0 = vec2<i32>(0);
+        for (var y = box.y; y <= box.w; y++) {
+            for (var x = box.x; x <= box.z; x++) {
+                cover_pixel32(s, x, y);
+            }
         }
+        return;
+    }
+    let slot = atomicAdd(&big_args[3], 1u);
+    if slot < r.big_capacity {
+        atomicMax(&big_args[0], slot + 1u);
+        big_triangles[slot] = BigTriangle(
+            vec4<i32>(s.v0, s.v1),
+            vec4<i32>(s.v2, bitcast<i32>(key), 0),
+            vec4<f32>(s.z, s.area),
+        );
+        return;
     }
     cover_box(s, box, vec2<i32>(0), 1);
 }
