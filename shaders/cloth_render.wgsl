@@ -87,7 +87,7 @@ struct Flat {
 };
 
 // Debug: one point per particle (cyan), or one line end per index; the instance index is the
-// spring kind: 0 structural (blue), 1 shear (green), 2 distance-2 diagonal (red).
+// spring kind: 0 structural (blue), 1 shear (green), 2 bend, two along a grid line (red).
 @vertex
 fn vs_debug(@builtin(vertex_index) particle: u32, @builtin(instance_index) kind: u32) -> Flat {
     let colors = array<vec4<f32>, 4>(

@@ -4,7 +4,7 @@
 use super::ClothUniforms;
 
 const OFFSETS: [(i32, i32); 12] =
-    [(-1, -1), (0, -1), (1, -1), (1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-2, -2), (2, -2), (2, 2), (-2, 2)];
+    [(-1, -1), (0, -1), (1, -1), (1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-2, 0), (2, 0), (0, -2), (0, 2)];
 
 /// One explicit Verlet substep: (previous, current) → next, the wind pushing along `normals`
 /// (the normals buffer as the last clock step left it).

@@ -222,10 +222,10 @@ fn index_buffer(device: &wgpu::Device, label: &str, indices: &[u32]) -> wgpu::Bu
     })
 }
 
-/// Line indices of every spring, grouped by kind: structural, shear, distance-2 diagonal; each
+/// Line indices of every spring, grouped by kind: structural, shear, bend (two along); each
 /// spring once, all inside the grid (the sample's debug lists ran past the border).
 fn spring_lines(device: &wgpu::Device, res: u32) -> (wgpu::Buffer, [std::ops::Range<u32>; 3]) {
-    let kinds: [&[(i32, i32)]; 3] = [&[(1, 0), (0, 1)], &[(1, 1), (-1, 1)], &[(2, 2), (-2, 2)]];
+    let kinds: [&[(i32, i32)]; 3] = [&[(1, 0), (0, 1)], &[(1, 1), (-1, 1)], &[(2, 0), (0, 2)]];
     let mut indices = Vec::new();
     let mut ranges: [std::ops::Range<u32>; 3] = Default::default();
     for (k, offsets) in kinds.iter().enumerate() {
