@@ -39,7 +39,8 @@ struct BigTriangle {
 @group(2) @binding(0) var<uniform> r: Raster;
 @group(2) @binding(1) var<storage, read_write> visibility: array<atomic<u64>>;
 @group(2) @binding(2) var<storage, read_write> big_triangles: array<BigTriangle>;
-// The queue's dispatch (x, 1, 1) and its length (zeroed before each frame; x ≤ capacity).
+// The queue's dispatch (x, 1, 1) and its length (x and the length zeroed before each frame;
+// x ≤ capacity).
 @group(2) @binding(3) var<storage, read_write> big_args: array<atomic<u32>>;
 @group(2) @binding(4) var<storage, read> visibility_in: array<u64>;
 @group(2) @binding(5) var image: texture_storage_2d<rgba16float, write>;
@@ -246,10 +247,6 @@ fn raster(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups)
     let triangle = id.y * groups.x * 64u + id.x;
     if triangle >= offsets_in[u.patch_count] {
         return;
-    }
-    if triangle == 0u {
-        atomicStore(&big_args[1], 1u);
-        atomicStore(&big_args[2], 1u);
     }
     let t = refined_triangle(triangle);
     var clip: array<vec4<f32>, 3>;

@@ -139,12 +139,15 @@ impl ComputeRaster {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        let big_args = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("tessellation_big_args"),
-            size: 16,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        // (x, y, z, count): y and z stay 1; x and the count are zeroed before each frame.
+        let big_args = wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("tessellation_big_args"),
+                contents: bytemuck::cast_slice(&[0u32, 1, 1, 0]),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+            },
+        );
         Ok(Self {
             device: device.clone(),
             raster,
@@ -168,10 +171,11 @@ impl ComputeRaster {
     /// (the caller draws with the pipeline then).
     pub fn prepare(&mut self, queue: &wgpu::Queue, size: (u32, u32), samples: u32, grid: u32) -> bool {
         let key = (size.0, size.1, samples);
+        let limits = self.device.limits();
+        let largest = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         if self.visibility.as_ref().is_none_or(|v| v.key != key) {
             let bytes = u64::from(size.0) * u64::from(size.1) * u64::from(samples) * 8;
-            let limits = self.device.limits();
-            if bytes > limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) {
+            if bytes > largest {
                 return false;
             }
             let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
@@ -181,15 +185,12 @@ impl ComputeRaster {
                 mapped_at_creation: false,
             });
             self.visibility = Some(Visibility { key, buffer, id: crate::graph::next_resource_id() });
-            // Old groups bind the old buffer.
-            self.raster_groups = None;
-            self.resolve_groups = BindGroupCache::default();
+            self.forget_groups();
         }
         if self.corners.as_ref().is_none_or(|c| c.grid != grid) {
             // At most level 64 (4,096 triangles) in each of the 2 grid² patches.
             let bytes = 2 * u64::from(grid * grid) * 4096 * CORNER_BYTES;
-            let limits = self.device.limits();
-            let cached = bytes <= CORNER_BUDGET.min(limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);
+            let cached = bytes <= CORNER_BUDGET.min(largest);
             let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("tessellation_corners"),
                 size: if cached { bytes } else { CORNER_BYTES },
@@ -197,8 +198,7 @@ impl ComputeRaster {
                 mapped_at_creation: false,
             });
             self.corners = Some(Corners { grid, buffer, cached });
-            self.raster_groups = None;
-            self.resolve_groups = BindGroupCache::default();
+            self.forget_groups();
         }
         self.resolve_groups.begin_frame();
         let cached = u32::from(self.corners.as_ref().is_some_and(|c| c.cached));
@@ -206,6 +206,12 @@ impl ComputeRaster {
             RasterUniforms { width: size.0, height: size.1, samples, big_capacity: BIG_CAPACITY, cached, _pad: [0; 3] };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
         true
+    }
+
+    /// Drops the bind groups: they bind a buffer just replaced.
+    fn forget_groups(&mut self) {
+        self.raster_groups = None;
+        self.resolve_groups = BindGroupCache::default();
     }
 
     /// Group 2 of `raster` and of `raster_big` (which reads the queue's arguments as its
@@ -244,7 +250,8 @@ impl ComputeRaster {
         }
         let groups = self.raster_groups.as_ref().expect("made above");
         encoder.clear_buffer(&visibility.buffer, 0, None);
-        encoder.clear_buffer(&self.big_args, 0, None);
+        encoder.clear_buffer(&self.big_args, 0, Some(4));
+        encoder.clear_buffer(&self.big_args, 12, Some(4));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("tessellation/raster"),
             timestamp_writes: None,

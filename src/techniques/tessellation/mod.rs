@@ -29,7 +29,7 @@ pub use params::{
 use std::cell::RefCell;
 
 use crate::gpu::{BindGroupCache, ComputeKernel, ShaderError, storage_entry as storage};
-use crate::graph::{BufferHandle, FrameGraph, PassContext, RasterTargets, TextureDesc, TextureHandle};
+use crate::graph::{BufferHandle, FrameGraph, PassBuilder, PassContext, RasterTargets, TextureDesc, TextureHandle};
 use crate::params::ParamSet;
 use crate::time::FrameTime;
 
@@ -349,7 +349,7 @@ impl Tessellation {
         pass.draw_indirect(&b.args.0, 0);
     }
 
-    /// Records the compute draw's coverage (`resolve` false) or its shading into `image`.
+    /// Records the compute draw's coverage (`image` None) or its shading into `image`.
     fn record_compute_draw(&self, ctx: &mut PassContext<'_>, height: TextureHandle, image: Option<TextureHandle>) {
         let (Some(b), Some(raster)) = (&self.buffers, &self.compute_raster) else { return };
         let mesh = self.draw_group(ctx, height, b);
@@ -414,19 +414,15 @@ impl Technique for Tessellation {
                 this.patches.dispatch(&mut pass, &[&b.compute_group], [patches, 1, 1]);
                 this.scan.dispatch(&mut pass, &[&b.compute_group], [256, 1, 1]);
             });
+        // Both draws read the input and the refined mesh's tables.
+        let mesh = [factors, levels, offsets, args];
         if this.drew_in_compute {
             let raster = this.compute_raster.as_ref().expect("drawn in compute").borrow();
             let (buffer, id) = raster.visibility().expect("prepared");
             let visibility = graph.import_buffer("tessellation/visibility", buffer, id);
             drop(raster);
             let image = graph.create_texture("tessellation/image", TextureDesc::full(FORMAT));
-            graph
-                .add_pass("tessellation/raster")
-                .read(height)
-                .read_buffer(factors)
-                .read_buffer(levels)
-                .read_buffer(offsets)
-                .read_buffer(args)
+            reading_mesh(graph.add_pass("tessellation/raster"), height, mesh)
                 .write_buffer(visibility)
                 .record(move |ctx| this.record_compute_draw(ctx, height, None));
             graph
@@ -437,16 +433,9 @@ impl Technique for Tessellation {
                 .record(move |ctx| this.record_compute_draw(ctx, height, Some(image)));
             return image;
         }
-        let samples = if params.choice("msaa") == 1 { this.samples } else { 1 };
         let targets = graph.create_raster_targets("tessellation", FORMAT, Some(DEPTH), samples);
         let clear = u.background;
-        graph
-            .add_pass("tessellation/draw")
-            .read(height)
-            .read_buffer(factors)
-            .read_buffer(levels)
-            .read_buffer(offsets)
-            .read_buffer(args)
+        reading_mesh(graph.add_pass("tessellation/draw"), height, mesh)
             .draws_into(&targets)
             .record(move |ctx| this.record_draw(ctx, height, &targets, clear));
         targets.color
@@ -469,6 +458,15 @@ impl Technique for Tessellation {
             if self.drew_in_compute { "compute (visibility buffer)" } else { "the raster pipeline" }
         )]
     }
+}
+
+/// `pass` reading the input `height` and the refined mesh's tables, as both draws do.
+fn reading_mesh<'g, 'r>(
+    pass: PassBuilder<'g, 'r>,
+    height: TextureHandle,
+    mesh: [BufferHandle; 4],
+) -> PassBuilder<'g, 'r> {
+    mesh.into_iter().fold(pass.read(height), PassBuilder::read_buffer)
 }
 
 /// The UV (0–1, y up) of the undisplaced plane under a pointer at `view` (0–1 on the output, y
