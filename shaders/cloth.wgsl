@@ -13,7 +13,13 @@
 // Wind pushes along the local normal (see `wind_at`). Positions are vec4: xyz, w = inverse mass
 // (0 = pinned). Each substep is one dispatch of 16x16 workgroups over the res x res grid that
 // stages a 20x20 tile (a halo of 2) in workgroup memory, so each of the 12 neighbour reads is
-// local; the normals for drawing run one invocation per particle.
+// local; the normals for drawing run one invocation per particle, once per frame, and check the
+// positions for a blow-up there.
+//
+// The substep is bound by memory latency, not bandwidth (H200, 1024^2: 41-45 us with its global
+// reads issued a few at a time, 26-32 us with all of them in flight at once; a copy of the same
+// bytes takes 12 us). So every invocation issues all its global reads - both of its tile slots,
+// its own previous position and normal, the attachment anchors - before it uses any of them.
 
 struct ClothUniforms {
     res: u32,            // particles per side
@@ -38,7 +44,7 @@ struct ClothUniforms {
 @group(0) @binding(2) var<storage, read> cur: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> next: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read_write> status: array<atomic<u32>>;
-// Vertex normals, written once per clock step after the substeps (for drawing, and for the
+// Vertex normals, written once per frame after its substeps (for drawing, and for the
 // wind of the next step's substeps).
 @group(0) @binding(5) var<storage, read_write> normals: array<vec4<f32>>;
 
@@ -48,17 +54,38 @@ const TILE: u32 = 16u;
 const SPAN: u32 = 20u; // TILE + 2 halo on each side
 var<workgroup> tile: array<vec4<f32>, 400>;
 
-// Loads the workgroup's tile (clamped at the grid border) from `cur`. Call from uniform control
-// flow: every invocation takes part before any returns.
-fn load_tile(local: u32, group: vec2<u32>) -> vec2<i32> {
-    let origin = vec2<i32>(group * TILE) - vec2<i32>(2);
+// Each invocation fills two tile slots: `local` and `local + SECOND` (400 slots, 256 invocations;
+// the second slot of the last 112 lies past the tile and is not stored).
+const SECOND: u32 = TILE * TILE;
+
+fn tile_origin(group: vec2<u32>) -> vec2<i32> {
+    return vec2<i32>(group * TILE) - vec2<i32>(2);
+}
+
+// The particle that tile slot k stages (clamped at the grid border; a slot past the tile stages
+// the last slot's particle, so its read stays in bounds).
+fn tile_source(k: u32, origin: vec2<i32>) -> u32 {
+    let slot = min(k, SPAN * SPAN - 1u);
     let last = vec2<i32>(i32(u.res) - 1);
-    for (var k = local; k < SPAN * SPAN; k = k + TILE * TILE) {
-        let c = clamp(origin + vec2<i32>(i32(k % SPAN), i32(k / SPAN)), vec2<i32>(0), last);
-        tile[k] = cur[u32(c.y) * u.res + u32(c.x)];
+    let c = clamp(origin + vec2<i32>(i32(slot % SPAN), i32(slot / SPAN)), vec2<i32>(0), last);
+    return u32(c.y) * u.res + u32(c.x);
+}
+
+// Stores a staged value in slot k, if the slot is in the tile.
+fn stage(k: u32, value: vec4<f32>) {
+    if (k < SPAN * SPAN) {
+        tile[k] = value;
     }
+}
+
+// Loads the workgroup's tile from `cur`, both slots' reads in flight together. Call from uniform
+// control flow: every invocation takes part before any returns.
+fn load_tile(local: u32, origin: vec2<i32>) {
+    let first = cur[tile_source(local, origin)];
+    let second = cur[tile_source(local + SECOND, origin)];
+    stage(local, first);
+    stage(local + SECOND, second);
     workgroupBarrier();
-    return origin;
 }
 
 fn from_tile(c: vec2<i32>, origin: vec2<i32>) -> vec4<f32> {
@@ -118,17 +145,24 @@ fn tether(p: vec3<f32>, anchor: vec3<f32>, limit: f32) -> vec3<f32> {
     return select(p, anchor + d / len * limit, len > limit);
 }
 
+// The anchors `attach` needs for column x: the column's top-row particle (the top-left corner
+// when the anchors are the corners) and the top-right corner. Read early (see the top).
+fn anchors(x: i32) -> array<vec3<f32>, 2> {
+    let first = select(0u, u32(min(x, i32(u.res) - 1)), u.attachments == 1u);
+    return array<vec3<f32>, 2>(cur[first].xyz, cur[u.res - 1u].xyz);
+}
+
 // Long-range attachments: the top-row pin of the same column (at j rest lengths), or the two
 // top corners (at their rest distances).
-fn attach(p: vec3<f32>, c: vec2<i32>) -> vec3<f32> {
+fn attach(p: vec3<f32>, c: vec2<i32>, anchor: array<vec3<f32>, 2>) -> vec3<f32> {
     let j = f32(c.y);
     if (u.attachments == 1u) {
-        return tether(p, cur[u32(c.x)].xyz, j * u.rest);
+        return tether(p, anchor[0], j * u.rest);
     }
     if (u.attachments == 2u) {
         let far = f32(i32(u.res) - 1 - c.x);
-        let q = tether(p, cur[0].xyz, sqrt(f32(c.x * c.x) + j * j) * u.rest);
-        return tether(q, cur[u.res - 1u].xyz, sqrt(far * far + j * j) * u.rest);
+        let q = tether(p, anchor[0], sqrt(f32(c.x * c.x) + j * j) * u.rest);
+        return tether(q, anchor[1], sqrt(far * far + j * j) * u.rest);
     }
     return p;
 }
@@ -152,7 +186,9 @@ fn collide(p: vec3<f32>) -> vec3<f32> {
     return p;
 }
 
-// Flags a non-finite result so the CPU resets the cloth.
+// Flags a non-finite position so the CPU resets the cloth. Called once per frame from the normals
+// pass, not per substep (where it cost 30% of the Verlet substep): a blown-up particle stays
+// non-finite (NaN and infinity survive every later update), so the end of the frame sees it.
 fn check(p: vec3<f32>) {
     let finite = all(abs(p) < vec3<f32>(1e30)) && all(p == p);
     if (!finite) {
@@ -166,19 +202,22 @@ fn verlet(
     @builtin(local_invocation_index) local: u32,
     @builtin(workgroup_id) group: vec3<u32>,
 ) {
-    let origin = load_tile(local, group.xy);
     let c = vec2<i32>(id.xy);
+    let i = index(min(c, vec2<i32>(i32(u.res) - 1)));
+    let before = prev[i].xyz;
+    let wind = wind_at(i);
+    let origin = tile_origin(group.xy);
+    load_tile(local, origin);
     if (any(id.xy >= vec2<u32>(u.res))) {
         return;
     }
-    let i = index(c);
     let x = from_tile(c, origin);
     if (x.w == 0.0) {
         next[i] = x;
         return;
     }
-    let v = (x.xyz - prev[i].xyz) / u.dt;
-    var force = (u.acceleration.xyz + wind_at(i)) * u.mass - u.damping * v;
+    let v = (x.xyz - before) / u.dt;
+    var force = (u.acceleration.xyz + wind) * u.mass - u.damping * v;
     let p0 = x.xyz;
     force += spring(p0, c, origin, vec2<i32>(-1, -1), SQRT2) + spring(p0, c, origin, vec2<i32>(0, -1), 1.0);
     force += spring(p0, c, origin, vec2<i32>(1, -1), SQRT2) + spring(p0, c, origin, vec2<i32>(1, 0), 1.0);
@@ -186,9 +225,16 @@ fn verlet(
     force += spring(p0, c, origin, vec2<i32>(-1, 1), SQRT2) + spring(p0, c, origin, vec2<i32>(-1, 0), 1.0);
     force += spring(p0, c, origin, vec2<i32>(-2, 0), 2.0) + spring(p0, c, origin, vec2<i32>(2, 0), 2.0);
     force += spring(p0, c, origin, vec2<i32>(0, -2), 2.0) + spring(p0, c, origin, vec2<i32>(0, 2), 2.0);
-    let p = collide(2.0 * x.xyz - prev[i].xyz + force / u.mass * u.dt * u.dt);
-    check(p);
+    let p = collide(2.0 * x.xyz - before + force / u.mass * u.dt * u.dt);
     next[i] = vec4<f32>(p, x.w);
+}
+
+// XPBD's inertial prediction of a particle from its current and previous position and its wind
+// (pinned particles stay).
+fn predict(x: vec4<f32>, before: vec3<f32>, wind: vec3<f32>) -> vec4<f32> {
+    let keep = max(1.0 - u.damping * u.dt, 0.0);
+    let p = x.xyz + (x.xyz - before) * keep + (u.acceleration.xyz + wind) * u.dt * u.dt;
+    return vec4<f32>(select(x.xyz, p, x.w != 0.0), x.w);
 }
 
 // XPBD, one small step in one pass: inertial prediction with gravity and wind, then one Jacobi
@@ -201,22 +247,19 @@ fn xpbd(
     @builtin(local_invocation_index) local: u32,
     @builtin(workgroup_id) group: vec3<u32>,
 ) {
-    let origin = vec2<i32>(group.xy * TILE) - vec2<i32>(2);
-    let last = vec2<i32>(i32(u.res) - 1);
-    let keep = max(1.0 - u.damping * u.dt, 0.0);
-    for (var k = local; k < SPAN * SPAN; k = k + TILE * TILE) {
-        let c = clamp(origin + vec2<i32>(i32(k % SPAN), i32(k / SPAN)), vec2<i32>(0), last);
-        let j = u32(c.y) * u.res + u32(c.x);
-        let x = cur[j];
-        var p = x.xyz;
-        if (x.w != 0.0) {
-            let a = u.acceleration.xyz + wind_at(j);
-            p = x.xyz + (x.xyz - prev[j].xyz) * keep + a * u.dt * u.dt;
-        }
-        tile[k] = vec4<f32>(p, x.w);
-    }
-    workgroupBarrier();
     let c = vec2<i32>(id.xy);
+    let anchor = anchors(c.x);
+    let origin = tile_origin(group.xy);
+    let j = vec2<u32>(tile_source(local, origin), tile_source(local + SECOND, origin));
+    let x0 = cur[j.x];
+    let x1 = cur[j.y];
+    let before0 = prev[j.x].xyz;
+    let before1 = prev[j.y].xyz;
+    let wind0 = wind_at(j.x);
+    let wind1 = wind_at(j.y);
+    stage(local, predict(x0, before0, wind0));
+    stage(local + SECOND, predict(x1, before1, wind1));
+    workgroupBarrier();
     if (any(id.xy >= vec2<u32>(u.res))) {
         return;
     }
@@ -234,8 +277,7 @@ fn xpbd(
     sum += constraint(x, c, origin, vec2<i32>(-2, 0), 2.0, alpha) + constraint(x, c, origin, vec2<i32>(2, 0), 2.0, alpha);
     sum += constraint(x, c, origin, vec2<i32>(0, -2), 2.0, alpha) + constraint(x, c, origin, vec2<i32>(0, 2), 2.0, alpha);
     // Averaging keeps the Jacobi sum from overshooting (Bridson et al. 2003 style).
-    let p = collide(attach(x.xyz + sum.xyz * (1.5 / max(sum.w, 1.0)), c));
-    check(p);
+    let p = collide(attach(x.xyz + sum.xyz * (1.5 / max(sum.w, 1.0)), c, anchor));
     next[i] = vec4<f32>(p, x.w);
 }
 
@@ -247,6 +289,7 @@ fn compute_normals(@builtin(global_invocation_id) id: vec3<u32>) {
     if (i >= u.count) {
         return;
     }
+    check(cur[i].xyz);
     let c = coord(i);
     let last = i32(u.res) - 1;
     let l = cur[index(vec2<i32>(max(c.x - 1, 0), c.y))].xyz;

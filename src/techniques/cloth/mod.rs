@@ -198,8 +198,6 @@ impl Technique for Cloth {
                 };
                 kernel.dispatch(&mut pass, &[&state.bind_groups[&d.key]], grid);
             }
-            drop(pass);
-            state.nan.after_simulate(ctx.encoder, &state.status, &state.status_readback);
         });
         let normals = graph.import_buffer("cloth/normals", &state.normals, state.normals_id);
         let cur = particles[state.cur];
@@ -209,6 +207,9 @@ impl Technique for Cloth {
                 timestamp_writes: None,
             });
             this.kernels.normals.dispatch(&mut pass, &[&state.bind_groups[&state.normals_key()]], [count, 1, 1]);
+            drop(pass);
+            // The normals pass is also where the positions are checked for a blow-up.
+            state.nan.after_check(ctx.encoder, &state.status, &state.status_readback);
         });
         let targets = graph.create_raster_targets("cloth", FORMAT, Some(render::DEPTH), this.renderer.samples);
         let mode = render::DrawMode {

@@ -48,7 +48,7 @@ impl NanWatch {
     }
 
     /// Records the copy of the flag, unless a read is still under way.
-    pub fn after_simulate(&self, encoder: &mut wgpu::CommandEncoder, status: &wgpu::Buffer, readback: &wgpu::Buffer) {
+    pub fn after_check(&self, encoder: &mut wgpu::CommandEncoder, status: &wgpu::Buffer, readback: &wgpu::Buffer) {
         if self.stage.load(Ordering::Acquire) == IDLE {
             encoder.copy_buffer_to_buffer(status, 0, readback, 0, 4);
             self.stage.store(COPIED, Ordering::Release);
