@@ -11,15 +11,17 @@
 //             Mueller 2012]: no particle farther from its pins than its rest distance, which a
 //             Jacobi sweep (one row per substep) cannot achieve on a tall hanging cloth.
 // Wind pushes along the local normal (see `wind_at`). Positions are vec4: xyz, w = inverse mass
-// (0 = pinned). Each substep is one dispatch of 16x16 workgroups over the res x res grid that
-// stages a 20x20 tile (a halo of 2) in workgroup memory, so each of the 12 neighbour reads is
-// local; the normals for drawing run one invocation per particle, once per frame, and check the
-// positions for a blow-up there.
+// (0 = pinned; every free particle has the same). Each substep is one dispatch of 16x16
+// workgroups over the res x res grid that stages a 20x20 tile (a halo of 2) in workgroup memory,
+// so each of the 12 neighbour reads is local; the normals for drawing run one invocation per
+// particle, once per frame, and check the positions for a blow-up there.
 //
-// The substep is bound by memory latency, not bandwidth (H200, 1024^2: 41-45 us with its global
-// reads issued a few at a time, 26-32 us with all of them in flight at once; a copy of the same
-// bytes takes 12 us). So every invocation issues all its global reads - both of its tile slots,
-// its own previous position and normal, the attachment anchors - before it uses any of them.
+// Speed (H200, 1024^2, us per substep, Verlet / XPBD; a copy of the bytes a substep moves takes
+// 12 us): 45 / 41 with the global reads issued a few at a time and the blow-up check in the
+// substep; 26 / 33 with every read of an invocation in flight at once (both tile slots, its own
+// previous position and normal) and the check once per frame; 24 / 28 with the neighbour tests
+// left out of interior workgroups (see `at_border`). Reading the attachment anchors early too, a
+// packed normal, and normals made from the tile instead of read did not pay.
 
 struct ClothUniforms {
     res: u32,            // particles per side
@@ -107,12 +109,20 @@ fn index(c: vec2<i32>) -> u32 {
 
 const SQRT2: f32 = 1.41421356;
 
-// Verlet: the force of the spring to neighbour c + offset (zero outside the grid). Called once
-// per neighbour with constant arguments: a dynamically indexed constant array would be copied to
-// per-invocation memory by the SPIR-V backend.
-fn spring(x: vec3<f32>, c: vec2<i32>, origin: vec2<i32>, offset: vec2<i32>, factor: f32) -> vec3<f32> {
+// Whether the workgroup's tile reaches past the grid, so that some of its particles miss
+// neighbours. The others (all but the outer ring of workgroups) skip the 12 per-neighbour tests:
+// the substep is bound by instruction issue once its reads are in flight, and the tests were a
+// fifth of the instructions (H200, 1024^2: 26.2 -> 23.6 us Verlet, 32.0 -> 28.2 us XPBD).
+fn at_border(origin: vec2<i32>) -> bool {
+    return any(origin < vec2<i32>(0)) || any(origin + vec2<i32>(i32(SPAN)) > vec2<i32>(i32(u.res)));
+}
+
+// Verlet: the force of the spring to neighbour c + offset (zero outside the grid; `border` as in
+// `at_border`). Called once per neighbour with constant arguments: a dynamically indexed constant
+// array would be copied to per-invocation memory by the SPIR-V backend.
+fn spring(x: vec3<f32>, c: vec2<i32>, origin: vec2<i32>, offset: vec2<i32>, factor: f32, border: bool) -> vec3<f32> {
     let nc = c + offset;
-    if (!inside(nc)) {
+    if (border && !inside(nc)) {
         return vec3<f32>(0.0);
     }
     let d = from_tile(nc, origin).xyz - x;
@@ -123,10 +133,12 @@ fn spring(x: vec3<f32>, c: vec2<i32>, origin: vec2<i32>, offset: vec2<i32>, fact
 }
 
 // XPBD: this particle's correction from the constraint to neighbour c + offset (xyz), and 1 in w
-// if the constraint exists.
-fn constraint(x: vec4<f32>, c: vec2<i32>, origin: vec2<i32>, offset: vec2<i32>, factor: f32, alpha: f32) -> vec4<f32> {
+// if the constraint exists. `weights` holds 1 / (w_self + w_other + alpha) for a free neighbour
+// and for a pinned one: every free particle has the same inverse mass, so these are the only two
+// (a divide per constraint cost 2%).
+fn constraint(x: vec4<f32>, c: vec2<i32>, origin: vec2<i32>, offset: vec2<i32>, factor: f32, weights: vec2<f32>, border: bool) -> vec4<f32> {
     let nc = c + offset;
-    if (!inside(nc)) {
+    if (border && !inside(nc)) {
         return vec4<f32>(0.0);
     }
     let other = from_tile(nc, origin);
@@ -134,7 +146,7 @@ fn constraint(x: vec4<f32>, c: vec2<i32>, origin: vec2<i32>, offset: vec2<i32>, 
     let len2 = dot(d, d);
     let inv = inverseSqrt(max(len2, 1e-18));
     // Delta lambda from zero (one iteration per small step), applied to this particle only.
-    let lambda = -(len2 * inv - factor * u.rest) / (x.w + other.w + alpha);
+    let lambda = -(len2 * inv - factor * u.rest) * select(weights.x, weights.y, other.w == 0.0);
     return vec4<f32>((x.w * lambda * inv) * d, 1.0);
 }
 
@@ -146,7 +158,7 @@ fn tether(p: vec3<f32>, anchor: vec3<f32>, limit: f32) -> vec3<f32> {
 }
 
 // The anchors `attach` needs for column x: the column's top-row particle (the top-left corner
-// when the anchors are the corners) and the top-right corner. Read early (see the top).
+// when the anchors are the corners) and the top-right corner.
 fn anchors(x: i32) -> array<vec3<f32>, 2> {
     let first = select(0u, u32(min(x, i32(u.res) - 1)), u.attachments == 1u);
     return array<vec3<f32>, 2>(cur[first].xyz, cur[u.res - 1u].xyz);
@@ -196,6 +208,19 @@ fn check(p: vec3<f32>) {
     }
 }
 
+// The sum of the 12 spring forces on the particle at c. Called with a constant `border` in each
+// branch of a workgroup-uniform test, so that the compiler drops the neighbour tests inside.
+fn springs(p0: vec3<f32>, c: vec2<i32>, origin: vec2<i32>, border: bool) -> vec3<f32> {
+    var force = vec3<f32>(0.0);
+    force += spring(p0, c, origin, vec2<i32>(-1, -1), SQRT2, border) + spring(p0, c, origin, vec2<i32>(0, -1), 1.0, border);
+    force += spring(p0, c, origin, vec2<i32>(1, -1), SQRT2, border) + spring(p0, c, origin, vec2<i32>(1, 0), 1.0, border);
+    force += spring(p0, c, origin, vec2<i32>(1, 1), SQRT2, border) + spring(p0, c, origin, vec2<i32>(0, 1), 1.0, border);
+    force += spring(p0, c, origin, vec2<i32>(-1, 1), SQRT2, border) + spring(p0, c, origin, vec2<i32>(-1, 0), 1.0, border);
+    force += spring(p0, c, origin, vec2<i32>(-2, 0), 2.0, border) + spring(p0, c, origin, vec2<i32>(2, 0), 2.0, border);
+    force += spring(p0, c, origin, vec2<i32>(0, -2), 2.0, border) + spring(p0, c, origin, vec2<i32>(0, 2), 2.0, border);
+    return force;
+}
+
 @compute @workgroup_size(16, 16, 1)
 fn verlet(
     @builtin(global_invocation_id) id: vec3<u32>,
@@ -219,14 +244,24 @@ fn verlet(
     let v = (x.xyz - before) / u.dt;
     var force = (u.acceleration.xyz + wind) * u.mass - u.damping * v;
     let p0 = x.xyz;
-    force += spring(p0, c, origin, vec2<i32>(-1, -1), SQRT2) + spring(p0, c, origin, vec2<i32>(0, -1), 1.0);
-    force += spring(p0, c, origin, vec2<i32>(1, -1), SQRT2) + spring(p0, c, origin, vec2<i32>(1, 0), 1.0);
-    force += spring(p0, c, origin, vec2<i32>(1, 1), SQRT2) + spring(p0, c, origin, vec2<i32>(0, 1), 1.0);
-    force += spring(p0, c, origin, vec2<i32>(-1, 1), SQRT2) + spring(p0, c, origin, vec2<i32>(-1, 0), 1.0);
-    force += spring(p0, c, origin, vec2<i32>(-2, 0), 2.0) + spring(p0, c, origin, vec2<i32>(2, 0), 2.0);
-    force += spring(p0, c, origin, vec2<i32>(0, -2), 2.0) + spring(p0, c, origin, vec2<i32>(0, 2), 2.0);
+    if (at_border(origin)) {
+        force += springs(p0, c, origin, true);
+    } else {
+        force += springs(p0, c, origin, false);
+    }
     let p = collide(2.0 * x.xyz - before + force / u.mass * u.dt * u.dt);
     next[i] = vec4<f32>(p, x.w);
+}
+
+// The summed corrections of the 12 constraints of the particle at c (as `springs`).
+fn constraints(x: vec4<f32>, c: vec2<i32>, origin: vec2<i32>, weights: vec2<f32>, border: bool) -> vec4<f32> {
+    var sum = constraint(x, c, origin, vec2<i32>(-1, -1), SQRT2, weights, border) + constraint(x, c, origin, vec2<i32>(0, -1), 1.0, weights, border);
+    sum += constraint(x, c, origin, vec2<i32>(1, -1), SQRT2, weights, border) + constraint(x, c, origin, vec2<i32>(1, 0), 1.0, weights, border);
+    sum += constraint(x, c, origin, vec2<i32>(1, 1), SQRT2, weights, border) + constraint(x, c, origin, vec2<i32>(0, 1), 1.0, weights, border);
+    sum += constraint(x, c, origin, vec2<i32>(-1, 1), SQRT2, weights, border) + constraint(x, c, origin, vec2<i32>(-1, 0), 1.0, weights, border);
+    sum += constraint(x, c, origin, vec2<i32>(-2, 0), 2.0, weights, border) + constraint(x, c, origin, vec2<i32>(2, 0), 2.0, weights, border);
+    sum += constraint(x, c, origin, vec2<i32>(0, -2), 2.0, weights, border) + constraint(x, c, origin, vec2<i32>(0, 2), 2.0, weights, border);
+    return sum;
 }
 
 // XPBD's inertial prediction of a particle from its current and previous position and its wind
@@ -248,7 +283,6 @@ fn xpbd(
     @builtin(workgroup_id) group: vec3<u32>,
 ) {
     let c = vec2<i32>(id.xy);
-    let anchor = anchors(c.x);
     let origin = tile_origin(group.xy);
     let j = vec2<u32>(tile_source(local, origin), tile_source(local + SECOND, origin));
     let x0 = cur[j.x];
@@ -270,14 +304,15 @@ fn xpbd(
         return;
     }
     let alpha = u.compliance / (u.dt * u.dt);
-    var sum = constraint(x, c, origin, vec2<i32>(-1, -1), SQRT2, alpha) + constraint(x, c, origin, vec2<i32>(0, -1), 1.0, alpha);
-    sum += constraint(x, c, origin, vec2<i32>(1, -1), SQRT2, alpha) + constraint(x, c, origin, vec2<i32>(1, 0), 1.0, alpha);
-    sum += constraint(x, c, origin, vec2<i32>(1, 1), SQRT2, alpha) + constraint(x, c, origin, vec2<i32>(0, 1), 1.0, alpha);
-    sum += constraint(x, c, origin, vec2<i32>(-1, 1), SQRT2, alpha) + constraint(x, c, origin, vec2<i32>(-1, 0), 1.0, alpha);
-    sum += constraint(x, c, origin, vec2<i32>(-2, 0), 2.0, alpha) + constraint(x, c, origin, vec2<i32>(2, 0), 2.0, alpha);
-    sum += constraint(x, c, origin, vec2<i32>(0, -2), 2.0, alpha) + constraint(x, c, origin, vec2<i32>(0, 2), 2.0, alpha);
+    let weights = vec2<f32>(1.0 / (x.w + x.w + alpha), 1.0 / (x.w + alpha));
+    var sum: vec4<f32>;
+    if (at_border(origin)) {
+        sum = constraints(x, c, origin, weights, true);
+    } else {
+        sum = constraints(x, c, origin, weights, false);
+    }
     // Averaging keeps the Jacobi sum from overshooting (Bridson et al. 2003 style).
-    let p = collide(attach(x.xyz + sum.xyz * (1.5 / max(sum.w, 1.0)), c, anchor));
+    let p = collide(attach(x.xyz + sum.xyz * (1.5 / max(sum.w, 1.0)), c, anchors(c.x)));
     next[i] = vec4<f32>(p, x.w);
 }
 
