@@ -20,14 +20,15 @@
 // 12 us): 45 / 41 with the global reads issued a few at a time and the blow-up check in the
 // substep; 26 / 33 with every read of an invocation in flight at once (both tile slots, its own
 // previous position and normal) and the check once per frame; 24 / 28 with the neighbour tests
-// left out of interior workgroups (see `at_border`). Reading the attachment anchors early too, a
-// packed normal, and normals made from the tile instead of read did not pay.
+// left out of interior workgroups (see `at_border`); XPBD 29 with the fabric's bending on. Reading
+// the attachment anchors early too, a packed normal, and normals made from the tile instead of
+// read did not pay.
 
 struct ClothUniforms {
     res: u32,            // particles per side
     count: u32,          // res * res
     solver: u32,         // 0 verlet, 1 xpbd
-    _pad0: u32,
+    bending: f32,        // xpbd: share of the way to the neighbours' mean per substep (0 = off)
     dt: f32,             // substep length, seconds
     rest: f32,           // structural rest length
     stiffness: f32,      // verlet spring constant k (N/m)
@@ -253,6 +254,17 @@ fn verlet(
     next[i] = vec4<f32>(p, x.w);
 }
 
+// XPBD bending along one grid line: the offset from the particle to the midpoint of its two
+// neighbours on the line (offset and -offset), and 1 in w if both exist. See `bending_share` in
+// params.rs for the model.
+fn bend(x: vec3<f32>, c: vec2<i32>, origin: vec2<i32>, offset: vec2<i32>, border: bool) -> vec4<f32> {
+    if (border && !(inside(c - offset) && inside(c + offset))) {
+        return vec4<f32>(0.0);
+    }
+    let mid = 0.5 * (from_tile(c - offset, origin).xyz + from_tile(c + offset, origin).xyz);
+    return vec4<f32>(mid - x, 1.0);
+}
+
 // The summed corrections of the 12 constraints of the particle at c (as `springs`).
 fn constraints(x: vec4<f32>, c: vec2<i32>, origin: vec2<i32>, weights: vec2<f32>, border: bool) -> vec4<f32> {
     var sum = constraint(x, c, origin, vec2<i32>(-1, -1), SQRT2, weights, border) + constraint(x, c, origin, vec2<i32>(0, -1), 1.0, weights, border);
@@ -262,6 +274,19 @@ fn constraints(x: vec4<f32>, c: vec2<i32>, origin: vec2<i32>, weights: vec2<f32>
     sum += constraint(x, c, origin, vec2<i32>(-2, 0), 2.0, weights, border) + constraint(x, c, origin, vec2<i32>(2, 0), 2.0, weights, border);
     sum += constraint(x, c, origin, vec2<i32>(0, -2), 2.0, weights, border) + constraint(x, c, origin, vec2<i32>(0, 2), 2.0, weights, border);
     return sum;
+}
+
+// XPBD's projection of the particle at c: the averaged corrections of its 12 constraints, then
+// its bending (as `springs` for `border`).
+fn project(x: vec4<f32>, c: vec2<i32>, origin: vec2<i32>, weights: vec2<f32>, border: bool) -> vec3<f32> {
+    let sum = constraints(x, c, origin, weights, border);
+    // Averaging keeps the Jacobi sum from overshooting (Bridson et al. 2003 style).
+    var p = x.xyz + sum.xyz * (1.5 / max(sum.w, 1.0));
+    if (u.bending > 0.0) {
+        let fold = bend(x.xyz, c, origin, vec2<i32>(1, 0), border) + bend(x.xyz, c, origin, vec2<i32>(0, 1), border);
+        p += fold.xyz * (u.bending / max(fold.w, 1.0));
+    }
+    return p;
 }
 
 // XPBD's inertial prediction of a particle from its current and previous position and its wind
@@ -305,14 +330,13 @@ fn xpbd(
     }
     let alpha = u.compliance / (u.dt * u.dt);
     let weights = vec2<f32>(1.0 / (x.w + x.w + alpha), 1.0 / (x.w + alpha));
-    var sum: vec4<f32>;
+    var p: vec3<f32>;
     if (at_border(origin)) {
-        sum = constraints(x, c, origin, weights, true);
+        p = project(x, c, origin, weights, true);
     } else {
-        sum = constraints(x, c, origin, weights, false);
+        p = project(x, c, origin, weights, false);
     }
-    // Averaging keeps the Jacobi sum from overshooting (Bridson et al. 2003 style).
-    let p = collide(attach(x.xyz + sum.xyz * (1.5 / max(sum.w, 1.0)), c, anchors(c.x)));
+    p = collide(attach(p, c, anchors(c.x)));
     next[i] = vec4<f32>(p, x.w);
 }
 
