@@ -1,6 +1,10 @@
 // Poisson disk samples [UGP4 ch.7] as instanced camera-facing quads: flat discs (2-D, seen from
 // above) or sphere impostors lit by one light (3-D). Colour follows insertion order along a
-// blue-magenta-yellow ramp, so the growth front reads as the brightest samples.
+// blue-magenta-yellow ramp, so the growth front reads as the brightest samples. A disc's rim is
+// cut here, not by the rasterizer, so the fragment shader works out which of the pixel's samples
+// the disc covers: multisampling then smooths the rim as it does a triangle's edge (a discard
+// would drop every sample of the pixel and leave the rim stair-stepped).
+// extends: msaa_samples.wgsl
 
 struct PoissonUniforms {
     view_proj: mat4x4<f32>,
@@ -9,7 +13,7 @@ struct PoissonUniforms {
     draw_radius: f32,       // radius of each drawn disc or sphere (world units)
     count: f32,             // samples so far
     spheres: u32,           // 0: discs, 1: lit spheres
-    _pad: f32,
+    samples: u32,           // samples per pixel of the draw
 };
 
 @group(0) @binding(0) var<uniform> u: PoissonUniforms;
@@ -44,12 +48,34 @@ fn ramp(t: f32) -> vec3<f32> {
     return pow(srgb, vec3<f32>(2.2));
 }
 
+struct FragmentOut {
+    @location(0) color: vec4<f32>,
+    @builtin(sample_mask) coverage: u32,
+};
+
+// The samples of this pixel that the disc covers: the quad coordinates moved to each sample's
+// position by their screen derivatives.
+fn disc_coverage(corner: vec2<f32>, per_x: vec2<f32>, per_y: vec2<f32>) -> u32 {
+    let count = max(u.samples, 1u);
+    var mask = 0u;
+    for (var s = 0u; s < count; s = s + 1u) {
+        let offset = vec2<f32>(sample_offset(count, s)) / 16.0;
+        let at = corner + per_x * offset.x + per_y * offset.y;
+        if (dot(at, at) <= 1.0) {
+            mask = mask | (1u << s);
+        }
+    }
+    return mask;
+}
+
 @fragment
-fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
-    let d2 = dot(in.corner, in.corner);
-    if (d2 > 1.0) {
+fn fs_main(in: VertexOut) -> FragmentOut {
+    let coverage = disc_coverage(in.corner, dpdx(in.corner), dpdy(in.corner));
+    if (coverage == 0u) {
         discard;
     }
+    // The pixel centre may lie just outside a disc some of whose samples it covers.
+    let d2 = min(dot(in.corner, in.corner), 1.0);
     var color = ramp(in.order);
     if (u.spheres == 1u) {
         // Sphere normal in camera space from the quad position; light from upper left, front.
@@ -57,5 +83,5 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
         let light = normalize(vec3<f32>(-0.5, 0.7, -0.6));
         color = color * (0.15 + 0.85 * max(dot(normal, light), 0.0));
     }
-    return vec4<f32>(color, 1.0);
+    return FragmentOut(vec4<f32>(color, 1.0), coverage);
 }

@@ -18,6 +18,9 @@
 //           vertices glide between them instead of popping. The
 //           height is sampled at the point's UV, the surface displaced along the normal, and the
 //           normal recomputed from the height field's gradient.
+//
+// The sample locations, for the compute draw:
+// extends: msaa_samples.wgsl
 
 struct Tess {
     model: mat4x4<f32>,

@@ -58,28 +58,6 @@ const SNAP_LIMIT: f32 = 16777216.0;
 // A triangle whose box holds more pixels than this goes to the queue.
 const INLINE_PIXELS: i32 = 256;
 
-// Sample s of `count` in sixteenths of a pixel from its centre (Vulkan's standard locations). A
-// switch, not an indexed array: the SPIR-V backend would copy an array to per-invocation memory.
-fn sample_offset(count: u32, s: u32) -> vec2<i32> {
-    switch count * 8u + s {
-        case 16u: { return vec2<i32>(4, 4); }
-        case 17u: { return vec2<i32>(-4, -4); }
-        case 32u: { return vec2<i32>(-2, -6); }
-        case 33u: { return vec2<i32>(6, -2); }
-        case 34u: { return vec2<i32>(-6, 2); }
-        case 35u: { return vec2<i32>(2, 6); }
-        case 64u: { return vec2<i32>(1, -3); }
-        case 65u: { return vec2<i32>(-1, 3); }
-        case 66u: { return vec2<i32>(5, 1); }
-        case 67u: { return vec2<i32>(-3, -5); }
-        case 68u: { return vec2<i32>(-5, 5); }
-        case 69u: { return vec2<i32>(-7, -1); }
-        case 70u: { return vec2<i32>(3, 7); }
-        case 71u: { return vec2<i32>(7, -7); }
-        default: { return vec2<i32>(0, 0); }
-    }
-}
-
 // A triangle ready for coverage: corners in sixteenths of a pixel (y down) relative to `origin`,
 // counter-clockwise in that frame (positive area), NDC depths, and 1 + its index in the mesh.
 // Edge functions are translation-invariant in integers, so a triangle measured from its own

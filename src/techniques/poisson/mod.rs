@@ -20,7 +20,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "Bridson Poisson disk samples in 2-D or 3-D, growing step by step",
     params,
     inputs: &[],
-    shaders: &["poisson.wgsl"],
+    shaders: &["poisson.wgsl", "msaa_samples.wgsl"],
     create,
 };
 
@@ -60,8 +60,8 @@ pub struct PoissonUniforms {
     pub count: f32,
     /// 0: flat discs, 1: lit spheres.
     pub spheres: u32,
-    /// Padding.
-    pub _pad: f32,
+    /// Samples per pixel of the draw (the shader cuts each disc's rim per sample).
+    pub samples: u32,
 }
 
 /// What restarts a run when it changes.
@@ -164,8 +164,9 @@ const INSTANCE: u64 = size_of::<[f32; 4]>() as u64;
 
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let device = &setup.gpu.device;
-    let (origin, source) = setup.shader_source("poisson.wgsl", &[("u", 0)])?;
-    let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
+    let shader = setup.joined_shader_source("poisson.wgsl", &[("u", 0)])?;
+    let origin = shader.origin().to_string();
+    let (module, _) = crate::gpu::compile_wgsl(device, &origin, &shader.source).map_err(|e| shader.relocate(e))?;
     let block = crate::gpu::UniformBlock::new::<PoissonUniforms>(device, "poisson_uniforms");
     let samples = setup.samples_for(&[FORMAT, DEPTH]);
     let pipeline = crate::gpu::validated(device, &origin, || {
@@ -258,7 +259,8 @@ impl Technique for Poisson {
 
         let targets = graph.create_raster_targets("poisson", FORMAT, Some(DEPTH), self.samples);
         let (w, h) = graph.texture_size(targets.color);
-        let uniforms = camera(&key, params, time, w as f32 / h as f32, count);
+        let uniforms =
+            PoissonUniforms { samples: self.samples, ..camera(&key, params, time, w as f32 / h as f32, count) };
         let this: &'r Poisson = self;
         graph.add_pass("poisson/draw").draws_into(&targets).record(move |ctx| {
             ctx.queue.write_buffer(&this.block.buffer, 0, bytemuck::bytes_of(&uniforms));
@@ -308,7 +310,7 @@ fn camera(key: &RunKey, params: &ParamSet, time: &FrameTime, aspect: f32, count:
         draw_radius,
         count: count as f32,
         spheres: u32::from(key.three_d),
-        _pad: 0.0,
+        samples: 1,
     }
 }
 
@@ -346,7 +348,9 @@ mod tests {
 
     #[test]
     fn uniform_layout_matches_the_wgsl_struct() {
-        let source = include_str!("../../../shaders/poisson.wgsl");
-        assert_eq!(crate::gpu::wgsl_struct_size(source, "PoissonUniforms"), Some(size_of::<PoissonUniforms>() as u32));
+        let source =
+            [include_str!("../../../shaders/msaa_samples.wgsl"), include_str!("../../../shaders/poisson.wgsl")]
+                .join("\n");
+        assert_eq!(crate::gpu::wgsl_struct_size(&source, "PoissonUniforms"), Some(size_of::<PoissonUniforms>() as u32));
     }
 }

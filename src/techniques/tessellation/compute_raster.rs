@@ -302,6 +302,7 @@ mod tests {
     #[test]
     fn the_uniform_block_matches_the_wgsl_struct() {
         let source = [
+            include_str!("../../../shaders/msaa_samples.wgsl"),
             include_str!("../../../shaders/tessellation.wgsl"),
             include_str!("../../../shaders/tessellation_raster.wgsl"),
         ]

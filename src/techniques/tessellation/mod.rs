@@ -43,7 +43,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "a plane tessellated on the GPU by screen-space edge length and displaced by an input texture",
     params,
     inputs: &["height"],
-    shaders: &["tessellation.wgsl", "tessellation_raster.wgsl"],
+    shaders: &["tessellation.wgsl", "tessellation_raster.wgsl", "msaa_samples.wgsl"],
     create,
 };
 
