@@ -158,24 +158,17 @@ fn tether(p: vec3<f32>, anchor: vec3<f32>, limit: f32) -> vec3<f32> {
     return select(p, anchor + d / len * limit, len > limit);
 }
 
-// The anchors `attach` needs for column x: the column's top-row particle (the top-left corner
-// when the anchors are the corners) and the top-right corner.
-fn anchors(x: i32) -> array<vec3<f32>, 2> {
-    let first = select(0u, u32(min(x, i32(u.res) - 1)), u.attachments == 1u);
-    return array<vec3<f32>, 2>(cur[first].xyz, cur[u.res - 1u].xyz);
-}
-
 // Long-range attachments: the top-row pin of the same column (at j rest lengths), or the two
 // top corners (at their rest distances).
-fn attach(p: vec3<f32>, c: vec2<i32>, anchor: array<vec3<f32>, 2>) -> vec3<f32> {
+fn attach(p: vec3<f32>, c: vec2<i32>) -> vec3<f32> {
     let j = f32(c.y);
     if (u.attachments == 1u) {
-        return tether(p, anchor[0], j * u.rest);
+        return tether(p, cur[u32(c.x)].xyz, j * u.rest);
     }
     if (u.attachments == 2u) {
         let far = f32(i32(u.res) - 1 - c.x);
-        let q = tether(p, anchor[0], sqrt(f32(c.x * c.x) + j * j) * u.rest);
-        return tether(q, anchor[1], sqrt(far * far + j * j) * u.rest);
+        let q = tether(p, cur[0].xyz, sqrt(f32(c.x * c.x) + j * j) * u.rest);
+        return tether(q, cur[u.res - 1u].xyz, sqrt(far * far + j * j) * u.rest);
     }
     return p;
 }
@@ -336,7 +329,7 @@ fn xpbd(
     } else {
         p = project(x, c, origin, weights, false);
     }
-    p = collide(attach(p, c, anchors(c.x)));
+    p = collide(attach(p, c));
     next[i] = vec4<f32>(p, x.w);
 }
 

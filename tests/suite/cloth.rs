@@ -197,10 +197,10 @@ fn golden_cloth_1024_at_ci_resolution() {
     golden_frames("cloth_1024", &[20, 60], &CLOTH_256);
 }
 
-/// A simulation rig of `cloth_1024` at 256² ([`CLOTH_256`]).
-fn cloth_256_rig() -> Runner {
+/// A simulation rig of `cloth_1024` at 256² ([`CLOTH_256`]), then `sets`.
+fn cloth_256_rig(sets: &[&str]) -> Runner {
     let mut scene = load_scene(&common::assets(), "cloth_1024").unwrap();
-    for set in CLOTH_256 {
+    for set in CLOTH_256.iter().chain(sets) {
         scene.set_from_str(set).unwrap();
     }
     runner(common::gpu(), &common::assets(), scene.nodes[0].params.clone(), scene.dt).unwrap()
@@ -212,7 +212,7 @@ fn a_hanging_cloth_in_gusty_wind_stays_smooth() {
     // the inextensible grid (no bending stiffness) answered with diagonal wrinkles a few
     // particles wide under the pinned row, growing with the gusts (roughness 0.025 in the top
     // quarter at 1 s, 0.0038 at 0.67 s). Wind along the normal leaves it smooth (0.0023).
-    let mut rig = cloth_256_rig();
+    let mut rig = cloth_256_rig(&[]);
     for second in 0..2 {
         rig.run(30);
         let top = roughness(&rig.node.positions(), 256, 0.02, 0..64);
@@ -254,12 +254,7 @@ fn bending_stiffness_smooths_a_blown_sheet() {
     // `examples/cloth_roughness`: roughness 0.031 after 10 s, 0.0038 with the scene's 0.003 N·m).
     // At 256² the same stiffness acts more weakly, so the test takes a stiff fabric.
     let roughness_after_2_s = |bending: &str| {
-        let mut scene = load_scene(&common::assets(), "cloth_1024").unwrap();
-        for set in CLOTH_256 {
-            scene.set_from_str(set).unwrap();
-        }
-        scene.set_from_str(&format!("cloth.bending={bending}")).unwrap();
-        let mut rig = runner(common::gpu(), &common::assets(), scene.nodes[0].params.clone(), scene.dt).unwrap();
+        let mut rig = cloth_256_rig(&[&format!("cloth.bending={bending}")]);
         rig.run(120);
         roughness(&rig.node.positions(), 256, 0.02, 0..256)
     };
@@ -273,7 +268,7 @@ fn a_cloth_blowing_for_seconds_does_not_crumple() {
     // resist a fold along a row, so after a few seconds of gusts the sheet crumpled into
     // grid-scale wrinkles (roughness of the whole sheet 0.0012, 0.0026, 0.0071 after 1, 2, 3 s).
     // Bend springs along the grid lines keep it smooth (0.0011, 0.0014, 0.0021).
-    let mut rig = cloth_256_rig();
+    let mut rig = cloth_256_rig(&[]);
     for second in 1..=3 {
         rig.run(60);
         let whole = roughness(&rig.node.positions(), 256, 0.02, 0..256);

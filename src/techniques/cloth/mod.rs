@@ -13,10 +13,7 @@ mod render;
 pub mod runner;
 mod state;
 
-pub use params::{
-    ClothUniforms, MAX_BENDING_SHARE, PIN_MODES, SOLVERS, VIEWS, bending_share, params, rest_pose, sphere_center,
-    wind_force,
-};
+pub use params::{ClothUniforms, PIN_MODES, SOLVERS, VIEWS, params, rest_pose, sphere_center, wind_force};
 use render::{ClothView, Renderer};
 use state::State;
 

@@ -1,5 +1,5 @@
 //! A cloth node driven headless (see [`crate::techniques::runner`]) and the strain and roughness
-//! measures the tests and `examples/cloth_strain` read from it.
+//! measures the tests, `examples/cloth_strain` and `examples/cloth_roughness` read from it.
 
 use super::Cloth;
 use crate::gpu::{Gpu, ShaderError};

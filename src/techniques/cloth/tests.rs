@@ -1,3 +1,4 @@
+use super::params::{MAX_BENDING_SHARE, bending_share};
 use super::*;
 
 #[test]

@@ -259,8 +259,7 @@ impl Technique for Poisson {
 
         let targets = graph.create_raster_targets("poisson", FORMAT, Some(DEPTH), self.samples);
         let (w, h) = graph.texture_size(targets.color);
-        let uniforms =
-            PoissonUniforms { samples: self.samples, ..camera(&key, params, time, w as f32 / h as f32, count) };
+        let uniforms = camera(&key, params, time, w as f32 / h as f32, count, self.samples);
         let this: &'r Poisson = self;
         graph.add_pass("poisson/draw").draws_into(&targets).record(move |ctx| {
             ctx.queue.write_buffer(&this.block.buffer, 0, bytemuck::bytes_of(&uniforms));
@@ -281,7 +280,14 @@ impl Technique for Poisson {
 /// 2-D: orthographic, top-down, the rectangle fitted with a 5% margin. 3-D: perspective (60°),
 /// orbiting the box slightly from above, far enough that the box's bounding sphere (and the
 /// spheres drawn at its corners) fits the narrower field of view at every angle.
-fn camera(key: &RunKey, params: &ParamSet, time: &FrameTime, aspect: f32, count: usize) -> PoissonUniforms {
+fn camera(
+    key: &RunKey,
+    params: &ParamSet,
+    time: &FrameTime,
+    aspect: f32,
+    count: usize,
+    samples: u32,
+) -> PoissonUniforms {
     use glam::Vec3;
     let draw_radius = key.radius * params.float("draw_scale") / 2.0;
     let (view_proj, right, up) = if key.three_d {
@@ -310,7 +316,7 @@ fn camera(key: &RunKey, params: &ParamSet, time: &FrameTime, aspect: f32, count:
         draw_radius,
         count: count as f32,
         spheres: u32::from(key.three_d),
-        samples: 1,
+        samples,
     }
 }
 
@@ -327,7 +333,7 @@ mod tests {
         for aspect in [16.0 / 9.0, 1.0, 9.0 / 16.0] {
             for frame in (0..7200).step_by(50) {
                 let time = FrameTime { frame, seconds: frame as f64 / 60.0, dt: 1.0 / 60.0, seed: 1 };
-                let u = camera(&key, &p, &time, aspect, 0);
+                let u = camera(&key, &p, &time, aspect, 0, 1);
                 let view_proj = glam::Mat4::from_cols_array_2d(&u.view_proj);
                 for corner in 0..8 {
                     let c = glam::Vec3::new(

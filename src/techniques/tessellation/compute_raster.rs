@@ -89,43 +89,38 @@ impl ComputeRaster {
         layouts: [&wgpu::BindGroupLayout; 2],
     ) -> Result<Self, ShaderError> {
         let compute = wgpu::ShaderStages::COMPUTE;
-        let raster_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("tessellation_raster_layout"),
-            entries: &[
-                crate::gpu::uniform_entry::<RasterUniforms>(0, compute),
+        // Group 2 of each kernel: the raster uniforms at binding 0, then `entries`.
+        let group_layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
+            let uniforms = crate::gpu::uniform_entry::<RasterUniforms>(0, compute);
+            let entries: Vec<_> = std::iter::once(uniforms).chain(entries.iter().copied()).collect();
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
+        };
+        let raster_layout = group_layout(
+            "tessellation_raster_layout",
+            &[
                 storage(1, compute, false),
                 storage(2, compute, false),
                 storage(3, compute, false),
                 storage(6, compute, false),
             ],
-        });
+        );
         // The queue's kernel reads big_args as its dispatch, so it may not bind them too.
-        let big_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("tessellation_raster_big_layout"),
-            entries: &[
-                crate::gpu::uniform_entry::<RasterUniforms>(0, compute),
-                storage(1, compute, false),
-                storage(2, compute, false),
-            ],
-        });
-        let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("tessellation_resolve_layout"),
-            entries: &[
-                crate::gpu::uniform_entry::<RasterUniforms>(0, compute),
-                storage(4, compute, true),
-                storage(7, compute, true),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: compute,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: FORMAT,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
-            ],
-        });
+        let big_layout =
+            group_layout("tessellation_raster_big_layout", &[storage(1, compute, false), storage(2, compute, false)]);
+        let output = wgpu::BindGroupLayoutEntry {
+            binding: 5,
+            visibility: compute,
+            ty: wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format: FORMAT,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
+            count: None,
+        };
+        let resolve_layout = group_layout(
+            "tessellation_resolve_layout",
+            &[storage(4, compute, true), storage(7, compute, true), output],
+        );
         let kernel = |entry, group: &wgpu::BindGroupLayout| {
             ComputeKernel::new(device, shader.origin(), &shader.source, entry, &[layouts[0], layouts[1], group])
                 .map_err(|e| shader.relocate(e))
