@@ -1,7 +1,8 @@
 //! Bridging holes into their outer ring [UGP4 ch.5, after Eberly, "Triangulation by Ear
-//! Clipping" §3]: holes are taken right to left by their rightmost vertex M; a ray from M to +x
-//! finds the nearest outer edge, and the bridge goes to the visible vertex that makes the
-//! smallest angle with the ray. Cutting along the bridge (both ends duplicated) turns an outer
+//! Clipping" §3, mirrored as in earcut]: holes are taken left to right by their leftmost vertex
+//! M; a ray from M to −x finds the nearest outer edge, and the bridge goes to the visible vertex
+//! that makes the smallest angle with the ray. (The book and Eberly go right to left; the
+//! mirror image merges rings exactly as earcut does, so the two cut crossing input alike.) Cutting along the bridge (both ends duplicated) turns an outer
 //! ring with holes into one weakly simple ring.
 //!
 //! With many holes, walking the whole merged ring per hole is O(holes × vertices); above
@@ -70,13 +71,18 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
         return outer;
     }
     for hole in holes.iter_mut() {
-        *hole = rightmost(rings, *hole);
+        *hole = leftmost(rings, *hole);
     }
-    // Right first: every hole to the right of the current one is already part of the outer ring,
-    // so its ray can only meet the outer ring.
+    // Left first: every hole to the left of the current one is already part of the outer ring,
+    // so its ray can only meet the outer ring. Holes whose leftmost points meet go in order of
+    // their first edge's slope (counter-clockwise), so each bridges at the shared point.
     holes.sort_unstable_by(|&a, &b| {
         let (na, nb) = (rings.get(a), rings.get(b));
-        nb.x.total_cmp(&na.x).then(na.y.total_cmp(&nb.y)).then(a.cmp(&b))
+        let slope = |n: &super::linked::Node| {
+            let next = rings.get(n.next);
+            (next.y - n.y) / (next.x - n.x)
+        };
+        na.x.total_cmp(&nb.x).then(na.y.total_cmp(&nb.y)).then(slope(na).total_cmp(&slope(nb))).then(a.cmp(&b))
     });
     let banded = holes.len() >= BANDS_FROM_HOLES;
     if banded {
@@ -114,12 +120,17 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
             rings.touched = touched;
         }
         touching.add_ring(rings, hole);
+        let one_point = rings.next(hole) == hole;
         let reverse = rings.split(bridge, hole);
+        // A hole bridged to a Steiner point: the copy of the point stays one too. Filtered away
+        // as collinear, it would leave the point on the edge that replaced it, a vertex of the
+        // triangles on one side only. (Not the copy of a one-point hole: two copies of a point
+        // that may not go would block every ear at it.)
+        let bridge_copy = rings.next(reverse);
+        rings.nodes[bridge_copy as usize].steiner = rings.get(bridge).steiner && !one_point;
         touching.add(rings, reverse);
         touching.add(rings, rings.next(reverse));
-        // Tidy collinear points around both cuts.
-        rings.filter(reverse, rings.next(reverse));
-        outer = rings.filter(bridge, rings.next(bridge));
+        outer = heal_bridge(rings, bridge, reverse, hole);
         if banded {
             // New edges: the hole's, both bridge edges, and those the filters shortened.
             for p in [bridge, reverse, rings.next(reverse), rings.prev(reverse)] {
@@ -138,6 +149,20 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
     rings.recording = false;
     // Bridges line up with edges often enough that a pass over the merged ring pays off.
     rings.filter(outer, NIL)
+}
+
+/// Tidies collinear and repeated points around the two new edges of a bridge (`bridge` on the
+/// outer ring, `reverse` the copy of the hole's point after it); returns a node of the ring.
+/// The copy of the bridge's point ahead of the hole is left alone: dropped as collinear, it
+/// would leave the bridge's point lying on the healed edge, where a later hole could bridge
+/// into it from outside its corner. Likewise the bridge's own point, when it lies strictly
+/// between its predecessor and the hole.
+fn heal_bridge(rings: &mut Rings, bridge: u32, reverse: u32, hole: u32) -> u32 {
+    rings.filter(rings.prev(reverse), reverse);
+    let (before, at, to) = (rings.get(rings.prev(bridge)), rings.get(bridge), rings.get(hole));
+    let between = super::linked::area(before, at, to) == 0.0
+        && (before.x - at.x) * (to.x - at.x) + (before.y - at.y) * (to.y - at.y) < 0.0;
+    if between { bridge } else { rings.filter(bridge, rings.next(bridge)) }
 }
 
 /// Points that two or more input rings share (holes touching each other or the outer ring), and
@@ -233,13 +258,13 @@ fn corner_holds(rings: &Rings, q: u32, h: u32) -> bool {
     hole_in < hole_out && hole_out <= ring_in
 }
 
-/// The node of a ring with the largest x (lowest y among ties).
-fn rightmost(rings: &Rings, start: u32) -> u32 {
+/// The node of a ring with the smallest x (lowest y among ties).
+fn leftmost(rings: &Rings, start: u32) -> u32 {
     let mut best = start;
     let mut p = rings.next(start);
     while p != start {
         let (n, b) = (rings.get(p), rings.get(best));
-        if n.x > b.x || (n.x == b.x && n.y < b.y) {
+        if n.x < b.x || (n.x == b.x && n.y < b.y) {
             best = p;
         }
         p = n.next;
@@ -275,28 +300,28 @@ fn for_each_edge(rings: &Rings, search: &Search, y0: f64, y1: f64, mut visit: im
 /// The outer vertex the hole's rightmost vertex connects to.
 fn find_bridge(rings: &Rings, hole: u32, search: Search) -> Option<u32> {
     let (hx, hy) = (rings.get(hole).x, rings.get(hole).y);
-    // The nearest crossing of the ray y = hy, x ≥ hx with an outer edge seen from inside
-    // (counter-clockwise, so an edge going up).
-    let mut qx = f64::INFINITY;
+    // The nearest crossing of the ray y = hy, x ≤ hx with an outer edge seen from inside
+    // (counter-clockwise, so an edge going down).
+    let mut qx = f64::NEG_INFINITY;
     let mut m = NIL;
     let mut touch = NIL;
     for_each_edge(rings, &search, hy, hy, |p| {
         let (n, nn) = (rings.get(p), rings.get(rings.next(p)));
-        if n.y <= hy && hy <= nn.y && nn.y != n.y {
+        if nn.y <= hy && hy <= n.y && nn.y != n.y {
             let x = n.x + (hy - n.y) * (nn.x - n.x) / (nn.y - n.y);
-            if x >= hx && (x < qx || (x == qx && touch == NIL && x == hx)) {
+            // The hole touches the outer ring at a vertex: bridge there (zero length).
+            let vertex = match x == hx {
+                true if hy == n.y => p,
+                true if hy == nn.y => n.next,
+                _ => NIL,
+            };
+            if x <= hx && x > qx {
                 qx = x;
-                m = if n.x > nn.x { p } else { n.next };
-                if x == hx {
-                    // The hole touches the outer ring at a vertex: bridge there (zero length).
-                    touch = if hy == n.y {
-                        p
-                    } else if hy == nn.y {
-                        n.next
-                    } else {
-                        NIL
-                    };
-                }
+                m = if n.x < nn.x { p } else { n.next };
+                touch = vertex;
+            } else if x == hx && touch == NIL && vertex != NIL {
+                // Another edge through the hole point, at a vertex of it: that one.
+                touch = vertex;
             }
         }
     });
@@ -306,6 +331,11 @@ fn find_bridge(rings: &Rings, hole: u32, search: Search) -> Option<u32> {
     if m == NIL {
         return None;
     }
+    if qx == hx {
+        // The hole point lies on an outer edge, between its ends: bridge to its left end (the
+        // triangle searched below would have no area).
+        return Some(m);
+    }
     // A reflex vertex inside triangle (hole point, crossing, endpoint) may hide the endpoint;
     // the visible one is the vertex in there with the smallest angle to the ray.
     let (mx, my) = (rings.get(m).x, rings.get(m).y);
@@ -313,12 +343,17 @@ fn find_bridge(rings: &Rings, hole: u32, search: Search) -> Option<u32> {
     let mut best = m;
     let consider = |p: u32| {
         let n = rings.get(p);
-        if hx <= n.x && n.x <= mx && hx != n.x && point_in_triangle([hx, hy], [qx, hy], [mx, my], [n.x, n.y]) {
-            let tan = (hy - n.y).abs() / (n.x - hx);
+        if mx <= n.x && n.x <= hx && hx != n.x && point_in_triangle([hx, hy], [qx, hy], [mx, my], [n.x, n.y]) {
+            let tan = (hy - n.y).abs() / (hx - n.x);
             let b = rings.get(best);
-            if rings.locally_inside(p, hole)
+            let next = rings.get(n.next);
+            // An outer edge along the ray, leading past the hole point, is seen from it too; so is
+            // a Steiner point (a spike of no width, inside from every side), which a bridge
+            // passing through it would leave out of the mesh.
+            let along = n.y == hy && next.y == hy && next.x > hx;
+            if (rings.locally_inside(p, hole) || along || n.steiner)
                 && (tan < tan_min
-                    || (tan == tan_min && (n.x < b.x || (n.x == b.x && rings.sector_contains_sector(best, p)))))
+                    || (tan == tan_min && (n.x > b.x || (n.x == b.x && rings.sector_contains_sector(best, p)))))
             {
                 best = p;
                 tan_min = tan;

@@ -4,6 +4,8 @@
 //! Convention: y up, outer rings counter-clockwise, holes clockwise; `area(p, q, r) > 0` is a
 //! left turn.
 
+use super::zorder::{ZHash, sort_by_code};
+
 /// "No node".
 pub(super) const NIL: u32 = u32::MAX;
 
@@ -22,6 +24,18 @@ pub(super) struct Node {
     pub queued: bool,
 }
 
+/// The z-order list of the ring being sliced, beside the nodes rather than in them: walking it
+/// chases one 8-byte link per step, the next address one load away (in the nodes, each step
+/// also waited on an index multiplied by the node size).
+#[derive(Default)]
+pub(super) struct ZList {
+    /// Per node: its neighbours on the list, lower code first (NIL at the ends and for nodes
+    /// not on it).
+    pub links: Vec<[u32; 2]>,
+    /// Per node: its Morton code.
+    pub codes: Vec<u32>,
+}
+
 /// The node arena (reused between calls).
 #[derive(Default)]
 pub(super) struct Rings {
@@ -29,6 +43,8 @@ pub(super) struct Rings {
     /// While set, [`Rings::filter`] records here each node whose outgoing edge it changed.
     pub recording: bool,
     pub touched: Vec<u32>,
+    /// The z-order list, once [`Rings::link_z`] made one.
+    pub z: ZList,
 }
 
 /// Twice the signed area of triangle (p, q, r): positive when p → q → r turns left.
@@ -83,6 +99,8 @@ impl Rings {
     /// Forgets every node (keeps the allocation).
     pub fn clear(&mut self) {
         self.nodes.clear();
+        self.z.links.clear();
+        self.z.codes.clear();
     }
 
     #[inline]
@@ -124,6 +142,21 @@ impl Rings {
         self.prev(self.next(p)) == p
     }
 
+    /// Whether every corner of the ring of `start` turns strictly left.
+    pub fn is_convex(&self, start: u32) -> bool {
+        let mut p = start;
+        loop {
+            let n = self.get(p);
+            if area(self.get(n.prev), n, self.get(n.next)) <= 0.0 {
+                return false;
+            }
+            p = n.next;
+            if p == start {
+                return true;
+            }
+        }
+    }
+
     /// Whether two nodes sit at the same position.
     #[inline]
     pub fn equals(&self, a: u32, b: u32) -> bool {
@@ -146,11 +179,49 @@ impl Rings {
         id
     }
 
-    /// Unlinks a node from its ring (it keeps its own links).
+    /// Unlinks a node from its ring and its z-order list (it keeps its own links).
     pub fn remove(&mut self, p: u32) {
         let Node { prev, next, .. } = *self.get(p);
         self.nodes[next as usize].prev = prev;
         self.nodes[prev as usize].next = next;
+        if let Some(&[down, up]) = self.z.links.get(p as usize) {
+            if down != NIL {
+                self.z.links[down as usize][1] = up;
+            }
+            if up != NIL {
+                self.z.links[up as usize][0] = down;
+            }
+        }
+    }
+
+    /// Puts the nodes of the ring of `start` on a z-order list of their own, sorted by code
+    /// (`keys` and `scratch` are scratch space). Nodes of other rings keep their links.
+    pub fn link_z(&mut self, start: u32, hash: &ZHash, keys: &mut Vec<u64>, scratch: &mut Vec<u64>) {
+        self.z.links.resize(self.nodes.len(), [NIL; 2]);
+        self.z.codes.resize(self.nodes.len(), 0);
+        keys.clear();
+        let mut p = start;
+        loop {
+            let node = &self.nodes[p as usize];
+            let z = hash.z(node.x, node.y);
+            self.z.codes[p as usize] = z;
+            keys.push((u64::from(z) << 32) | u64::from(p));
+            p = node.next;
+            if p == start {
+                break;
+            }
+        }
+        sort_by_code(keys, scratch);
+        let mut before = NIL;
+        for &key in keys.iter() {
+            let p = key as u32;
+            self.z.links[p as usize][0] = before;
+            if before != NIL {
+                self.z.links[before as usize][1] = p;
+            }
+            before = p;
+        }
+        self.z.links[before as usize][1] = NIL;
     }
 
     /// Links `points` (vertex index, position) into a ring that runs counter-clockwise when

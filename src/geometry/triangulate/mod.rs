@@ -17,7 +17,7 @@ mod linked;
 mod nesting;
 mod zorder;
 
-use ear::{HASH_THRESHOLD, Slicer};
+use ear::{HASH_THRESHOLD, LINKED_MAX, Slicer};
 use linked::{NIL, Rings, signed_area};
 use nesting::RingShape;
 use std::ops::Range;
@@ -359,6 +359,7 @@ impl Triangulator {
         Slicer {
             rings: &mut self.rings,
             hash,
+            linked: total <= LINKED_MAX,
             out,
             index: &mut self.zindex,
             jobs: &mut self.jobs,
