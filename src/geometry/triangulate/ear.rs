@@ -13,7 +13,7 @@
 
 use std::collections::VecDeque;
 
-use super::linked::{NIL, Rings, area, point_in_triangle};
+use super::linked::{NIL, Rings, area};
 use super::zorder::{ZHash, ZIndex, bigmin, code, in_box};
 
 /// Rings with more vertices than this use the z-order hash (below it, a plain walk is faster).
@@ -49,8 +49,7 @@ impl Corner {
             && x <= self.max[0]
             && y >= self.min[1]
             && y <= self.max[1]
-            && !(x == self.a[0] && y == self.a[1])
-            && point_in_triangle(self.a, self.b, self.c, [x, y])
+            && self.holds([x, y])
     }
 
     /// [`Self::covers`] without the bounding box test (for points the z-order range already
@@ -189,7 +188,7 @@ impl Slicer<'_> {
             let (prev, next) = (self.rings.prev(ear), self.rings.next(ear));
             let is_ear = if self.hash.is_some() { self.is_ear_hashed(ear) } else { self.is_ear(ear) };
             if is_ear {
-                self.emit(prev, ear, next);
+                self.emit_ear(prev, ear, next);
                 self.rings.remove(ear);
                 size -= 1;
                 (clipped, last, skip) = (true, next, next);
@@ -234,7 +233,7 @@ impl Slicer<'_> {
                 None => self.is_ear(ear),
             };
             if is_ear {
-                self.emit(prev, ear, next);
+                self.emit_ear(prev, ear, next);
                 self.rings.remove(ear);
                 let after = self.rings.next(next);
                 (ear, stop) = (after, after);
@@ -313,6 +312,14 @@ impl Slicer<'_> {
         } else if area > 0.0 {
             self.out.extend_from_slice(&[va, vb, vc]);
         }
+    }
+
+    /// Emits an ear: a corner the ear test found convex, so counter-clockwise with area.
+    #[inline]
+    fn emit_ear(&mut self, a: u32, b: u32, c: u32) {
+        let vertex = |p: u32| self.rings.get(p).vertex;
+        let triangle = [vertex(a), vertex(b), vertex(c)];
+        self.out.extend_from_slice(&triangle);
     }
 
     /// The convex corner at `ear` as a candidate ear; `None` if reflex or flat.
