@@ -297,7 +297,7 @@ fn for_each_edge(rings: &Rings, search: &Search, y0: f64, y1: f64, mut visit: im
     }
 }
 
-/// The outer vertex the hole's rightmost vertex connects to.
+/// The outer vertex the hole's leftmost vertex connects to.
 fn find_bridge(rings: &Rings, hole: u32, search: Search) -> Option<u32> {
     let (hx, hy) = (rings.get(hole).x, rings.get(hole).y);
     // The nearest crossing of the ray y = hy, x ≤ hx with an outer edge seen from inside
