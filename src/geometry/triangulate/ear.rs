@@ -45,11 +45,7 @@ impl Corner {
     /// (bridges duplicate points).
     #[inline]
     fn covers(&self, [x, y]: [f64; 2]) -> bool {
-        x >= self.min[0]
-            && x <= self.max[0]
-            && y >= self.min[1]
-            && y <= self.max[1]
-            && self.holds([x, y])
+        x >= self.min[0] && x <= self.max[0] && y >= self.min[1] && y <= self.max[1] && self.holds([x, y])
     }
 
     /// [`Self::covers`] without the bounding box test (for points the z-order range already
