@@ -187,8 +187,15 @@ impl Touching {
             return touching;
         }
         let mut hole_points = Vec::new();
+        // A 4,096-bit filter of the hole points: most outer points skip the binary search.
+        let mut filter = [0u64; 64];
         for (ring, &start) in holes.iter().enumerate() {
-            rings.for_each_node(start, |p| hole_points.push((key(rings, p), ring)));
+            rings.for_each_node(start, |p| {
+                let k = key(rings, p);
+                let bit = filter_bit(k);
+                filter[bit >> 6] |= 1 << (bit & 63);
+                hole_points.push((k, ring));
+            });
         }
         hole_points.sort_unstable();
         let mut shared: Vec<(u64, u64)> = hole_points
@@ -198,6 +205,10 @@ impl Touching {
             .collect();
         rings.for_each_node(outer, |p| {
             let k = key(rings, p);
+            let bit = filter_bit(k);
+            if filter[bit >> 6] & (1 << (bit & 63)) == 0 {
+                return;
+            }
             let at = hole_points.partition_point(|probe| probe.0 < k);
             if hole_points.get(at).is_some_and(|probe| probe.0 == k) {
                 shared.push(k);
@@ -241,6 +252,12 @@ impl Touching {
             }
         }
     }
+}
+
+/// A point's bit in [`Touching::new`]'s filter: its coordinate bits mixed and multiplied (a
+/// Fibonacci hash), the top 12 bits.
+fn filter_bit((x, y): (u64, u64)) -> usize {
+    ((x ^ y.rotate_left(29)).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 52) as usize
 }
 
 /// Whether the hole's corner at `h` lies inside the ring's corner at `q` (same point): going
