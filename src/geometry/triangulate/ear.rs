@@ -205,11 +205,13 @@ impl Slicer<'_> {
     /// clipped without ear tests until a corner fails.
     fn walk(&mut self, start: u32, jobs: &mut Vec<(u32, Pass)>) {
         let hash = self.hash;
-        if let Some(hash) = &hash {
-            self.rings.link_z(start, hash, &mut self.index.keys, &mut self.index.scratch);
-        }
-        // Nodes visited (corners and z-list steps) before the ring goes to the queue instead.
-        let budget = WALK_STEPS_PER_NODE * self.index.keys.len() + 4096;
+        let size = match &hash {
+            Some(hash) => self.rings.link_z(start, hash, &mut self.index.keys, &mut self.index.scratch),
+            None => 0,
+        };
+        // Nodes visited (corners and z-list steps) before the ring goes to the queue instead
+        // (hashed rings only: below the hash threshold the walk is cheap whatever it does).
+        let budget = WALK_STEPS_PER_NODE * size + 4096;
         let mut steps = 0;
         let mut convex = hash.is_some() && self.rings.is_convex(start);
         let (mut ear, mut stop, mut cured) = (start, start, false);
@@ -367,13 +369,13 @@ impl Slicer<'_> {
     fn is_ear_linked(&self, ear: u32, hash: &ZHash, steps: &mut usize) -> bool {
         let Some(corner) = self.corner(ear) else { return false };
         let (min_z, max_z) = (hash.z(corner.min[0], corner.min[1]), hash.z(corner.max[0], corner.max[1]));
-        let (nodes, links, codes) = (&self.rings.nodes, &self.rings.z.links, &self.rings.z.codes);
-        let c = nodes[ear as usize].next;
+        let (links, codes) = (&self.rings.z.links, &self.rings.z.codes);
+        let c = self.rings.next(ear);
         // Whether a node blocks the ear: in or on the triangle (a copy of its first corner
         // aside), not its last corner, and reflex or flat.
         let blocks = |p: u32| {
-            let n = &nodes[p as usize];
-            p != c && corner.holds([n.x, n.y]) && area(&nodes[n.prev as usize], n, &nodes[n.next as usize]) <= 0.0
+            let n = self.rings.get(p);
+            p != c && corner.holds([n.x, n.y]) && !self.convex(p)
         };
         let [mut down, mut up] = links[ear as usize];
         while down != NIL && up != NIL {
@@ -513,11 +515,6 @@ impl Slicer<'_> {
 
     /// Splits the ring along the first valid diagonal found and queues both halves.
     fn split(&mut self, start: u32, jobs: &mut Vec<(u32, Pass)>) {
-        if std::env::var_os("CNT").is_some() {
-            let mut n = 0;
-            self.rings.for_each_node(start, |_| n += 1);
-            eprintln!("split ring of {n}");
-        }
         let mut a = start;
         loop {
             let mut b = self.rings.next(self.rings.next(a));

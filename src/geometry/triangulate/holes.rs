@@ -2,8 +2,8 @@
 //! Clipping" §3, mirrored as in earcut]: holes are taken left to right by their leftmost vertex
 //! M; a ray from M to −x finds the nearest outer edge, and the bridge goes to the visible vertex
 //! that makes the smallest angle with the ray. (The book and Eberly go right to left; the
-//! mirror image merges rings exactly as earcut does, so the two cut crossing input alike.) Cutting along the bridge (both ends duplicated) turns an outer
-//! ring with holes into one weakly simple ring.
+//! mirror image merges rings as earcut does, so the two cut crossing input alike.) Cutting along
+//! the bridge (both ends duplicated) turns an outer ring with holes into one weakly simple ring.
 //!
 //! With many holes, walking the whole merged ring per hole is O(holes × vertices); above
 //! [`BANDS_FROM_HOLES`] holes the ring's edges are bucketed into horizontal bands so that both
@@ -11,7 +11,7 @@
 
 use std::collections::HashMap;
 
-use super::linked::{NIL, Rings, point_in_triangle};
+use super::linked::{NIL, Node, Rings, area, point_in_triangle};
 
 /// Holes from which the band index pays for itself.
 const BANDS_FROM_HOLES: usize = 8;
@@ -78,7 +78,7 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
     // their first edge's slope (counter-clockwise), so each bridges at the shared point.
     holes.sort_unstable_by(|&a, &b| {
         let (na, nb) = (rings.get(a), rings.get(b));
-        let slope = |n: &super::linked::Node| {
+        let slope = |n: &Node| {
             let next = rings.get(n.next);
             (next.y - n.y) / (next.x - n.x)
         };
@@ -160,8 +160,8 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
 fn heal_bridge(rings: &mut Rings, bridge: u32, reverse: u32, hole: u32) -> u32 {
     rings.filter(rings.prev(reverse), reverse);
     let (before, at, to) = (rings.get(rings.prev(bridge)), rings.get(bridge), rings.get(hole));
-    let between = super::linked::area(before, at, to) == 0.0
-        && (before.x - at.x) * (to.x - at.x) + (before.y - at.y) * (to.y - at.y) < 0.0;
+    let between =
+        area(before, at, to) == 0.0 && (before.x - at.x) * (to.x - at.x) + (before.y - at.y) * (to.y - at.y) < 0.0;
     if between { bridge } else { rings.filter(bridge, rings.next(bridge)) }
 }
 

@@ -195,8 +195,9 @@ impl Rings {
     }
 
     /// Puts the nodes of the ring of `start` on a z-order list of their own, sorted by code
-    /// (`keys` and `scratch` are scratch space). Nodes of other rings keep their links.
-    pub fn link_z(&mut self, start: u32, hash: &ZHash, keys: &mut Vec<u64>, scratch: &mut Vec<u64>) {
+    /// (`keys` and `scratch` are scratch space); returns the ring's size. Nodes of other rings
+    /// keep their links.
+    pub fn link_z(&mut self, start: u32, hash: &ZHash, keys: &mut Vec<u64>, scratch: &mut Vec<u64>) -> usize {
         self.z.links.resize(self.nodes.len(), [NIL; 2]);
         self.z.codes.resize(self.nodes.len(), 0);
         keys.clear();
@@ -222,6 +223,7 @@ impl Rings {
             before = p;
         }
         self.z.links[before as usize][1] = NIL;
+        keys.len()
     }
 
     /// Links `points` (vertex index, position) into a ring that runs counter-clockwise when

@@ -74,7 +74,7 @@ impl ZIndex {
     /// Sorts `keys`, gathers their positions (`position_of` a node) and builds the radix table
     /// (about one bucket per key).
     pub fn build(&mut self, position_of: impl Fn(u32) -> [f64; 2]) {
-        self.keys.sort_unstable();
+        sort_by_code(&mut self.keys, &mut self.scratch);
         self.positions.clear();
         self.positions.extend(self.keys.iter().map(|&key| position_of(key as u32)));
         self.skip.clear();
