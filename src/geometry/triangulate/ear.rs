@@ -13,7 +13,7 @@
 
 use std::collections::VecDeque;
 
-use super::linked::{NIL, Rings, area};
+use super::linked::{NIL, Rings, area, mark};
 use super::zorder::{ZHash, ZIndex, bigmin, code, in_box};
 
 /// Rings with more vertices than this use the z-order hash (below it, a plain walk is faster).
@@ -171,7 +171,7 @@ impl Slicer<'_> {
                 self.enqueue_ring(last, &mut queue);
                 continue;
             };
-            self.rings.nodes[ear as usize].queued = false;
+            self.rings.set_mark(ear, mark::QUEUED, false);
             if !self.rings.alive(ear) {
                 continue;
             }
@@ -273,9 +273,8 @@ impl Slicer<'_> {
 
     #[inline]
     fn enqueue(&mut self, p: u32, queue: &mut VecDeque<u32>) {
-        let node = &mut self.rings.nodes[p as usize];
-        if !node.queued {
-            node.queued = true;
+        if !self.rings.marked(p, mark::QUEUED) {
+            self.rings.set_mark(p, mark::QUEUED, true);
             queue.push_back(p);
         }
     }
@@ -369,7 +368,7 @@ impl Slicer<'_> {
     fn is_ear_linked(&self, ear: u32, hash: &ZHash, steps: &mut usize) -> bool {
         let Some(corner) = self.corner(ear) else { return false };
         let (min_z, max_z) = (hash.z(corner.min[0], corner.min[1]), hash.z(corner.max[0], corner.max[1]));
-        let (links, codes) = (&self.rings.z.links, &self.rings.z.codes);
+        let (links, nodes) = (&self.rings.z.links, &self.rings.nodes);
         let c = self.rings.next(ear);
         // Whether a node blocks the ear: in or on the triangle (a copy of its first corner
         // aside), not its last corner, and reflex or flat.
@@ -379,7 +378,7 @@ impl Slicer<'_> {
         };
         let [mut down, mut up] = links[ear as usize];
         while down != NIL && up != NIL {
-            if codes[down as usize] < min_z || codes[up as usize] > max_z {
+            if nodes[down as usize].z < min_z || nodes[up as usize].z > max_z {
                 break;
             }
             *steps += 2;
@@ -388,14 +387,14 @@ impl Slicer<'_> {
             }
             (down, up) = (links[down as usize][0], links[up as usize][1]);
         }
-        while down != NIL && codes[down as usize] >= min_z {
+        while down != NIL && nodes[down as usize].z >= min_z {
             *steps += 1;
             if blocks(down) {
                 return false;
             }
             down = links[down as usize][0];
         }
-        while up != NIL && codes[up as usize] <= max_z {
+        while up != NIL && nodes[up as usize].z <= max_z {
             *steps += 1;
             if blocks(up) {
                 return false;

@@ -11,7 +11,7 @@
 
 use std::collections::HashMap;
 
-use super::linked::{NIL, Node, Rings, area, point_in_triangle};
+use super::linked::{NIL, Node, Rings, area, mark, point_in_triangle};
 
 /// Holes from which the band index pays for itself.
 const BANDS_FROM_HOLES: usize = 8;
@@ -127,7 +127,8 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
         // triangles on one side only. (Not the copy of a one-point hole: two copies of a point
         // that may not go would block every ear at it.)
         let bridge_copy = rings.next(reverse);
-        rings.nodes[bridge_copy as usize].steiner = rings.get(bridge).steiner && !one_point;
+        let steiner = rings.marked(bridge, mark::STEINER) && !one_point;
+        rings.set_mark(bridge_copy, mark::STEINER, steiner);
         touching.add(rings, reverse);
         touching.add(rings, rings.next(reverse));
         outer = heal_bridge(rings, bridge, reverse, hole);
@@ -368,7 +369,7 @@ fn find_bridge(rings: &Rings, hole: u32, search: Search) -> Option<u32> {
             // a Steiner point (a spike of no width, inside from every side), which a bridge
             // passing through it would leave out of the mesh.
             let along = n.y == hy && next.y == hy && next.x > hx;
-            if (rings.locally_inside(p, hole) || along || n.steiner)
+            if (rings.locally_inside(p, hole) || along || rings.marked(p, mark::STEINER))
                 && (tan < tan_min
                     || (tan == tan_min && (n.x > b.x || (n.x == b.x && rings.sector_contains_sector(best, p)))))
             {

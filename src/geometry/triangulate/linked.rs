@@ -18,10 +18,9 @@ pub(super) struct Node {
     pub vertex: u32,
     pub prev: u32,
     pub next: u32,
-    /// A hole of one point: never filtered away.
-    pub steiner: bool,
-    /// Whether the node waits in the slicer's queue.
-    pub queued: bool,
+    /// Its Morton code, once [`Rings::link_z`] put it on a z-order list: the walk over the list
+    /// reads code and position from one 32-byte node.
+    pub z: u32,
 }
 
 /// The z-order list of the ring being sliced, beside the nodes rather than in them: walking it
@@ -32,8 +31,14 @@ pub(super) struct ZList {
     /// Per node: its neighbours on the list, lower code first (NIL at the ends and for nodes
     /// not on it).
     pub links: Vec<[u32; 2]>,
-    /// Per node: its Morton code.
-    pub codes: Vec<u32>,
+}
+
+/// Per-node marks, beside the nodes (rarely read, and keeping them out holds a node to 32 bytes).
+pub(super) mod mark {
+    /// A hole of one point: never filtered away.
+    pub const STEINER: u8 = 1;
+    /// The node waits in the slicer's queue.
+    pub const QUEUED: u8 = 2;
 }
 
 /// The node arena (reused between calls).
@@ -43,6 +48,8 @@ pub(super) struct Rings {
     /// While set, [`Rings::filter`] records here each node whose outgoing edge it changed.
     pub recording: bool,
     pub touched: Vec<u32>,
+    /// Per node: its [`mark`] bits.
+    pub marks: Vec<u8>,
     /// The z-order list, once [`Rings::link_z`] made one.
     pub z: ZList,
 }
@@ -99,13 +106,26 @@ impl Rings {
     /// Forgets every node (keeps the allocation).
     pub fn clear(&mut self) {
         self.nodes.clear();
+        self.marks.clear();
         self.z.links.clear();
-        self.z.codes.clear();
     }
 
     #[inline]
     pub fn get(&self, i: u32) -> &Node {
         &self.nodes[i as usize]
+    }
+
+    /// Whether node `i` carries mark `bit`.
+    #[inline]
+    pub fn marked(&self, i: u32, bit: u8) -> bool {
+        self.marks[i as usize] & bit != 0
+    }
+
+    /// Sets or clears mark `bit` of node `i`.
+    #[inline]
+    pub fn set_mark(&mut self, i: u32, bit: u8, on: bool) {
+        let m = &mut self.marks[i as usize];
+        *m = if on { *m | bit } else { *m & !bit };
     }
 
     #[inline]
@@ -167,7 +187,7 @@ impl Rings {
     /// Appends a node for `vertex` after `last` (or as a ring of one) and returns it.
     fn insert(&mut self, vertex: u32, [x, y]: [f64; 2], last: u32) -> u32 {
         let id = self.nodes.len() as u32;
-        let mut node = Node { x, y, vertex, prev: id, next: id, steiner: false, queued: false };
+        let mut node = Node { x, y, vertex, prev: id, next: id, z: 0 };
         if last != NIL {
             node.prev = last;
             node.next = self.next(last);
@@ -176,6 +196,7 @@ impl Rings {
             self.nodes[last as usize].next = id;
         }
         self.nodes.push(node);
+        self.marks.push(0);
         id
     }
 
@@ -199,13 +220,12 @@ impl Rings {
     /// keep their links.
     pub fn link_z(&mut self, start: u32, hash: &ZHash, keys: &mut Vec<u64>, scratch: &mut Vec<u64>) -> usize {
         self.z.links.resize(self.nodes.len(), [NIL; 2]);
-        self.z.codes.resize(self.nodes.len(), 0);
         keys.clear();
         let mut p = start;
         loop {
-            let node = &self.nodes[p as usize];
+            let node = &mut self.nodes[p as usize];
             let z = hash.z(node.x, node.y);
-            self.z.codes[p as usize] = z;
+            node.z = z;
             keys.push((u64::from(z) << 32) | u64::from(p));
             p = node.next;
             if p == start {
@@ -273,8 +293,9 @@ impl Rings {
         loop {
             let next = self.next(p);
             let prev = self.prev(p);
-            let removable =
-                p != next && !self.get(p).steiner && (self.equals(p, next) || self.area(prev, p, next) == 0.0);
+            let removable = p != next
+                && (self.equals(p, next) || self.area(prev, p, next) == 0.0)
+                && !self.marked(p, mark::STEINER);
             let again = if removable {
                 if full || p == end {
                     end = prev;

@@ -343,7 +343,7 @@ impl Triangulator {
                 continue;
             }
             if self.rings.next(start) == start {
-                self.rings.nodes[start as usize].steiner = true;
+                self.rings.set_mark(start, linked::mark::STEINER, true);
             }
             self.holes.push(start);
         }
