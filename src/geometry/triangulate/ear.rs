@@ -368,38 +368,38 @@ impl Slicer<'_> {
     fn is_ear_linked(&self, ear: u32, hash: &ZHash, steps: &mut usize) -> bool {
         let Some(corner) = self.corner(ear) else { return false };
         let (min_z, max_z) = (hash.z(corner.min[0], corner.min[1]), hash.z(corner.max[0], corner.max[1]));
-        let (links, nodes) = (&self.rings.z.links, &self.rings.nodes);
-        let c = self.rings.next(ear);
+        let r = &*self.rings;
+        let c = r.next(ear);
         // Whether a node blocks the ear: in or on the triangle (a copy of its first corner
         // aside), not its last corner, and reflex or flat.
         let blocks = |p: u32| {
-            let n = self.rings.get(p);
+            let n = r.get(p);
             p != c && corner.holds([n.x, n.y]) && !self.convex(p)
         };
-        let [mut down, mut up] = links[ear as usize];
+        let [mut down, mut up] = r.z_links(ear);
         while down != NIL && up != NIL {
-            if nodes[down as usize].z < min_z || nodes[up as usize].z > max_z {
+            if r.get(down).z < min_z || r.get(up).z > max_z {
                 break;
             }
             *steps += 2;
             if blocks(down) || blocks(up) {
                 return false;
             }
-            (down, up) = (links[down as usize][0], links[up as usize][1]);
+            (down, up) = (r.z_links(down)[0], r.z_links(up)[1]);
         }
-        while down != NIL && nodes[down as usize].z >= min_z {
+        while down != NIL && r.get(down).z >= min_z {
             *steps += 1;
             if blocks(down) {
                 return false;
             }
-            down = links[down as usize][0];
+            down = r.z_links(down)[0];
         }
-        while up != NIL && nodes[up as usize].z <= max_z {
+        while up != NIL && r.get(up).z <= max_z {
             *steps += 1;
             if blocks(up) {
                 return false;
             }
-            up = links[up as usize][1];
+            up = r.z_links(up)[1];
         }
         true
     }

@@ -112,7 +112,18 @@ impl Rings {
 
     #[inline]
     pub fn get(&self, i: u32) -> &Node {
-        &self.nodes[i as usize]
+        debug_assert!((i as usize) < self.nodes.len());
+        // SAFETY: every node id the slicer holds came from `insert` (so is below the arena's
+        // length), and nodes leave the arena only in `clear`, after which no id is used.
+        unsafe { self.nodes.get_unchecked(i as usize) }
+    }
+
+    /// Node `i`'s neighbours on the z-order list, lower code first.
+    #[inline]
+    pub fn z_links(&self, i: u32) -> [u32; 2] {
+        debug_assert!((i as usize) < self.z.links.len());
+        // SAFETY: as in `get`; `link_z` sizes the links to the arena before any walk.
+        unsafe { *self.z.links.get_unchecked(i as usize) }
     }
 
     /// Whether node `i` carries mark `bit`.
@@ -130,12 +141,12 @@ impl Rings {
 
     #[inline]
     pub fn next(&self, i: u32) -> u32 {
-        self.nodes[i as usize].next
+        self.get(i).next
     }
 
     #[inline]
     pub fn prev(&self, i: u32) -> u32 {
-        self.nodes[i as usize].prev
+        self.get(i).prev
     }
 
     /// Calls `visit` with every node of the ring of `start`, in ring order.
