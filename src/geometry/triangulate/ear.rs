@@ -14,7 +14,7 @@
 use std::collections::VecDeque;
 
 use super::linked::{NIL, Rings, area, mark};
-use super::zorder::{ZHash, ZIndex, bigmin, code, in_box};
+use super::zorder::{ZHash, ZIndex, bigmin, box_codes, code, in_box};
 
 /// Rings with more vertices than this use the z-order hash (below it, a plain walk is faster).
 pub(super) const HASH_THRESHOLD: usize = 80;
@@ -29,6 +29,25 @@ pub(super) const LINKED_MAX: usize = 1 << 15;
 /// on the thin ears of a spiky star, where the walk took 0.16 s at 25,000 points (0.018 s with
 /// this budget).
 const WALK_STEPS_PER_NODE: usize = 64;
+
+/// A counter-clockwise triangle (a, b, c): a convex corner tested as an ear.
+#[derive(Clone, Copy)]
+struct Triangle {
+    a: [f64; 2],
+    b: [f64; 2],
+    c: [f64; 2],
+}
+
+impl Triangle {
+    /// Whether a point lies in or on the triangle and is not a copy of a (bridges duplicate
+    /// points).
+    #[inline]
+    fn holds(&self, p: [f64; 2]) -> bool {
+        // Left of (or on) each edge in turn, most points failing the first or second test.
+        let left = |s: [f64; 2], e: [f64; 2]| (e[0] - s[0]) * (p[1] - s[1]) >= (e[1] - s[1]) * (p[0] - s[0]);
+        left(self.a, self.b) && left(self.b, self.c) && left(self.c, self.a) && p != self.a
+    }
+}
 
 /// A convex corner (a, b, c) tested as an ear, with its bounding box.
 #[derive(Clone, Copy)]
@@ -48,13 +67,9 @@ impl Corner {
         x >= self.min[0] && x <= self.max[0] && y >= self.min[1] && y <= self.max[1] && self.holds([x, y])
     }
 
-    /// [`Self::covers`] without the bounding box test (for points the z-order range already
-    /// puts near the ear).
     #[inline]
     fn holds(&self, p: [f64; 2]) -> bool {
-        // Left of (or on) each edge in turn, most points failing the first or second test.
-        let left = |s: [f64; 2], e: [f64; 2]| (e[0] - s[0]) * (p[1] - s[1]) >= (e[1] - s[1]) * (p[0] - s[0]);
-        left(self.a, self.b) && left(self.b, self.c) && left(self.c, self.a) && p != self.a
+        Triangle { a: self.a, b: self.b, c: self.c }.holds(p)
     }
 
     /// Whether the whole box lies strictly outside the triangle, beyond one of its edges (the
@@ -227,7 +242,7 @@ impl Slicer<'_> {
                     jobs.push((ear, Pass::Queued));
                     return;
                 }
-                Some(hash) => self.is_ear_linked(ear, hash, &mut steps),
+                Some(_) => self.is_ear_linked(ear, &mut steps),
                 None => self.is_ear(ear),
             };
             if is_ear {
@@ -365,11 +380,16 @@ impl Slicer<'_> {
     /// of the ear box's corners, walking out from the ear's own node both ways in step (two
     /// independent chains of loads in flight), as earcut does.
     #[inline]
-    fn is_ear_linked(&self, ear: u32, hash: &ZHash, steps: &mut usize) -> bool {
-        let Some(corner) = self.corner(ear) else { return false };
-        let (min_z, max_z) = (hash.z(corner.min[0], corner.min[1]), hash.z(corner.max[0], corner.max[1]));
+    fn is_ear_linked(&self, ear: u32, steps: &mut usize) -> bool {
         let r = &*self.rings;
         let c = r.next(ear);
+        let (na, nb, nc) = (r.get(r.prev(ear)), r.get(ear), r.get(c));
+        if area(na, nb, nc) <= 0.0 {
+            return false;
+        }
+        let corner = Triangle { a: [na.x, na.y], b: [nb.x, nb.y], c: [nc.x, nc.y] };
+        // From the corners' codes: quantising the box's corners again was a sixth of the walk.
+        let (min_z, max_z) = box_codes(na.z, nb.z, nc.z);
         // Whether a node blocks the ear: in or on the triangle (a copy of its first corner
         // aside), not its last corner, and reflex or flat.
         let blocks = |p: u32| {

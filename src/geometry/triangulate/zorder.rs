@@ -168,6 +168,19 @@ pub(super) fn code(key: u64) -> u32 {
     (key >> 32) as u32
 }
 
+/// The codes of the lowest and the highest corner of the box around three coded points, from
+/// their codes alone: quantising is monotone, and the x bits (even) and the y bits (odd) of a
+/// code, masked apart, compare as the coordinates do. So the least x bits of the three are the
+/// x bits of the box's least corner: no float is quantised again.
+#[inline]
+pub(super) fn box_codes(a: u32, b: u32, c: u32) -> (u32, u32) {
+    const X: u32 = 0x5555_5555;
+    const Y: u32 = !X;
+    let least = |m: u32| (a & m).min(b & m).min(c & m);
+    let most = |m: u32| (a & m).max(b & m).max(c & m);
+    (least(X) | least(Y), most(X) | most(Y))
+}
+
 /// Spreads the low 16 bits of `v` to the even bit positions.
 #[inline]
 fn spread(mut v: u32) -> u32 {
@@ -255,6 +268,23 @@ mod tests {
                 let expected = inside.iter().copied().find(|&c| c > z);
                 assert_eq!(bigmin(z, min, max), expected, "bigmin({z}) in {:?}", (x0, y0, x1, y1));
             }
+        }
+    }
+
+    #[test]
+    fn box_codes_are_the_codes_of_the_box_corners() {
+        let hash = ZHash::new([-3.0, 2.0], [1000.0, 700.0]);
+        let mut rng = crate::geometry::rng::SplitMix64::new(11);
+        for _ in 0..10_000 {
+            // Some points beyond the hash's box, where codes clamp.
+            let mut point = || [-100.0 + 1200.0 * rng.unit(), -100.0 + 900.0 * rng.unit()];
+            let [a, b, c] = [point(), point(), point()];
+            let (min, max) = (
+                [a[0].min(b[0]).min(c[0]), a[1].min(b[1]).min(c[1])],
+                [a[0].max(b[0]).max(c[0]), a[1].max(b[1]).max(c[1])],
+            );
+            let expected = (hash.z(min[0], min[1]), hash.z(max[0], max[1]));
+            assert_eq!(box_codes(hash.z(a[0], a[1]), hash.z(b[0], b[1]), hash.z(c[0], c[1])), expected);
         }
     }
 
