@@ -24,10 +24,12 @@ pub(super) const HASH_THRESHOLD: usize = 80;
 /// walking round long reflex stretches and scanning thin ears' code ranges grow quadratically.
 pub(super) const LINKED_MAX: usize = 1 << 15;
 
-/// Nodes the walk may visit per node of the ring (corners tested plus z-order list steps) before
-/// it hands the ring to the queue: about 26 on real outlines (water, 2,523 vertices), thousands
-/// on the thin ears of a spiky star, where the walk took 0.16 s at 25,000 points (0.018 s with
-/// this budget).
+/// Nodes the walk may visit per node of the ring before it hands the ring to the queue: z-order
+/// list steps, and two for each corner visited (it reads three nodes). About 28 on real outlines
+/// (water, 2,523 vertices), thousands on the thin ears of a spiky star, where the walk took
+/// 0.16 s at 25,000 points (0.016 s with this budget). Corners count twice since the blocker
+/// cache (see `is_ear_linked`) made most list walks one test: counted once, crossing input
+/// (water-huge2) stayed in the walk through dozens of stuck rounds, 10% slower.
 const WALK_STEPS_PER_NODE: usize = 64;
 
 /// A counter-clockwise triangle (a, b, c): a convex corner tested as an ear.
@@ -113,6 +115,15 @@ fn min3(a: f64, b: f64, c: f64) -> f64 {
 fn max3(a: f64, b: f64, c: f64) -> f64 {
     let ab = if a > b { a } else { b };
     if ab > c { ab } else { c }
+}
+
+/// What the linked ear test found at a corner.
+enum Verdict {
+    Ear,
+    /// Reflex or flat: no ear whatever lies near.
+    Reflex,
+    /// Convex, but this node lies in or on the triangle.
+    BlockedBy(u32),
 }
 
 /// Which fallback a ring is on.
@@ -224,7 +235,7 @@ impl Slicer<'_> {
             Some(hash) => self.rings.link_z(start, hash, &mut self.index.keys, &mut self.index.scratch),
             None => 0,
         };
-        // Nodes visited (corners and z-list steps) before the ring goes to the queue instead
+        // Nodes visited (see WALK_STEPS_PER_NODE) before the ring goes to the queue instead
         // (hashed rings only: below the hash threshold the walk is cheap whatever it does).
         let budget = WALK_STEPS_PER_NODE * size + 4096;
         let mut steps = 0;
@@ -235,14 +246,21 @@ impl Slicer<'_> {
             if prev == next {
                 return;
             }
-            steps += 1;
+            steps += 2;
             let is_ear = match &hash {
                 _ if convex => self.rings.area(prev, ear, next) > 0.0,
                 Some(_) if steps > budget => {
                     jobs.push((ear, Pass::Queued));
                     return;
                 }
-                Some(_) => self.is_ear_linked(ear, &mut steps),
+                Some(_) => match self.is_ear_linked(ear, &mut steps) {
+                    Verdict::Ear => true,
+                    Verdict::Reflex => false,
+                    Verdict::BlockedBy(p) => {
+                        self.rings.z.blockers[ear as usize] = p;
+                        false
+                    }
+                },
                 None => self.is_ear(ear),
             };
             if is_ear {
@@ -380,12 +398,12 @@ impl Slicer<'_> {
     /// of the ear box's corners, walking out from the ear's own node both ways in step (two
     /// independent chains of loads in flight), as earcut does.
     #[inline]
-    fn is_ear_linked(&self, ear: u32, steps: &mut usize) -> bool {
+    fn is_ear_linked(&self, ear: u32, steps: &mut usize) -> Verdict {
         let r = &*self.rings;
         let c = r.next(ear);
         let (na, nb, nc) = (r.get(r.prev(ear)), r.get(ear), r.get(c));
         if area(na, nb, nc) <= 0.0 {
-            return false;
+            return Verdict::Reflex;
         }
         let corner = Triangle { a: [na.x, na.y], b: [nb.x, nb.y], c: [nc.x, nc.y] };
         // From the corners' codes: quantising the box's corners again was a sixth of the walk.
@@ -396,32 +414,41 @@ impl Slicer<'_> {
             let n = r.get(p);
             p != c && corner.holds([n.x, n.y]) && !self.convex(p)
         };
+        // The node that blocked this corner last time (a node of this ring, which link_z
+        // starts afresh): if it still does, the answer is the same as the walk's.
+        let known = r.z.blockers[ear as usize];
+        if known != NIL && r.alive(known) && blocks(known) {
+            return Verdict::BlockedBy(known);
+        }
         let [mut down, mut up] = r.z_links(ear);
         while down != NIL && up != NIL {
             if r.get(down).z < min_z || r.get(up).z > max_z {
                 break;
             }
             *steps += 2;
-            if blocks(down) || blocks(up) {
-                return false;
+            if blocks(down) {
+                return Verdict::BlockedBy(down);
+            }
+            if blocks(up) {
+                return Verdict::BlockedBy(up);
             }
             (down, up) = (r.z_links(down)[0], r.z_links(up)[1]);
         }
         while down != NIL && r.get(down).z >= min_z {
             *steps += 1;
             if blocks(down) {
-                return false;
+                return Verdict::BlockedBy(down);
             }
             down = r.z_links(down)[0];
         }
         while up != NIL && r.get(up).z <= max_z {
             *steps += 1;
             if blocks(up) {
-                return false;
+                return Verdict::BlockedBy(up);
             }
             up = r.z_links(up)[1];
         }
-        true
+        Verdict::Ear
     }
 
     /// [`Self::is_ear`] over the nodes on the z-order list whose code lies in the ear's box,
@@ -535,10 +562,13 @@ impl Slicer<'_> {
     /// Splits the ring along the first valid diagonal found and queues both halves.
     fn split(&mut self, start: u32, jobs: &mut Vec<(u32, Pass)>) {
         let mut a = start;
+        let mut hints = [NIL; 4];
         loop {
             let mut b = self.rings.next(self.rings.next(a));
             while b != self.rings.prev(a) {
-                if self.rings.get(a).vertex != self.rings.get(b).vertex && self.rings.is_valid_diagonal(a, b) {
+                if self.rings.get(a).vertex != self.rings.get(b).vertex
+                    && self.rings.is_valid_diagonal(a, b, &mut hints)
+                {
                     let c = self.rings.split(a, b);
                     let a = self.rings.filter(a, self.rings.next(a));
                     let c = self.rings.filter(c, self.rings.next(c));
