@@ -25,7 +25,7 @@ pub(super) const HASH_THRESHOLD: usize = 80;
 pub(super) const LINKED_MAX: usize = 1 << 15;
 
 /// Nodes the walk may visit per node of the ring before it hands the ring to the queue: z-order
-/// list steps, and two for each corner visited (it reads three nodes). About 28 on real outlines
+/// list steps, and two for each corner visited (it reads three nodes). About 33 on real outlines
 /// (water, 2,523 vertices), thousands on the thin ears of a spiky star, where the walk took
 /// 0.16 s at 25,000 points (0.016 s with this budget). Corners count twice since the blocker
 /// cache (see `is_ear_linked`) made most list walks one test: counted once, crossing input
