@@ -285,8 +285,14 @@ impl Slicer<'_> {
                 stop = ear;
                 continue;
             }
-            self.split(ear, jobs);
-            return;
+            if hash.is_none() {
+                // No z-order list to carry over: both halves start afresh.
+                self.split(ear, jobs);
+                return;
+            }
+            let Some(larger) = self.split_in_walk(ear, jobs) else { return };
+            (ear, stop, cured) = (larger, larger, false);
+            convex = self.rings.is_convex(larger);
         }
     }
 
@@ -414,10 +420,11 @@ impl Slicer<'_> {
             let n = r.get(p);
             p != c && corner.holds([n.x, n.y]) && !self.convex(p)
         };
-        // The node that blocked this corner last time (a node of this ring, which link_z
-        // starts afresh): if it still does, the answer is the same as the walk's.
+        // The node that blocked this corner last time: if it is still on this ring's list (link_z
+        // starts the cache afresh; a split takes the smaller half off the list) and still
+        // blocks, the answer is the same as the list walk's.
         let known = r.z.blockers[ear as usize];
-        if known != NIL && r.alive(known) && blocks(known) {
+        if known != NIL && r.alive(known) && r.z_links(known) != [NIL; 2] && blocks(known) {
             return Verdict::BlockedBy(known);
         }
         let [mut down, mut up] = r.z_links(ear);
@@ -561,6 +568,36 @@ impl Slicer<'_> {
 
     /// Splits the ring along the first valid diagonal found and queues both halves.
     fn split(&mut self, start: u32, jobs: &mut Vec<(u32, Pass)>) {
+        if let Some((a, b)) = self.find_diagonal(start) {
+            let c = self.rings.split(a, b);
+            let a = self.rings.filter(a, self.rings.next(a));
+            let c = self.rings.filter(c, self.rings.next(c));
+            jobs.push((a, Pass::Ears));
+            jobs.push((c, Pass::Ears));
+        }
+    }
+
+    /// [`Self::split`] inside the walk: queues the smaller half and returns a node of the larger,
+    /// whose z-order list is the ring's own less the smaller half's nodes (the copies the cut
+    /// makes join it beside their originals). On crossing input a stuck ring sheds a few nodes
+    /// per split, dozens of times: building the larger half's list anew each time, and losing
+    /// its blocker cache, was a fifth of the time.
+    fn split_in_walk(&mut self, start: u32, jobs: &mut Vec<(u32, Pass)>) -> Option<u32> {
+        let (a, b) = self.find_diagonal(start)?;
+        let c = self.rings.split(a, b);
+        let a2 = self.rings.next(c);
+        self.rings.z_insert_copy(a, a2);
+        self.rings.z_insert_copy(b, c);
+        let a = self.rings.filter(a, self.rings.next(a));
+        let c = self.rings.filter(c, self.rings.next(c));
+        let (smaller, larger) = if self.rings.smaller_ring(a, c) { (a, c) } else { (c, a) };
+        self.rings.z_unlink_ring(smaller);
+        jobs.push((smaller, Pass::Ears));
+        Some(larger)
+    }
+
+    /// The first valid diagonal from `start` on, in ring order.
+    fn find_diagonal(&self, start: u32) -> Option<(u32, u32)> {
         let mut a = start;
         let mut hints = [NIL; 4];
         loop {
@@ -569,18 +606,13 @@ impl Slicer<'_> {
                 if self.rings.get(a).vertex != self.rings.get(b).vertex
                     && self.rings.is_valid_diagonal(a, b, &mut hints)
                 {
-                    let c = self.rings.split(a, b);
-                    let a = self.rings.filter(a, self.rings.next(a));
-                    let c = self.rings.filter(c, self.rings.next(c));
-                    jobs.push((a, Pass::Ears));
-                    jobs.push((c, Pass::Ears));
-                    return;
+                    return Some((a, b));
                 }
                 b = self.rings.next(b);
             }
             a = self.rings.next(a);
             if a == start {
-                return;
+                return None;
             }
         }
     }

@@ -263,6 +263,54 @@ impl Rings {
         keys.len()
     }
 
+    /// Puts `copy` (a new node at `original`'s position) on the z-order list right after
+    /// `original`, with its code.
+    pub fn z_insert_copy(&mut self, original: u32, copy: u32) {
+        self.z.links.resize(self.nodes.len(), [NIL; 2]);
+        self.z.blockers.resize(self.nodes.len(), NIL);
+        self.nodes[copy as usize].z = self.nodes[original as usize].z;
+        let up = self.z.links[original as usize][1];
+        self.z.links[copy as usize] = [original, up];
+        self.z.links[original as usize][1] = copy;
+        if up != NIL {
+            self.z.links[up as usize][0] = copy;
+        }
+    }
+
+    /// Takes every node of the ring of `start` off the z-order list (their links become NIL).
+    pub fn z_unlink_ring(&mut self, start: u32) {
+        let mut p = start;
+        loop {
+            let [down, up] = self.z.links[p as usize];
+            if down != NIL {
+                self.z.links[down as usize][1] = up;
+            }
+            if up != NIL {
+                self.z.links[up as usize][0] = down;
+            }
+            self.z.links[p as usize] = [NIL; 2];
+            p = self.next(p);
+            if p == start {
+                return;
+            }
+        }
+    }
+
+    /// Whether the ring of `a` has at most as many nodes as the ring of `b` (walking both in
+    /// step, so the cost is the smaller ring's size).
+    pub fn smaller_ring(&self, a: u32, b: u32) -> bool {
+        let (mut p, mut q) = (self.next(a), self.next(b));
+        loop {
+            if p == a {
+                return true;
+            }
+            if q == b {
+                return false;
+            }
+            (p, q) = (self.next(p), self.next(q));
+        }
+    }
+
     /// Links `points` (vertex index, position) into a ring that runs counter-clockwise when
     /// `ccw` (clockwise otherwise), whatever their input order, skipping repeats of the previous
     /// point. `signed_area` is the ring's shoelace area (positive = counter-clockwise). Returns a
