@@ -49,8 +49,22 @@ impl Bands {
         }
     }
 
+    /// Registers every edge of the ring of `start`, each node's band worked out once (edge by
+    /// edge, each was worked out twice).
     fn add_ring(&mut self, rings: &Rings, start: u32) {
-        rings.for_each_node(start, |p| self.add_edge(rings, p));
+        let mut p = start;
+        let mut band = self.band(rings.get(p).y);
+        loop {
+            let next = rings.next(p);
+            let next_band = self.band(rings.get(next).y);
+            for b in band.min(next_band)..=band.max(next_band) {
+                self.lists[b].push(p);
+            }
+            (p, band) = (next, next_band);
+            if p == start {
+                return;
+            }
+        }
     }
 }
 
