@@ -11,7 +11,7 @@
 
 use std::collections::HashMap;
 
-use super::linked::{NIL, Node, Rings, area, mark, point_in_triangle};
+use super::linked::{NIL, Node, Rings, area, greatest, least, mark, point_in_triangle};
 
 /// Holes from which the band index pays for itself.
 const BANDS_FROM_HOLES: usize = 8;
@@ -44,7 +44,7 @@ impl Bands {
     /// Registers the edge that starts at `p`.
     fn add_edge(&mut self, rings: &Rings, p: u32) {
         let (a, b) = (rings.get(p).y, rings.get(rings.next(p)).y);
-        for band in self.band(a.min(b))..=self.band(a.max(b)) {
+        for band in self.band(least(a, b))..=self.band(greatest(a, b)) {
             self.lists[band].push(p);
         }
     }
@@ -102,8 +102,8 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
     if banded {
         let (mut lo, mut hi, mut count) = (f64::INFINITY, f64::NEG_INFINITY, 0);
         rings.for_each_node(outer, |p| {
-            lo = lo.min(rings.get(p).y);
-            hi = hi.max(rings.get(p).y);
+            lo = least(lo, rings.get(p).y);
+            hi = greatest(hi, rings.get(p).y);
             count += 1;
         });
         // About four edges a band, but no more bands than the holes' searches need: filling

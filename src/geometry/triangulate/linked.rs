@@ -57,6 +57,19 @@ pub(super) struct Rings {
     pub z: ZList,
 }
 
+/// The lesser of two finite numbers, by a plain comparison (one instruction; `f64::min`'s NaN
+/// handling costs several and chains them in loops).
+#[inline]
+pub(super) fn least(a: f64, b: f64) -> f64 {
+    if a < b { a } else { b }
+}
+
+/// The greater of two finite numbers (see [`least`]).
+#[inline]
+pub(super) fn greatest(a: f64, b: f64) -> f64 {
+    if a > b { a } else { b }
+}
+
 /// Twice the signed area of triangle (p, q, r): positive when p → q → r turns left.
 #[inline]
 pub(super) fn area(p: &Node, q: &Node, r: &Node) -> f64 {
@@ -457,13 +470,16 @@ impl Rings {
     pub fn intersects_ring(&self, a: u32, b: u32, hints: &mut [u32; 4]) -> bool {
         let (na, nb) = (self.get(a), self.get(b));
         let (va, vb) = (na.vertex, nb.vertex);
-        let (x0, x1) = (na.x.min(nb.x), na.x.max(nb.x));
-        let (y0, y1) = (na.y.min(nb.y), na.y.max(nb.y));
+        let (x0, x1) = (least(na.x, nb.x), greatest(na.x, nb.x));
+        let (y0, y1) = (least(na.y, nb.y), greatest(na.y, nb.y));
         let crosses_edge = |p: u32| {
             let np = self.get(p);
             let nq = self.get(np.next);
             // Edges whose box misses the segment's box cannot touch it.
-            let overlaps = np.x.max(nq.x) >= x0 && np.x.min(nq.x) <= x1 && np.y.max(nq.y) >= y0 && np.y.min(nq.y) <= y1;
+            let overlaps = greatest(np.x, nq.x) >= x0
+                && least(np.x, nq.x) <= x1
+                && greatest(np.y, nq.y) >= y0
+                && least(np.y, nq.y) <= y1;
             overlaps
                 && np.vertex != va
                 && nq.vertex != va

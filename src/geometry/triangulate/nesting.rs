@@ -5,6 +5,8 @@
 use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{AABB, RTree};
 
+use super::linked::{greatest, least};
+
 /// What the tree needs to know of one ring.
 pub(super) struct RingShape<'a> {
     pub vertices: &'a [[f64; 2]],
@@ -20,10 +22,12 @@ impl<'a> RingShape<'a> {
     pub fn new(vertices: &'a [[f64; 2]]) -> Self {
         let mut min = [f64::INFINITY; 2];
         let mut max = [f64::NEG_INFINITY; 2];
+        // Plain comparisons (coordinates are finite by now): `f64::min`'s NaN handling was 5%
+        // of a 104-vertex polygon's time.
         for v in vertices {
             for k in 0..2 {
-                min[k] = min[k].min(v[k]);
-                max[k] = max[k].max(v[k]);
+                min[k] = least(min[k], v[k]);
+                max[k] = greatest(max[k], v[k]);
             }
         }
         Self { vertices, min, max, family: None }
