@@ -38,7 +38,8 @@ impl Bands {
 
     #[inline]
     fn band(&self, y: f64) -> usize {
-        (((y - self.min_y) * self.inv_height).max(0.0) as usize).min(self.lists.len() - 1)
+        // `as` takes negatives to 0.
+        (((y - self.min_y) * self.inv_height) as usize).min(self.lists.len() - 1)
     }
 
     /// Registers the edge that starts at `p`.
