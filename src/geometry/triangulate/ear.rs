@@ -51,12 +51,10 @@ impl Triangle {
     }
 }
 
-/// A convex corner (a, b, c) tested as an ear, with its bounding box.
+/// A convex corner tested as an ear, with its bounding box.
 #[derive(Clone, Copy)]
 struct Corner {
-    a: [f64; 2],
-    b: [f64; 2],
-    c: [f64; 2],
+    triangle: Triangle,
     min: [f64; 2],
     max: [f64; 2],
 }
@@ -66,12 +64,7 @@ impl Corner {
     /// (bridges duplicate points).
     #[inline]
     fn covers(&self, [x, y]: [f64; 2]) -> bool {
-        x >= self.min[0] && x <= self.max[0] && y >= self.min[1] && y <= self.max[1] && self.holds([x, y])
-    }
-
-    #[inline]
-    fn holds(&self, p: [f64; 2]) -> bool {
-        Triangle { a: self.a, b: self.b, c: self.c }.holds(p)
+        x >= self.min[0] && x <= self.max[0] && y >= self.min[1] && y <= self.max[1] && self.triangle.holds([x, y])
     }
 
     /// Whether the whole box lies strictly outside the triangle, beyond one of its edges (the
@@ -84,7 +77,8 @@ impl Corner {
             let (x, y) = (if ey > 0.0 { lo[0] } else { hi[0] }, if ex > 0.0 { hi[1] } else { lo[1] });
             ex * (y - p[1]) - ey * (x - p[0]) < 0.0
         };
-        beyond(self.a, self.b) || beyond(self.b, self.c) || beyond(self.c, self.a)
+        let Triangle { a, b, c } = self.triangle;
+        beyond(a, b) || beyond(b, c) || beyond(c, a)
     }
 
     /// The last code of the largest aligned cell (2 × 2 grid steps or more) that holds code `z`
@@ -361,9 +355,7 @@ impl Slicer<'_> {
         let r = &*self.rings;
         let (a, b, c) = (r.get(r.prev(ear)), r.get(ear), r.get(r.next(ear)));
         (area(a, b, c) > 0.0).then(|| Corner {
-            a: [a.x, a.y],
-            b: [b.x, b.y],
-            c: [c.x, c.y],
+            triangle: Triangle { a: [a.x, a.y], b: [b.x, b.y], c: [c.x, c.y] },
             min: [min3(a.x, b.x, c.x), min3(a.y, b.y, c.y)],
             max: [max3(a.x, b.x, c.x), max3(a.y, b.y, c.y)],
         })
@@ -566,9 +558,7 @@ impl Slicer<'_> {
     /// Splits the ring along the first valid diagonal found and queues both halves.
     fn split(&mut self, start: u32, jobs: &mut Vec<(u32, Pass)>) {
         if let Some((a, b)) = self.find_diagonal(start) {
-            let c = self.rings.split(a, b);
-            let a = self.rings.filter(a, self.rings.next(a));
-            let c = self.rings.filter(c, self.rings.next(c));
+            let (a, c) = self.cut(a, b, false);
             jobs.push((a, Pass::Ears));
             jobs.push((c, Pass::Ears));
         }
@@ -581,16 +571,24 @@ impl Slicer<'_> {
     /// its blocker cache, was a fifth of the time.
     fn split_in_walk(&mut self, start: u32, jobs: &mut Vec<(u32, Pass)>) -> Option<u32> {
         let (a, b) = self.find_diagonal(start)?;
-        let c = self.rings.split(a, b);
-        let a2 = self.rings.next(c);
-        self.rings.z_insert_copy(a, a2);
-        self.rings.z_insert_copy(b, c);
-        let a = self.rings.filter(a, self.rings.next(a));
-        let c = self.rings.filter(c, self.rings.next(c));
+        let (a, c) = self.cut(a, b, true);
         let (smaller, larger) = if self.rings.smaller_ring(a, c) { (a, c) } else { (c, a) };
         self.rings.z_unlink_ring(smaller);
         jobs.push((smaller, Pass::Ears));
         Some(larger)
+    }
+
+    /// Cuts the ring along diagonal a–b and tidies both new edges; returns a node of each half.
+    /// With `keep_z`, the two copies the cut makes join the z-order list beside their originals.
+    fn cut(&mut self, a: u32, b: u32, keep_z: bool) -> (u32, u32) {
+        let c = self.rings.split(a, b);
+        if keep_z {
+            self.rings.z_insert_copy(a, self.rings.next(c));
+            self.rings.z_insert_copy(b, c);
+        }
+        let a = self.rings.filter(a, self.rings.next(a));
+        let c = self.rings.filter(c, self.rings.next(c));
+        (a, c)
     }
 
     /// The first valid diagonal from `start` on, in ring order.
@@ -635,7 +633,7 @@ mod tests {
                 [a[0].min(b[0]).min(c[0]), a[1].min(b[1]).min(c[1])],
                 [a[0].max(b[0]).max(c[0]), a[1].max(b[1]).max(c[1])],
             );
-            let corner = Corner { a, b, c, min, max };
+            let corner = Corner { triangle: Triangle { a, b, c }, min, max };
             for _ in 0..40 {
                 let p = [min[0] + (max[0] - min[0]) * random(), min[1] + (max[1] - min[1]) * random()];
                 let z = hash.z(p[0], p[1]);

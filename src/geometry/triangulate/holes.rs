@@ -45,9 +45,7 @@ impl Bands {
     /// Registers the edge that starts at `p`.
     fn add_edge(&mut self, rings: &Rings, p: u32) {
         let (a, b) = (rings.get(p).y, rings.get(rings.next(p)).y);
-        for band in self.band(least(a, b))..=self.band(greatest(a, b)) {
-            self.lists[band].push(p);
-        }
+        self.add_span(p, self.band(a), self.band(b));
     }
 
     /// Registers every edge of the ring of `start`, each node's band worked out once (edge by
@@ -58,13 +56,19 @@ impl Bands {
         loop {
             let next = rings.next(p);
             let next_band = self.band(rings.get(next).y);
-            for b in band.min(next_band)..=band.max(next_band) {
-                self.lists[b].push(p);
-            }
+            self.add_span(p, band, next_band);
             (p, band) = (next, next_band);
             if p == start {
                 return;
             }
+        }
+    }
+
+    /// Lists the edge that starts at `p` in every band from `a`'s to `b`'s (either order).
+    #[inline]
+    fn add_span(&mut self, p: u32, a: usize, b: usize) {
+        for band in a.min(b)..=a.max(b) {
+            self.lists[band].push(p);
         }
     }
 }

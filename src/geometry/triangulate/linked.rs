@@ -233,22 +233,33 @@ impl Rings {
         let Node { prev, next, .. } = *self.get(p);
         self.nodes[next as usize].prev = prev;
         self.nodes[prev as usize].next = next;
-        if let Some(&[down, up]) = self.z.links.get(p as usize) {
-            if down != NIL {
-                self.z.links[down as usize][1] = up;
-            }
-            if up != NIL {
-                self.z.links[up as usize][0] = down;
-            }
+        if (p as usize) < self.z.links.len() {
+            self.unlink_z(p);
         }
+    }
+
+    /// Takes node `p` off the z-order list: its neighbours there join up (`p` keeps its links).
+    fn unlink_z(&mut self, p: u32) {
+        let [down, up] = self.z.links[p as usize];
+        if down != NIL {
+            self.z.links[down as usize][1] = up;
+        }
+        if up != NIL {
+            self.z.links[up as usize][0] = down;
+        }
+    }
+
+    /// Gives every node of the arena a z-order link pair and blocker slot (NIL for new ones).
+    fn size_z(&mut self) {
+        self.z.links.resize(self.nodes.len(), [NIL; 2]);
+        self.z.blockers.resize(self.nodes.len(), NIL);
     }
 
     /// Puts the nodes of the ring of `start` on a z-order list of their own, sorted by code
     /// (`keys` and `scratch` are scratch space); returns the ring's size. Nodes of other rings
     /// keep their links.
     pub fn link_z(&mut self, start: u32, hash: &ZHash, keys: &mut Vec<u64>, scratch: &mut Vec<u64>) -> usize {
-        self.z.links.resize(self.nodes.len(), [NIL; 2]);
-        self.z.blockers.resize(self.nodes.len(), NIL);
+        self.size_z();
         keys.clear();
         let mut p = start;
         loop {
@@ -279,8 +290,7 @@ impl Rings {
     /// Puts `copy` (a new node at `original`'s position) on the z-order list right after
     /// `original`, with its code.
     pub fn z_insert_copy(&mut self, original: u32, copy: u32) {
-        self.z.links.resize(self.nodes.len(), [NIL; 2]);
-        self.z.blockers.resize(self.nodes.len(), NIL);
+        self.size_z();
         self.nodes[copy as usize].z = self.nodes[original as usize].z;
         let up = self.z.links[original as usize][1];
         self.z.links[copy as usize] = [original, up];
@@ -294,13 +304,7 @@ impl Rings {
     pub fn z_unlink_ring(&mut self, start: u32) {
         let mut p = start;
         loop {
-            let [down, up] = self.z.links[p as usize];
-            if down != NIL {
-                self.z.links[down as usize][1] = up;
-            }
-            if up != NIL {
-                self.z.links[up as usize][0] = down;
-            }
+            self.unlink_z(p);
             self.z.links[p as usize] = [NIL; 2];
             p = self.next(p);
             if p == start {
@@ -462,11 +466,11 @@ impl Rings {
         }
     }
 
-    /// Whether segment a–b crosses an edge of a's ring that does not end at a or b. The edge
-    /// that starts at `hint` (a node, or NIL) is tried first, and on a crossing `hint` is set
-    /// to the edge found: the split's search tries diagonal after diagonal from one node, and
-    /// the edge that crossed the last one most often crosses the next (a walk of the whole
-    /// ring each time was half the time on crossing input).
+    /// Whether segment a–b crosses an edge of a's ring that does not end at a or b. The edges
+    /// that start at `hints` (nodes, or NIL) are tried first, and an edge found crossing joins
+    /// them: the split's search tries diagonal after diagonal from one node, and an edge that
+    /// crossed a recent one most often crosses the next (a walk of the whole ring each time was
+    /// half the time on crossing input).
     pub fn intersects_ring(&self, a: u32, b: u32, hints: &mut [u32; 4]) -> bool {
         let (na, nb) = (self.get(a), self.get(b));
         let (va, vb) = (na.vertex, nb.vertex);
@@ -506,7 +510,7 @@ impl Rings {
     }
 
     /// Whether a–b is a diagonal that splits the ring into two valid rings. The O(1) tests run
-    /// before the two that walk the ring; `hint` as in [`Rings::intersects_ring`].
+    /// before the two that walk the ring; `hints` as in [`Rings::intersects_ring`].
     pub fn is_valid_diagonal(&self, a: u32, b: u32, hints: &mut [u32; 4]) -> bool {
         let (na, nb) = (self.get(a), self.get(b));
         if self.get(na.next).vertex == nb.vertex || self.get(na.prev).vertex == nb.vertex {
