@@ -192,6 +192,8 @@ fn heal_bridge(rings: &mut Rings, bridge: u32, reverse: u32, hole: u32) -> u32 {
 /// the nodes of the merged ring at each (some may have been filtered away since).
 struct Touching {
     copies: HashMap<(u64, u64), Vec<u32>>,
+    /// A 4,096-bit filter of the shared points: most nodes skip hashing their point.
+    filter: BitFilter,
 }
 
 fn key(rings: &Rings, p: u32) -> (u64, u64) {
@@ -205,18 +207,17 @@ impl Touching {
     /// sort of the hole points, a binary search per outer point) — and records the outer
     /// ring's nodes at them. Without holes nothing is sorted or allocated.
     fn new(rings: &Rings, outer: u32, holes: &[u32]) -> Self {
-        let mut touching = Self { copies: HashMap::new() };
+        let mut touching = Self { copies: HashMap::new(), filter: BitFilter::default() };
         if holes.is_empty() {
             return touching;
         }
         let mut hole_points = Vec::new();
-        // A 4,096-bit filter of the hole points: most outer points skip the binary search.
-        let mut filter = [0u64; 64];
+        // The hole points: most outer points skip the binary search.
+        let mut filter = BitFilter::default();
         for (ring, &start) in holes.iter().enumerate() {
             rings.for_each_node(start, |p| {
                 let k = key(rings, p);
-                let bit = filter_bit(k);
-                filter[bit >> 6] |= 1 << (bit & 63);
+                filter.insert(k);
                 hole_points.push((k, ring));
             });
         }
@@ -228,8 +229,7 @@ impl Touching {
             .collect();
         rings.for_each_node(outer, |p| {
             let k = key(rings, p);
-            let bit = filter_bit(k);
-            if filter[bit >> 6] & (1 << (bit & 63)) == 0 {
+            if !filter.may_hold(k) {
                 return;
             }
             let at = hole_points.partition_point(|probe| probe.0 < k);
@@ -237,6 +237,9 @@ impl Touching {
                 shared.push(k);
             }
         });
+        for &k in &shared {
+            touching.filter.insert(k);
+        }
         touching.copies.extend(shared.into_iter().map(|k| (k, Vec::new())));
         touching.add_ring(rings, outer);
         touching
@@ -244,7 +247,11 @@ impl Touching {
 
     /// Records a node of the merged ring if it sits at a shared point.
     fn add(&mut self, rings: &Rings, p: u32) {
-        if let Some(list) = self.copies.get_mut(&key(rings, p)) {
+        let k = key(rings, p);
+        if !self.filter.may_hold(k) {
+            return;
+        }
+        if let Some(list) = self.copies.get_mut(&k) {
             list.push(p);
         }
     }
@@ -263,7 +270,8 @@ impl Touching {
         }
         let mut h = hole;
         loop {
-            if let Some(list) = self.copies.get(&key(rings, h)) {
+            let k = key(rings, h);
+            if let Some(list) = self.filter.may_hold(k).then(|| self.copies.get(&k)).flatten() {
                 let fits = |&&q: &&u32| rings.alive(q) && rings.equals(q, h) && corner_holds(rings, q, h);
                 if let Some(&q) = list.iter().find(fits) {
                     return Some((q, h));
@@ -277,10 +285,31 @@ impl Touching {
     }
 }
 
-/// A point's bit in [`Touching::new`]'s filter: its coordinate bits mixed and multiplied (a
-/// Fibonacci hash), the top 12 bits.
-fn filter_bit((x, y): (u64, u64)) -> usize {
-    ((x ^ y.rotate_left(29)).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 52) as usize
+/// A 4,096-bit set of points (a one-hash Bloom filter): `false` from [`Self::may_hold`] is
+/// certain, `true` may be wrong.
+struct BitFilter([u64; 64]);
+
+impl Default for BitFilter {
+    fn default() -> Self {
+        Self([0; 64])
+    }
+}
+
+impl BitFilter {
+    /// A point's bit: its coordinate bits mixed and multiplied (a Fibonacci hash), the top 12.
+    fn bit((x, y): (u64, u64)) -> usize {
+        ((x ^ y.rotate_left(29)).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 52) as usize
+    }
+
+    fn insert(&mut self, k: (u64, u64)) {
+        let bit = Self::bit(k);
+        self.0[bit >> 6] |= 1 << (bit & 63);
+    }
+
+    fn may_hold(&self, k: (u64, u64)) -> bool {
+        let bit = Self::bit(k);
+        self.0[bit >> 6] & (1 << (bit & 63)) != 0
+    }
 }
 
 /// Whether the hole's corner at `h` lies inside the ring's corner at `q` (same point): going
