@@ -2,7 +2,7 @@
 //! triangle counts), property tests on random simple polygons with holes, and random garbage that
 //! must not panic or hang.
 
-use indra::geometry::triangulate::{Mesh2D, triangulate, triangulate_flat};
+use indra::geometry::triangulate::{Mesh2D, Triangulator, triangulate, triangulate_flat};
 use proptest::prelude::*;
 
 #[path = "../common/earcut_fixtures.rs"]
@@ -272,6 +272,42 @@ proptest! {
         let mesh = triangulate(&rings).unwrap();
         prop_assert!(mesh.indices.iter().all(|&i| (i as usize) < mesh.positions.len()));
         prop_assert!(mesh.report.area_deviation().is_finite() || mesh.report.polygon_area == 0.0);
+    }
+}
+
+proptest! {
+    // Not shrunk: every shrinking step of a hang would wait out the watchdog.
+    #![proptest_config(ProptestConfig { cases: 20_000, max_shrink_iters: 0, ..ProptestConfig::default() })]
+
+    #[test]
+    fn garbage_in_every_layout_finishes(rings in prop::collection::vec(prop::collection::vec(prop::array::uniform2(0i8..8), 1..14), 1..8)) {
+        // earcut's layout takes every ring after the first as a hole, as given: collinear holes,
+        // holes outside, holes crossing the outer ring. A hang here stops a show, so each run
+        // gets a watchdog (a 14-point input once looped for ever).
+        // Holes drawn in the middle of the outer ring's grid, where they meet its edges.
+        let rings: Vec<Ring> = rings
+            .iter()
+            .enumerate()
+            .map(|(ring, r)| {
+                let at = |v: i8| if ring == 0 { f64::from(v) } else { f64::from(2 + v % 4) };
+                r.iter().map(|p| [at(p[0]), at(p[1])]).collect()
+            })
+            .collect();
+        let (done, finished) = std::sync::mpsc::channel();
+        let input = rings.clone();
+        std::thread::spawn(move || {
+            let (coords, starts) = flat(&input);
+            let indices = triangulate_flat(&coords, &starts).unwrap();
+            let mesh = Triangulator::new().outer_and_holes(&input).unwrap();
+            let nested = triangulate(&input).unwrap();
+            let _ = done.send((indices, mesh, nested, coords.len() / 2));
+        });
+        let result = finished.recv_timeout(std::time::Duration::from_secs(10));
+        prop_assert!(result.is_ok(), "no result within 10 s (hang or panic): {:?}", rings);
+        let (indices, mesh, nested, vertices) = result.unwrap();
+        prop_assert!(indices.iter().all(|&i| (i as usize) < vertices));
+        prop_assert!(mesh.indices.iter().all(|&i| (i as usize) < mesh.positions.len()));
+        prop_assert!(nested.indices.iter().all(|&i| (i as usize) < nested.positions.len()));
     }
 }
 

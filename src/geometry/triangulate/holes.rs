@@ -181,7 +181,14 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
 /// into it from outside its corner. Likewise the bridge's own point, when it lies strictly
 /// between its predecessor and the hole.
 fn heal_bridge(rings: &mut Rings, bridge: u32, reverse: u32, hole: u32) -> u32 {
-    rings.filter(rings.prev(reverse), reverse);
+    let healed = rings.filter(rings.prev(reverse), reverse);
+    if !rings.alive(bridge) {
+        // A hole that is a spike once bridged (two points, or collinear ones), bridged along
+        // an outer edge in line with the bridge: the filter went back through the whole hole and
+        // the bridge's node. Going on from the removed node (its links are stale) walked a ring
+        // it was no longer on, for ever.
+        return healed;
+    }
     let (before, at, to) = (rings.get(rings.prev(bridge)), rings.get(bridge), rings.get(hole));
     let between =
         area(before, at, to) == 0.0 && (before.x - at.x) * (to.x - at.x) + (before.y - at.y) * (to.y - at.y) < 0.0;

@@ -121,6 +121,22 @@ fn bad_input_is_an_error() {
 }
 
 #[test]
+fn a_hole_of_two_points_bridged_along_an_edge_finishes() {
+    // Random crossing input in earcut's layout. The hole [3,2]-[5,3] (two points, a spike once
+    // bridged) is bridged from [1,2], on the outer edge [0,2]-[1,2]: healing the bridge went back
+    // through the spike and removed the bridge's own node, and the next bridge search walked
+    // round from that removed node for ever.
+    let coords = [
+        0.0, 2.0, 1.0, 2.0, 2.0, 0.0, 3.0, 6.0, 4.0, 3.0, 4.0, 4.0, 5.0, 5.0, 5.0, 2.0, 4.0, 3.0, 2.0, 4.0, 5.0, 5.0,
+        5.0, 3.0, 3.0, 2.0, 5.0, 3.0,
+    ];
+    let (done, finished) = std::sync::mpsc::channel();
+    std::thread::spawn(move || done.send(triangulate_flat(&coords, &[4, 11, 12])));
+    let indices = finished.recv_timeout(std::time::Duration::from_secs(10)).expect("finishes").unwrap();
+    assert!(indices.iter().all(|&i| i < 14));
+}
+
+#[test]
 fn coordinates_whose_areas_would_overflow_are_an_error_and_large_ones_still_work() {
     // Was: "its points are collinear" (the area overflowed to infinity and back to NaN).
     let huge = rect(-1.7e308, -1.7e308, 1.7e308, 1.7e308);
