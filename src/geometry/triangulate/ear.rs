@@ -27,10 +27,12 @@ pub(super) const LINKED_MAX: usize = 1 << 15;
 /// Nodes the walk may visit per node of the ring before it hands the ring to the queue: z-order
 /// list steps, and two for each corner visited (it reads three nodes). About 33 on real outlines
 /// (water, 2,523 vertices), thousands on the thin ears of a spiky star, where the walk took
-/// 0.16 s at 25,000 points (0.016 s with this budget). Corners count twice since the blocker
+/// 0.16 s at 25,000 points (0.015 s with this budget). Corners count twice since the blocker
 /// cache (see `is_ear_linked`) made most list walks one test: counted once, crossing input
-/// (water-huge2) stayed in the walk through dozens of stuck rounds, 10% slower.
-const WALK_STEPS_PER_NODE: usize = 64;
+/// (water-huge2) stayed in the walk through dozens of stuck rounds, 10% slower. At 64, one of
+/// water-huge2's stuck rings went to the queue, whose other order of ears covered 0.0025 too
+/// much where earcut's walk (and ours at 96) covers 0.0022.
+const WALK_STEPS_PER_NODE: usize = 96;
 
 /// A counter-clockwise triangle (a, b, c): a convex corner tested as an ear.
 #[derive(Clone, Copy)]
@@ -213,9 +215,10 @@ impl Slicer<'_> {
     }
 
     /// [`Self::slice`] for rings up to [`LINKED_MAX`] nodes, as earcut does it: round the ring
-    /// from `start`, clipping each ear met and going on two nodes further (mapbox's earcut; going
-    /// on from the clipped ear's neighbour, as the `earcut` crate does, makes fans of slivers,
-    /// and on crossing input covered up to 0.11 too much, water-huge2 turned 90°); a whole round
+    /// from `start`, clipping each ear met and going on from its next neighbour, whose corner
+    /// just changed (the `earcut` crate's way: the same triangles as earcut on rings bridged
+    /// alike, and a fifth faster on water-huge than going on two nodes further, mapbox's way,
+    /// which leaves that corner for the next round); a whole round
     /// without a clip drops collinear and repeated points and goes on if any went, else cures
     /// local crossings once, else splits the ring. On a few thousand nodes the queue's
     /// bookkeeping cost more than the rounds. A strictly convex ring (found in one pass) is
@@ -257,8 +260,7 @@ impl Slicer<'_> {
             if is_ear {
                 self.emit_ear(prev, ear, next);
                 self.rings.remove(ear);
-                let after = self.rings.next(next);
-                (ear, stop) = (after, after);
+                (ear, stop) = (next, next);
                 continue;
             }
             convex = false;

@@ -4,12 +4,12 @@
 //! that makes the smallest angle with the ray. (The book and Eberly go right to left; the
 //! mirror image merges rings as earcut does, so the two cut crossing input alike.) Cutting along
 //! the bridge (both ends duplicated) turns an outer ring with holes into one weakly simple ring.
+//! Holes that touch the ring so far at their leftmost point bridge there (zero length), in the
+//! order of their first edges' slopes, so each lands in its own corner of the shared point.
 //!
 //! With many holes, walking the whole merged ring per hole is O(holes × vertices); above
 //! [`BANDS_FROM_HOLES`] holes the ring's edges are bucketed into horizontal bands so that both
 //! searches only visit edges near the hole's y.
-
-use std::collections::HashMap;
 
 use super::linked::{NIL, Node, Rings, area, greatest, least, mark, point_in_triangle};
 
@@ -118,22 +118,16 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
         bands.add_ring(rings, outer);
         rings.recording = true;
     }
-    let mut touching = Touching::new(rings, outer, holes);
+    // Where walks round the ring start, as in earcut (the first of several points the hole
+    // touches is taken): the outer ring's first node, or the next live one.
+    let mut head = outer;
     for &hole in holes.iter() {
-        // A hole that shares a point with the ring so far is joined there, in the copy of the
-        // point whose corner it sits in: bridging it elsewhere would leave the ring touching
-        // itself at that point, where ears can reach across.
-        let (bridge, hole) = match touching.find(rings, hole) {
-            Some(joint) => joint,
-            None => {
-                let search = if banded { Search::Bands(bands) } else { Search::Ring(outer) };
-                match find_bridge(rings, hole, search) {
-                    Some(bridge) => (bridge, hole),
-                    // No outer edge to the right: the hole is not inside this ring. Leave it out.
-                    None => continue,
-                }
-            }
-        };
+        while !rings.alive(head) {
+            head = rings.next(head);
+        }
+        let search = if banded { Search::Bands(bands) } else { Search::Ring(head) };
+        // No outer edge to the left: the hole is not inside this ring. Leave it out.
+        let Some(bridge) = find_bridge(rings, hole, search) else { continue };
         rings.touched.clear();
         if banded {
             // The hole's edges join the ring: note them while the hole is still a ring of its own.
@@ -141,7 +135,6 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
             rings.for_each_node(hole, |p| touched.push(p));
             rings.touched = touched;
         }
-        touching.add_ring(rings, hole);
         let one_point = rings.next(hole) == hole;
         let reverse = rings.split(bridge, hole);
         // A hole bridged to a Steiner point: the copy of the point stays one too. Filtered away
@@ -151,8 +144,6 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
         let bridge_copy = rings.next(reverse);
         let steiner = rings.marked(bridge, mark::STEINER) && !one_point;
         rings.set_mark(bridge_copy, mark::STEINER, steiner);
-        touching.add(rings, reverse);
-        touching.add(rings, rings.next(reverse));
         outer = heal_bridge(rings, bridge, reverse, hole);
         if banded {
             // New edges: the hole's, both bridge edges, and those the filters shortened.
@@ -193,145 +184,6 @@ fn heal_bridge(rings: &mut Rings, bridge: u32, reverse: u32, hole: u32) -> u32 {
     let between =
         area(before, at, to) == 0.0 && (before.x - at.x) * (to.x - at.x) + (before.y - at.y) * (to.y - at.y) < 0.0;
     if between { bridge } else { rings.filter(bridge, rings.next(bridge)) }
-}
-
-/// Points that two or more input rings share (holes touching each other or the outer ring), and
-/// the nodes of the merged ring at each (some may have been filtered away since).
-struct Touching {
-    copies: HashMap<(u64, u64), Vec<u32>>,
-    /// A 4,096-bit filter of the shared points: most nodes skip hashing their point.
-    filter: BitFilter,
-}
-
-fn key(rings: &Rings, p: u32) -> (u64, u64) {
-    let n = rings.get(p);
-    // +0.0 and −0.0 are one point.
-    ((n.x + 0.0).to_bits(), (n.y + 0.0).to_bits())
-}
-
-impl Touching {
-    /// Finds the shared points — hole points that another hole or the outer ring also has (a
-    /// sort of the hole points, a binary search per outer point) — and records the outer
-    /// ring's nodes at them. Without holes nothing is sorted or allocated.
-    fn new(rings: &Rings, outer: u32, holes: &[u32]) -> Self {
-        let mut touching = Self { copies: HashMap::new(), filter: BitFilter::default() };
-        if holes.is_empty() {
-            return touching;
-        }
-        let mut hole_points = Vec::new();
-        // The hole points: most outer points skip the binary search.
-        let mut filter = BitFilter::default();
-        for (ring, &start) in holes.iter().enumerate() {
-            rings.for_each_node(start, |p| {
-                let k = key(rings, p);
-                filter.insert(k);
-                hole_points.push((k, ring));
-            });
-        }
-        hole_points.sort_unstable();
-        let mut shared: Vec<(u64, u64)> = hole_points
-            .windows(2)
-            .filter(|pair| pair[0].0 == pair[1].0 && pair[0].1 != pair[1].1)
-            .map(|pair| pair[0].0)
-            .collect();
-        rings.for_each_node(outer, |p| {
-            let k = key(rings, p);
-            if !filter.may_hold(k) {
-                return;
-            }
-            let at = hole_points.partition_point(|probe| probe.0 < k);
-            if hole_points.get(at).is_some_and(|probe| probe.0 == k) {
-                shared.push(k);
-            }
-        });
-        for &k in &shared {
-            touching.filter.insert(k);
-        }
-        touching.copies.extend(shared.into_iter().map(|k| (k, Vec::new())));
-        touching.add_ring(rings, outer);
-        touching
-    }
-
-    /// Records a node of the merged ring if it sits at a shared point.
-    fn add(&mut self, rings: &Rings, p: u32) {
-        let k = key(rings, p);
-        if !self.filter.may_hold(k) {
-            return;
-        }
-        if let Some(list) = self.copies.get_mut(&k) {
-            list.push(p);
-        }
-    }
-
-    fn add_ring(&mut self, rings: &Rings, start: u32) {
-        if !self.copies.is_empty() {
-            rings.for_each_node(start, |p| self.add(rings, p));
-        }
-    }
-
-    /// A node of the merged ring and a node of the hole at the same point, the hole sitting in
-    /// that node's corner.
-    fn find(&self, rings: &Rings, hole: u32) -> Option<(u32, u32)> {
-        if self.copies.is_empty() {
-            return None;
-        }
-        let mut h = hole;
-        loop {
-            let k = key(rings, h);
-            if let Some(list) = self.filter.may_hold(k).then(|| self.copies.get(&k)).flatten() {
-                let fits = |&&q: &&u32| rings.alive(q) && rings.equals(q, h) && corner_holds(rings, q, h);
-                if let Some(&q) = list.iter().find(fits) {
-                    return Some((q, h));
-                }
-            }
-            h = rings.next(h);
-            if h == hole {
-                return None;
-            }
-        }
-    }
-}
-
-/// A 4,096-bit set of points (a one-hash Bloom filter): `false` from [`Self::may_hold`] is
-/// certain, `true` may be wrong.
-struct BitFilter([u64; 64]);
-
-impl Default for BitFilter {
-    fn default() -> Self {
-        Self([0; 64])
-    }
-}
-
-impl BitFilter {
-    /// A point's bit: its coordinate bits mixed and multiplied (a Fibonacci hash), the top 12.
-    fn bit((x, y): (u64, u64)) -> usize {
-        ((x ^ y.rotate_left(29)).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 52) as usize
-    }
-
-    fn insert(&mut self, k: (u64, u64)) {
-        let bit = Self::bit(k);
-        self.0[bit >> 6] |= 1 << (bit & 63);
-    }
-
-    fn may_hold(&self, k: (u64, u64)) -> bool {
-        let bit = Self::bit(k);
-        self.0[bit >> 6] & (1 << (bit & 63)) != 0
-    }
-}
-
-/// Whether the hole's corner at `h` lies inside the ring's corner at `q` (same point): going
-/// counter-clockwise around the point from the ring's outgoing edge, the hole's edges come (in
-/// the hole's clockwise order: incoming, then outgoing) before the ring's incoming edge.
-fn corner_holds(rings: &Rings, q: u32, h: u32) -> bool {
-    let at = rings.get(q);
-    let direction = |p: u32| {
-        let n = rings.get(p);
-        (n.y - at.y).atan2(n.x - at.x)
-    };
-    let start = direction(rings.next(q));
-    let turn = |p: u32| (direction(p) - start).rem_euclid(std::f64::consts::TAU);
-    let (hole_in, hole_out, ring_in) = (turn(rings.prev(h)), turn(rings.next(h)), turn(rings.prev(q)));
-    hole_in < hole_out && hole_out <= ring_in
 }
 
 /// The node of a ring with the smallest x (lowest y among ties).
@@ -377,40 +229,37 @@ fn for_each_edge(rings: &Rings, search: &Search, y0: f64, y1: f64, mut visit: im
 fn find_bridge(rings: &Rings, hole: u32, search: Search) -> Option<u32> {
     let (hx, hy) = (rings.get(hole).x, rings.get(hole).y);
     // The nearest crossing of the ray y = hy, x ≤ hx with an outer edge seen from inside
-    // (counter-clockwise, so an edge going down).
+    // (counter-clockwise, so an edge going down). The first vertex met at the hole point
+    // itself, or the first edge through it, ends the search: the bridge has no length there.
     let mut qx = f64::NEG_INFINITY;
     let mut m = NIL;
-    let mut touch = NIL;
+    let mut found = NIL;
     for_each_edge(rings, &search, hy, hy, |p| {
+        if found != NIL {
+            return;
+        }
         let (n, nn) = (rings.get(p), rings.get(rings.next(p)));
+        if nn.x == hx && nn.y == hy {
+            found = n.next;
+            return;
+        }
         if nn.y <= hy && hy <= n.y && nn.y != n.y {
             let x = n.x + (hy - n.y) * (nn.x - n.x) / (nn.y - n.y);
-            // The hole touches the outer ring at a vertex: bridge there (zero length).
-            let vertex = match x == hx {
-                true if hy == n.y => p,
-                true if hy == nn.y => n.next,
-                _ => NIL,
-            };
             if x <= hx && x > qx {
                 qx = x;
                 m = if n.x < nn.x { p } else { n.next };
-                touch = vertex;
-            } else if x == hx && touch == NIL && vertex != NIL {
-                // Another edge through the hole point, at a vertex of it: that one.
-                touch = vertex;
+                if x == hx {
+                    // On the edge, between its ends: its left end.
+                    found = m;
+                }
             }
         }
     });
-    if touch != NIL {
-        return Some(touch);
+    if found != NIL {
+        return Some(found);
     }
     if m == NIL {
         return None;
-    }
-    if qx == hx {
-        // The hole point lies on an outer edge, between its ends: bridge to its left end (the
-        // triangle searched below would have no area).
-        return Some(m);
     }
     // A reflex vertex inside triangle (hole point, crossing, endpoint) may hide the endpoint;
     // the visible one is the vertex in there with the smallest angle to the ray.

@@ -329,9 +329,11 @@ impl Rings {
     }
 
     /// Links `points` (vertex index, position) into a ring that runs counter-clockwise when
-    /// `ccw` (clockwise otherwise), whatever their input order, skipping repeats of the previous
-    /// point. `signed_area` is the ring's shoelace area (positive = counter-clockwise). Returns a
-    /// node of the ring, or NIL when there were no points.
+    /// `ccw` (clockwise otherwise), whatever their input order. Repeated points stay, as in
+    /// earcut, for the filters to take: dropped here, a hole that repeats its leftmost point
+    /// was bridged and healed otherwise than earcut's, and on crossing input (water-huge) cut
+    /// elsewhere. `signed_area` is the ring's shoelace area (positive = counter-clockwise).
+    /// Returns a node of the ring, or NIL when there were no points.
     pub fn link_ring(&mut self, vertices: &[[f64; 2]], first_vertex: u32, signed_area: f64, ccw: bool) -> u32 {
         // Built in one go: node k of the ring is node `first + k` of the arena, its
         // neighbours known as it is pushed (inserting one by one cost a tenth of a small
@@ -339,9 +341,6 @@ impl Rings {
         let first = self.nodes.len() as u32;
         let mut push = |i: usize| {
             let [x, y] = vertices[i];
-            if self.nodes.len() as u32 > first && self.nodes.last().is_some_and(|l| l.x == x && l.y == y) {
-                return;
-            }
             let id = self.nodes.len() as u32;
             self.nodes.push(Node {
                 x,
