@@ -7,14 +7,10 @@
 //! Holes that touch the ring so far at their leftmost point bridge there (zero length), in the
 //! order of their first edges' slopes, so each lands in its own corner of the shared point.
 //!
-//! With many holes, walking the whole merged ring per hole is O(holes × vertices); above
-//! [`BANDS_FROM_HOLES`] holes the ring's edges are bucketed into horizontal bands so that both
-//! searches only visit edges near the hole's y.
+//! Walking the whole merged ring per hole is O(holes × vertices): the ring's edges are bucketed
+//! into horizontal bands instead, so that both searches only visit edges near the hole's y.
 
 use super::linked::{NIL, Node, Rings, area, greatest, least, mark, point_in_triangle};
-
-/// Holes from which the band index pays for itself.
-const BANDS_FROM_HOLES: usize = 8;
 
 /// Edges of the merged ring bucketed by y: each band lists the start nodes of the edges whose y
 /// range overlaps it. Entries go stale when nodes are removed (checked on use) and are added for
@@ -73,14 +69,6 @@ impl Bands {
     }
 }
 
-/// Where the bridge searches look for outer edges and vertices.
-enum Search<'a> {
-    /// Walk the whole ring from a node.
-    Ring(u32),
-    /// Look up the bands.
-    Bands(&'a Bands),
-}
-
 /// Splices every hole (a node of each linked clockwise hole ring in `holes`) into the outer ring
 /// of `outer`; returns a node of the merged ring.
 pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u32, holes: &mut [u32]) -> u32 {
@@ -103,38 +91,28 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
         };
         na.x.total_cmp(&nb.x).then(na.y.total_cmp(&nb.y)).then(slope(na).total_cmp(&slope(nb))).then(a.cmp(&b))
     });
-    let banded = holes.len() >= BANDS_FROM_HOLES;
-    if banded {
-        let (mut lo, mut hi, mut count) = (f64::INFINITY, f64::NEG_INFINITY, 0);
-        rings.for_each_node(outer, |p| {
-            lo = least(lo, rings.get(p).y);
-            hi = greatest(hi, rings.get(p).y);
-            count += 1;
-        });
-        // About four edges a band, but no more bands than the holes' searches need: filling
-        // them is paid per edge, and on a long ring with a few holes (water: 2,397 vertices,
-        // 9 holes) it cost a tenth of the whole triangulation.
-        bands.reset(lo, hi, (count / 4).min(holes.len() * 8));
-        bands.add_ring(rings, outer);
-        rings.recording = true;
-    }
-    // Where walks round the ring start, as in earcut (the first of several points the hole
-    // touches is taken): the outer ring's first node, or the next live one.
-    let mut head = outer;
+    let (mut lo, mut hi, mut count) = (f64::INFINITY, f64::NEG_INFINITY, 0);
+    rings.for_each_node(outer, |p| {
+        lo = least(lo, rings.get(p).y);
+        hi = greatest(hi, rings.get(p).y);
+        count += 1;
+    });
+    // About four edges a band, but no more bands than the holes' searches need: filling them is
+    // paid per edge, and on a long ring with a few holes (water: 2,397 vertices, 9 holes) it
+    // cost a tenth of the whole triangulation. With fewer than eight holes the ring was walked
+    // round twice per hole instead: no faster on dude (2 holes) or water4 (5), slower on water2
+    // (7 holes: 230 against 196 µs, the least of five runs each).
+    bands.reset(lo, hi, (count / 4).min(holes.len() * 8));
+    bands.add_ring(rings, outer);
+    rings.recording = true;
     for &hole in holes.iter() {
-        while !rings.alive(head) {
-            head = rings.next(head);
-        }
-        let search = if banded { Search::Bands(bands) } else { Search::Ring(head) };
         // No outer edge to the left: the hole is not inside this ring. Leave it out.
-        let Some(bridge) = find_bridge(rings, hole, search) else { continue };
-        rings.touched.clear();
-        if banded {
-            // The hole's edges join the ring: note them while the hole is still a ring of its own.
-            let mut touched = std::mem::take(&mut rings.touched);
-            rings.for_each_node(hole, |p| touched.push(p));
-            rings.touched = touched;
-        }
+        let Some(bridge) = find_bridge(rings, hole, bands) else { continue };
+        // The hole's edges join the ring: note them while the hole is still a ring of its own.
+        let mut touched = std::mem::take(&mut rings.touched);
+        touched.clear();
+        rings.for_each_node(hole, |p| touched.push(p));
+        rings.touched = touched;
         let one_point = rings.next(hole) == hole;
         let reverse = rings.split(bridge, hole);
         // A hole bridged to a Steiner point: the copy of the point stays one too. Filtered away
@@ -145,18 +123,16 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
         let steiner = rings.marked(bridge, mark::STEINER) && !one_point;
         rings.set_mark(bridge_copy, mark::STEINER, steiner);
         outer = heal_bridge(rings, bridge, reverse, hole);
-        if banded {
-            // New edges: the hole's, both bridge edges, and those the filters shortened.
-            for p in [bridge, reverse, rings.next(reverse), rings.prev(reverse)] {
-                if rings.alive(p) {
-                    bands.add_edge(rings, p);
-                }
+        // New edges: the hole's, both bridge edges, and those the filters shortened.
+        for p in [bridge, reverse, rings.next(reverse), rings.prev(reverse)] {
+            if rings.alive(p) {
+                bands.add_edge(rings, p);
             }
-            for i in 0..rings.touched.len() {
-                let p = rings.touched[i];
-                if rings.alive(p) {
-                    bands.add_edge(rings, p);
-                }
+        }
+        for i in 0..rings.touched.len() {
+            let p = rings.touched[i];
+            if rings.alive(p) {
+                bands.add_edge(rings, p);
             }
         }
     }
@@ -201,32 +177,18 @@ fn leftmost(rings: &Rings, start: u32) -> u32 {
 }
 
 /// Calls `visit` with the start node of every live edge that may cross y in [y0, y1].
-fn for_each_edge(rings: &Rings, search: &Search, y0: f64, y1: f64, mut visit: impl FnMut(u32)) {
-    match search {
-        Search::Ring(start) => {
-            let mut p = *start;
-            loop {
+fn for_each_edge(rings: &Rings, bands: &Bands, y0: f64, y1: f64, mut visit: impl FnMut(u32)) {
+    for band in bands.band(y0)..=bands.band(y1) {
+        for &p in &bands.lists[band] {
+            if rings.alive(p) {
                 visit(p);
-                p = rings.next(p);
-                if p == *start {
-                    break;
-                }
-            }
-        }
-        Search::Bands(bands) => {
-            for band in bands.band(y0)..=bands.band(y1) {
-                for &p in &bands.lists[band] {
-                    if rings.alive(p) {
-                        visit(p);
-                    }
-                }
             }
         }
     }
 }
 
 /// The outer vertex the hole's leftmost vertex connects to.
-fn find_bridge(rings: &Rings, hole: u32, search: Search) -> Option<u32> {
+fn find_bridge(rings: &Rings, hole: u32, bands: &Bands) -> Option<u32> {
     let (hx, hy) = (rings.get(hole).x, rings.get(hole).y);
     // The nearest crossing of the ray y = hy, x ≤ hx with an outer edge seen from inside
     // (counter-clockwise, so an edge going down). The first vertex met at the hole point
@@ -234,7 +196,7 @@ fn find_bridge(rings: &Rings, hole: u32, search: Search) -> Option<u32> {
     let mut qx = f64::NEG_INFINITY;
     let mut m = NIL;
     let mut found = NIL;
-    for_each_edge(rings, &search, hy, hy, |p| {
+    for_each_edge(rings, bands, hy, hy, |p| {
         if found != NIL {
             return;
         }
@@ -285,11 +247,6 @@ fn find_bridge(rings: &Rings, hole: u32, search: Search) -> Option<u32> {
             }
         }
     };
-    // Walking the ring, start at the endpoint (the sample's order, which decides exact ties).
-    let around = match search {
-        Search::Ring(_) => Search::Ring(m),
-        bands => bands,
-    };
-    for_each_edge(rings, &around, hy.min(my), hy.max(my), consider);
+    for_each_edge(rings, bands, hy.min(my), hy.max(my), consider);
     Some(best)
 }
