@@ -18,25 +18,12 @@ fn main() {
         let base = earcut_fixtures::fixture(&name);
         let mut line = format!("{name}:");
         for turn in 0..4 {
-            let rings: Vec<earcut_fixtures::Ring> = base
-                .iter()
-                .map(|ring| {
-                    ring.iter()
-                        .map(|&[x, y]| match turn {
-                            0 => [x, y],
-                            1 => [-y, x],
-                            2 => [-x, -y],
-                            _ => [y, -x],
-                        })
-                        .collect()
-                })
-                .collect();
+            let rings = earcut_fixtures::rotate(&base, turn);
             let (coords, hole_starts) = earcut_fixtures::flat(&rings);
             let points: Vec<[f64; 2]> = coords.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
             let holes: Vec<u32> = hole_starts.iter().map(|&h| h as u32).collect();
             let ours = triangulate_flat(&coords, &hole_starts).expect("fixture triangulates");
-            let mut theirs = Vec::new();
-            earcut::Earcut::new().earcut(points.iter().copied(), &holes, &mut theirs);
+            let theirs = earcut_fixtures::earcut_triangles(&coords, &hole_starts);
             let ours = earcut::deviation(points.iter().copied(), &holes, &ours);
             let theirs = earcut::deviation(points.iter().copied(), &holes, &theirs);
             let worse = if ours > theirs { " worse" } else { "" };

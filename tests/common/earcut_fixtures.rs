@@ -1,5 +1,6 @@
 //! earcut's fixture polygons (`tests/fixtures/earcut/`, ISC, see its NOTICE.md), read as rings
-//! or in earcut's flat layout. Shared by `tests/suite/triangulate.rs` and `benches/triangulate.rs`.
+//! or in earcut's flat layout, turned, and as the `earcut` crate triangulates them. Shared by
+//! `tests/suite/triangulate.rs`, `benches/triangulate.rs` and `examples/triangulate_deviation.rs`.
 #![allow(dead_code)]
 
 /// One ring of [x, y] points.
@@ -24,4 +25,25 @@ pub fn flat(rings: &[Ring]) -> (Vec<f64>, Vec<usize>) {
         })
         .collect();
     (coords, starts)
+}
+
+/// The rings turned counter-clockwise by `quarter_turns` × 90° (exact: coordinates only swap
+/// and change sign).
+pub fn rotate(rings: &[Ring], quarter_turns: u32) -> Vec<Ring> {
+    let turn = |[x, y]: [f64; 2]| match quarter_turns % 4 {
+        0 => [x, y],
+        1 => [-y, x],
+        2 => [-x, -y],
+        _ => [y, -x],
+    };
+    rings.iter().map(|r| r.iter().map(|&p| turn(p)).collect()).collect()
+}
+
+/// The `earcut` crate's triangles for flat input (coordinates and hole starts, as [`flat`]).
+pub fn earcut_triangles(coords: &[f64], starts: &[usize]) -> Vec<u32> {
+    let points: Vec<[f64; 2]> = coords.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
+    let holes: Vec<u32> = starts.iter().map(|&s| s as u32).collect();
+    let mut indices = Vec::new();
+    earcut::Earcut::new().earcut(points.iter().copied(), &holes, &mut indices);
+    indices
 }

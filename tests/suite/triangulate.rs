@@ -8,18 +8,7 @@ use proptest::prelude::*;
 #[path = "../common/earcut_fixtures.rs"]
 mod earcut_fixtures;
 
-use earcut_fixtures::{Ring, fixture, flat};
-
-/// Exact rotation by a multiple of 90°.
-fn rotate(rings: &[Ring], quarter_turns: u32) -> Vec<Ring> {
-    let turn = |[x, y]: [f64; 2]| match quarter_turns % 4 {
-        0 => [x, y],
-        1 => [-y, x],
-        2 => [-x, -y],
-        _ => [y, -x],
-    };
-    rings.iter().map(|r| r.iter().map(|&p| turn(p)).collect()).collect()
-}
+use earcut_fixtures::{Ring, earcut_triangles, fixture, flat, rotate};
 
 fn ring_area(ring: &[[f64; 2]]) -> f64 {
     let mut sum = 0.0;
@@ -105,15 +94,6 @@ const CROSSING: f64 = f64::INFINITY;
 /// tidies from the removed node's stale links, which re-links removed nodes (at 270°, walking
 /// its ring from its outer node no longer comes back); ours goes on from a live node.
 const CROSSING_SLACK: f64 = 0.02;
-
-/// The `earcut` crate's triangles for the same flat input.
-fn earcut_triangles(coords: &[f64], starts: &[usize]) -> Vec<u32> {
-    let points: Vec<[f64; 2]> = coords.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
-    let holes: Vec<u32> = starts.iter().map(|&s| s as u32).collect();
-    let mut indices = Vec::new();
-    earcut::Earcut::new().earcut(points.iter().copied(), &holes, &mut indices);
-    indices
-}
 
 #[test]
 fn earcut_fixtures_in_four_rotations() {

@@ -109,10 +109,15 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
         // No outer edge to the left: the hole is not inside this ring. Leave it out.
         let Some(bridge) = find_bridge(rings, hole, bands) else { continue };
         // The hole's edges join the ring: note them while the hole is still a ring of its own.
-        let mut touched = std::mem::take(&mut rings.touched);
-        touched.clear();
-        rings.for_each_node(hole, |p| touched.push(p));
-        rings.touched = touched;
+        rings.touched.clear();
+        let mut p = hole;
+        loop {
+            rings.touched.push(p);
+            p = rings.next(p);
+            if p == hole {
+                break;
+            }
+        }
         let one_point = rings.next(hole) == hole;
         let reverse = rings.split(bridge, hole);
         // A hole bridged to a Steiner point: the copy of the point stays one too. Filtered away
