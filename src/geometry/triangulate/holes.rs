@@ -10,7 +10,7 @@
 //! Walking the whole merged ring per hole is O(holes × vertices): the ring's edges are bucketed
 //! into horizontal bands instead, so that both searches only visit edges near the hole's y.
 
-use super::linked::{NIL, Node, Rings, area, greatest, least, mark, point_in_triangle};
+use super::linked::{NIL, Node, Rings, area, mark, point_in_triangle};
 
 /// Edges of the merged ring bucketed by y: each band lists the start nodes of the edges whose y
 /// range overlaps it. Entries go stale when nodes are removed (checked on use) and are added for
@@ -23,7 +23,7 @@ pub(super) struct Bands {
 }
 
 impl Bands {
-    fn reset(&mut self, min_y: f64, max_y: f64, count: usize) {
+    fn reset(&mut self, [min_y, max_y]: [f64; 2], count: usize) {
         let count = count.max(1);
         self.lists.iter_mut().for_each(Vec::clear);
         self.lists.resize_with(count, Vec::new);
@@ -44,19 +44,19 @@ impl Bands {
         self.add_span(p, self.band(a), self.band(b));
     }
 
-    /// Registers every edge of the ring of `start`, each node's band worked out once (edge by
-    /// edge, each was worked out twice).
-    fn add_ring(&mut self, rings: &Rings, start: u32) {
-        let mut p = start;
-        let mut band = self.band(rings.get(p).y);
-        loop {
+    /// Registers every edge of the outer ring, from its node `start` on (earcut's order: ties in
+    /// the bridge search go to the edge listed first). Its nodes are the arena's first, in ring
+    /// order (see [`OuterRing`]): read in order, each node's band worked out once (walking the
+    /// ring, each node's load waited on the one before).
+    fn add_outer_ring(&mut self, rings: &Rings, outer: &OuterRing) {
+        let (start, size) = (outer.node, outer.size);
+        let first = self.band(rings.get(start).y);
+        let mut band = first;
+        for p in (start..size).chain(0..start) {
             let next = rings.next(p);
-            let next_band = self.band(rings.get(next).y);
+            let next_band = if next == start { first } else { self.band(rings.get(next).y) };
             self.add_span(p, band, next_band);
-            (p, band) = (next, next_band);
-            if p == start {
-                return;
-            }
+            band = next_band;
         }
     }
 
@@ -69,14 +69,20 @@ impl Bands {
     }
 }
 
+/// The outer ring, linked first into the arena: nodes `0..size`, each followed by the next
+/// (the last by the first).
+pub(super) struct OuterRing {
+    /// A node of it.
+    pub node: u32,
+    pub size: u32,
+    /// Its lowest and highest y.
+    pub y_range: [f64; 2],
+}
+
 /// Splices every hole (a node of each linked clockwise hole ring in `holes`) into the outer ring
 /// of `outer`; returns a node of the merged ring.
-pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u32, holes: &mut [u32]) -> u32 {
-    if holes.is_empty() {
-        // Nothing cut, nothing to tidy: collinear points of the ring itself wait for the
-        // slicer's first fallback, as in earcut (a pass over a small ring cost 13% of it).
-        return outer;
-    }
+pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, outer: &OuterRing, holes: &mut [u32]) -> u32 {
+    let mut merged = outer.node;
     for hole in holes.iter_mut() {
         *hole = leftmost(rings, *hole);
     }
@@ -91,19 +97,13 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
         };
         na.x.total_cmp(&nb.x).then(na.y.total_cmp(&nb.y)).then(slope(na).total_cmp(&slope(nb))).then(a.cmp(&b))
     });
-    let (mut lo, mut hi, mut count) = (f64::INFINITY, f64::NEG_INFINITY, 0);
-    rings.for_each_node(outer, |p| {
-        lo = least(lo, rings.get(p).y);
-        hi = greatest(hi, rings.get(p).y);
-        count += 1;
-    });
     // About four edges a band, but no more bands than the holes' searches need: filling them is
     // paid per edge, and on a long ring with a few holes (water: 2,397 vertices, 9 holes) it
     // cost a tenth of the whole triangulation. With fewer than eight holes the ring was walked
     // round twice per hole instead: no faster on dude (2 holes) or water4 (5), slower on water2
     // (7 holes: 230 against 196 µs, the least of five runs each).
-    bands.reset(lo, hi, (count / 4).min(holes.len() * 8));
-    bands.add_ring(rings, outer);
+    bands.reset(outer.y_range, (outer.size as usize / 4).min(holes.len() * 8));
+    bands.add_outer_ring(rings, outer);
     rings.recording = true;
     for &hole in holes.iter() {
         // No outer edge to the left: the hole is not inside this ring. Leave it out.
@@ -127,7 +127,7 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
         let bridge_copy = rings.next(reverse);
         let steiner = rings.marked(bridge, mark::STEINER) && !one_point;
         rings.set_mark(bridge_copy, mark::STEINER, steiner);
-        outer = heal_bridge(rings, bridge, reverse, hole);
+        merged = heal_bridge(rings, bridge, reverse, hole);
         // New edges: the hole's, both bridge edges, and those the filters shortened.
         for p in [bridge, reverse, rings.next(reverse), rings.prev(reverse)] {
             if rings.alive(p) {
@@ -143,7 +143,7 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, mut outer: u
     }
     rings.recording = false;
     // Bridges line up with edges often enough that a pass over the merged ring pays off.
-    rings.filter(outer, NIL)
+    rings.filter(merged, NIL)
 }
 
 /// Tidies collinear and repeated points around the two new edges of a bridge (`bridge` on the

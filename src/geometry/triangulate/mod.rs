@@ -335,6 +335,7 @@ impl Triangulator {
         if node == NIL || self.rings.next(node) == self.rings.prev(node) {
             return;
         }
+        let outer_nodes = self.rings.nodes.len() as u32;
         self.holes.clear();
         for hole in holes {
             let ring = &vertices[hole.clone()];
@@ -347,15 +348,23 @@ impl Triangulator {
             }
             self.holes.push(start);
         }
-        let mut hole_nodes = std::mem::take(&mut self.holes);
-        node = holes::eliminate_holes(&mut self.rings, &mut self.bands, node, &mut hole_nodes);
-        self.holes = hole_nodes;
-
         let total = outer.len() + holes.iter().map(Range::len).sum::<usize>();
-        let hash = (total > HASH_THRESHOLD).then(|| {
-            let shape = RingShape::new(outer_vertices);
-            ZHash::new(shape.min, shape.max)
-        });
+        let hashed = total > HASH_THRESHOLD;
+        // The outer ring's box, read from the input in order (walking the ring for it was a
+        // tenth of bridging): the hash's extent and the bands' height.
+        let shape = (hashed || !self.holes.is_empty()).then(|| RingShape::new(outer_vertices));
+        // Without holes nothing is cut and nothing tidied: collinear points of the ring itself
+        // wait for the slicer's first fallback, as in earcut (a pass over a small ring cost 13%
+        // of it).
+        if let Some(shape) = &shape
+            && !self.holes.is_empty()
+        {
+            let mut hole_nodes = std::mem::take(&mut self.holes);
+            let outer = holes::OuterRing { node, size: outer_nodes, y_range: [shape.min[1], shape.max[1]] };
+            node = holes::eliminate_holes(&mut self.rings, &mut self.bands, &outer, &mut hole_nodes);
+            self.holes = hole_nodes;
+        }
+        let hash = shape.filter(|_| hashed).map(|shape| ZHash::new(shape.min, shape.max));
         Slicer {
             rings: &mut self.rings,
             hash,
