@@ -402,14 +402,18 @@ impl Slicer<'_> {
         if area(na, nb, nc) <= 0.0 {
             return Verdict::Reflex;
         }
-        let corner = Triangle { a: [na.x, na.y], b: [nb.x, nb.y], c: [nc.x, nc.y] };
+        let corner = Corner {
+            triangle: Triangle { a: [na.x, na.y], b: [nb.x, nb.y], c: [nc.x, nc.y] },
+            min: [min3(na.x, nb.x, nc.x), min3(na.y, nb.y, nc.y)],
+            max: [max3(na.x, nb.x, nc.x), max3(na.y, nb.y, nc.y)],
+        };
         // From the corners' codes: quantising the box's corners again was a sixth of the walk.
         let (min_z, max_z) = box_codes(na.z, nb.z, nc.z);
         // Whether a node blocks the ear: in or on the triangle (a copy of its first corner
         // aside), not its last corner, and reflex or flat.
         let blocks = |p: u32| {
             let n = r.get(p);
-            p != c && corner.holds([n.x, n.y]) && !self.convex(p)
+            p != c && corner.covers([n.x, n.y]) && !self.convex(p)
         };
         // The node that blocked this corner last time: if it is still on this ring's list (link_z
         // starts the cache afresh; a split takes the smaller half off the list) and still
