@@ -229,6 +229,7 @@ impl Rings {
     }
 
     /// Unlinks a node from its ring and its z-order list (it keeps its own links).
+    #[inline]
     pub fn remove(&mut self, p: u32) {
         let Node { prev, next, .. } = *self.get(p);
         self.nodes[next as usize].prev = prev;
