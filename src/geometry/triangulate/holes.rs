@@ -10,7 +10,8 @@
 //! Walking the whole merged ring per hole is O(holes × vertices): the ring's edges are bucketed
 //! into horizontal bands instead, so that both searches only visit edges near the hole's y.
 
-use super::linked::{NIL, Node, Rings, area, mark, point_in_triangle};
+use super::linked::{NIL, Rings, area, mark, point_in_triangle};
+use super::ring_order::RingOrder;
 
 /// Edges of the merged ring bucketed by y: each band lists the start nodes of the edges whose y
 /// range overlaps it. Entries go stale when nodes are removed (checked on use) and are added for
@@ -81,22 +82,29 @@ pub(super) struct OuterRing {
 
 /// Splices every hole (a node of each linked clockwise hole ring in `holes`) into the outer ring
 /// of `outer`; returns a node of the merged ring.
-pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, outer: &OuterRing, holes: &mut [u32]) -> u32 {
+pub(super) fn eliminate_holes(
+    rings: &mut Rings,
+    bands: &mut Bands,
+    order: &mut RingOrder,
+    outer: &OuterRing,
+    holes: &mut [u32],
+) -> u32 {
     let mut merged = outer.node;
+    order.reset(outer.node);
     for hole in holes.iter_mut() {
         *hole = leftmost(rings, *hole);
     }
     // Left first: every hole to the left of the current one is already part of the outer ring,
     // so its ray can only meet the outer ring. Holes whose leftmost points meet go in order of
     // their first edge's slope (counter-clockwise), so each bridges at the shared point.
+    let point = |h: u32| [rings.get(h).x, rings.get(h).y];
     holes.sort_unstable_by(|&a, &b| {
-        let (na, nb) = (rings.get(a), rings.get(b));
-        let slope = |n: &Node| {
-            let next = rings.get(n.next);
-            (next.y - n.y) / (next.x - n.x)
-        };
-        na.x.total_cmp(&nb.x).then(na.y.total_cmp(&nb.y)).then(slope(na).total_cmp(&slope(nb))).then(a.cmp(&b))
+        let ([ax, ay], [bx, by]) = (point(a), point(b));
+        ax.total_cmp(&bx).then(ay.total_cmp(&by)).then(a.cmp(&b))
     });
+    for run in holes.chunk_by_mut(|&a, &b| point(a) == point(b)) {
+        order_by_slope(rings, run);
+    }
     // About four edges a band, but no more bands than the holes' searches need: filling them is
     // paid per edge, and on a long ring with a few holes (water: 2,397 vertices, 9 holes) it
     // cost a tenth of the whole triangulation. With fewer than eight holes the ring was walked
@@ -107,7 +115,7 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, outer: &Oute
     rings.recording = true;
     for &hole in holes.iter() {
         // No outer edge to the left: the hole is not inside this ring. Leave it out.
-        let Some(bridge) = find_bridge(rings, hole, bands) else { continue };
+        let Some(bridge) = find_bridge(rings, hole, bands, order) else { continue };
         // The hole's edges join the ring: note them while the hole is still a ring of its own.
         rings.touched.clear();
         let mut p = hole;
@@ -119,7 +127,9 @@ pub(super) fn eliminate_holes(rings: &mut Rings, bands: &mut Bands, outer: &Oute
             }
         }
         let one_point = rings.next(hole) == hole;
+        let after = rings.next(bridge);
         let reverse = rings.split(bridge, hole);
+        order.spliced(rings, bridge, after);
         // A hole bridged to a Steiner point: the copy of the point stays one too. Filtered away
         // as collinear, it would leave the point on the edge that replaced it, a vertex of the
         // triangles on one side only. (Not the copy of a one-point hole: two copies of a point
@@ -167,6 +177,26 @@ fn heal_bridge(rings: &mut Rings, bridge: u32, reverse: u32, hole: u32) -> u32 {
     if between { bridge } else { rings.filter(bridge, rings.next(bridge)) }
 }
 
+/// Orders holes that share their leftmost point by the slope of their first edge, keeping
+/// input order where a slope is undefined (a first edge of no length: a hole of repeated
+/// points), as earcut's stable sort does, which calls such a slope equal to any other. A total
+/// order (NaN first or last) bridged such holes in another order than earcut's: on crossing
+/// input, other triangles. An insertion sort, as that rule is no total order (a sort may panic
+/// on one); runs are a few holes long.
+fn order_by_slope(rings: &Rings, run: &mut [u32]) {
+    let slope = |h: u32| {
+        let (n, next) = (rings.get(h), rings.get(rings.next(h)));
+        (next.y - n.y) / (next.x - n.x)
+    };
+    for i in 1..run.len() {
+        let mut j = i;
+        while j > 0 && slope(run[j]) < slope(run[j - 1]) {
+            run.swap(j, j - 1);
+            j -= 1;
+        }
+    }
+}
+
 /// The node of a ring with the smallest x (lowest y among ties).
 fn leftmost(rings: &Rings, start: u32) -> u32 {
     let mut best = start;
@@ -192,66 +222,97 @@ fn for_each_edge(rings: &Rings, bands: &Bands, y0: f64, y1: f64, mut visit: impl
     }
 }
 
-/// The outer vertex the hole's leftmost vertex connects to.
-fn find_bridge(rings: &Rings, hole: u32, bands: &Bands) -> Option<u32> {
+/// The outer vertex the hole's leftmost vertex connects to. Where candidates tie, the one
+/// earcut's scan meets first in ring order wins (see [`RingOrder`]).
+fn find_bridge(rings: &Rings, hole: u32, bands: &Bands, order: &mut RingOrder) -> Option<u32> {
     let (hx, hy) = (rings.get(hole).x, rings.get(hole).y);
     // The nearest crossing of the ray y = hy, x ≤ hx with an outer edge seen from inside
-    // (counter-clockwise, so an edge going down). The first vertex met at the hole point
-    // itself, or the first edge through it, ends the search: the bridge has no length there.
+    // (counter-clockwise, so an edge going down). A vertex at the hole point itself, or an
+    // edge through it, ends earcut's scan: the bridge has no length there.
+    let head = order.live_head(rings);
     let mut qx = f64::NEG_INFINITY;
-    let mut m = NIL;
-    let mut found = NIL;
+    let (mut hits, mut crossings) = (std::mem::take(&mut order.hits), std::mem::take(&mut order.crossings));
+    hits.clear();
+    crossings.clear();
     for_each_edge(rings, bands, hy, hy, |p| {
-        if found != NIL {
-            return;
-        }
         let (n, nn) = (rings.get(p), rings.get(rings.next(p)));
         if nn.x == hx && nn.y == hy {
-            found = n.next;
+            hits.push((p, n.next));
             return;
         }
         if nn.y <= hy && hy <= n.y && nn.y != n.y {
             let x = n.x + (hy - n.y) * (nn.x - n.x) / (nn.y - n.y);
-            if x <= hx && x > qx {
-                qx = x;
-                m = if n.x < nn.x { p } else { n.next };
-                if x == hx {
-                    // On the edge, between its ends: its left end.
-                    found = m;
+            let m = if n.x < nn.x { p } else { n.next };
+            if x == hx {
+                // Leaving the hole point: the edge into it was met first (unless it starts at
+                // the head), and found the vertex.
+                let from_vertex = n.x == hx && n.y == hy && p != head;
+                hits.push(if from_vertex { (n.prev, p) } else { (p, m) });
+            } else if x < hx && x >= qx {
+                if x > qx {
+                    qx = x;
+                    crossings.clear();
                 }
+                // On the ray's side of the edge, its left end.
+                crossings.push((p, m));
             }
         }
     });
-    if found != NIL {
-        return Some(found);
-    }
-    if m == NIL {
-        return None;
-    }
-    // A reflex vertex inside triangle (hole point, crossing, endpoint) may hide the endpoint;
-    // the visible one is the vertex in there with the smallest angle to the ray.
+    let found = if !hits.is_empty() {
+        Some(order.first(rings, &hits))
+    } else if !crossings.is_empty() {
+        let m = order.first(rings, &crossings);
+        Some(visible_vertex(rings, hole, bands, order, m, qx))
+    } else {
+        // No outer edge to the left.
+        None
+    };
+    (order.hits, order.crossings) = (hits, crossings);
+    found
+}
+
+/// A reflex vertex inside triangle (hole point, crossing at `qx`, endpoint `m`) may hide `m`;
+/// the visible one is the vertex in there with the smallest angle to the ray (the rightmost
+/// among equal angles, and of copies of one point the one whose sector lies inside the
+/// other's).
+fn visible_vertex(rings: &Rings, hole: u32, bands: &Bands, order: &mut RingOrder, m: u32, qx: f64) -> u32 {
+    let (hx, hy) = (rings.get(hole).x, rings.get(hole).y);
     let (mx, my) = (rings.get(m).x, rings.get(m).y);
     let mut tan_min = f64::INFINITY;
-    let mut best = m;
+    let mut best_x = f64::NEG_INFINITY;
+    // Every candidate at the best angle and x, met in band order.
+    let mut group = std::mem::take(&mut order.group);
+    group.clear();
     let consider = |p: u32| {
         let n = rings.get(p);
         if mx <= n.x && n.x <= hx && hx != n.x && point_in_triangle([hx, hy], [qx, hy], [mx, my], [n.x, n.y]) {
             let tan = (hy - n.y).abs() / (hx - n.x);
-            let b = rings.get(best);
+            if tan > tan_min || (tan == tan_min && n.x < best_x) {
+                return;
+            }
             let next = rings.get(n.next);
             // An outer edge along the ray, leading past the hole point, is seen from it too; so is
             // a Steiner point (a spike of no width, inside from every side), which a bridge
             // passing through it would leave out of the mesh.
             let along = n.y == hy && next.y == hy && next.x > hx;
-            if (rings.locally_inside(p, hole) || along || rings.marked(p, mark::STEINER))
-                && (tan < tan_min
-                    || (tan == tan_min && (n.x > b.x || (n.x == b.x && rings.sector_contains_sector(best, p)))))
-            {
-                best = p;
-                tan_min = tan;
+            if !(rings.locally_inside(p, hole) || along || rings.marked(p, mark::STEINER)) {
+                return;
+            }
+            if tan < tan_min || n.x > best_x {
+                (tan_min, best_x) = (tan, n.x);
+                group.clear();
+            }
+            if !group.contains(&p) {
+                group.push(p);
             }
         }
     };
     for_each_edge(rings, bands, hy.min(my), hy.max(my), consider);
-    Some(best)
+    if group.len() > 1 {
+        order.sort(rings, &mut group);
+    }
+    // In ring order, a candidate whose sector lies inside the one kept so far replaces it.
+    let best = group.iter().copied().reduce(|best, p| if rings.sector_contains_sector(best, p) { p } else { best });
+    order.group = group;
+    best.unwrap_or(m)
 }

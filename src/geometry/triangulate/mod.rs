@@ -15,6 +15,7 @@ mod ear;
 mod holes;
 mod linked;
 mod nesting;
+mod ring_order;
 mod zorder;
 
 use ear::{HASH_THRESHOLD, LINKED_MAX, Slicer};
@@ -194,6 +195,7 @@ pub struct Triangulator {
     zindex: ZIndex,
     holes: Vec<u32>,
     bands: holes::Bands,
+    order: ring_order::RingOrder,
     ranges: Vec<Range<usize>>,
     jobs: Vec<(u32, ear::Pass)>,
     queue: std::collections::VecDeque<u32>,
@@ -361,7 +363,7 @@ impl Triangulator {
         {
             let mut hole_nodes = std::mem::take(&mut self.holes);
             let outer = holes::OuterRing { node, size: outer_nodes, y_range: [shape.min[1], shape.max[1]] };
-            node = holes::eliminate_holes(&mut self.rings, &mut self.bands, &outer, &mut hole_nodes);
+            node = holes::eliminate_holes(&mut self.rings, &mut self.bands, &mut self.order, &outer, &mut hole_nodes);
             self.holes = hole_nodes;
         }
         let hash = shape.filter(|_| hashed).map(|shape| ZHash::new(shape.min, shape.max));
