@@ -1,12 +1,13 @@
 //! Ear slicing of one linked ring (an outer ring with its holes already bridged in), after
-//! Eberly's ear clipping and Held's FIST as refined in mapbox's earcut. Two ways, by size:
+//! Eberly's ear clipping and Held's FIST as refined in mapbox's earcut, in two ways:
 //!
-//! - Up to [`LINKED_MAX`] vertices, earcut's: walk round the ring clipping every ear met, and,
-//!   above [`HASH_THRESHOLD`] vertices, test "no vertex inside the ear" only on the nodes of a
-//!   linked z-order list whose codes lie between those of the ear box's corners.
-//! - Above, from a queue of corners (the neighbours of clipped ears) with a sorted z-order
-//!   index that jumps over code ranges outside the ear's box (BIGMIN): near-linear where the
-//!   walk and the list grow quadratically (long reflex stretches, the thin ears of spikes).
+//! - First earcut's: walk round the ring clipping every ear met, and, above
+//!   [`HASH_THRESHOLD`] vertices, test "no vertex inside the ear" only on the nodes of a linked
+//!   z-order list whose codes lie between those of the ear box's corners.
+//! - When the walk has spent its budget (see [`WALK_STEPS_PER_NODE`]), from a queue of corners
+//!   (the neighbours of clipped ears) with a sorted z-order index that jumps over code ranges
+//!   outside the ear's box (BIGMIN): near-linear where the walk and the list grow
+//!   quadratically (long reflex stretches, the thin ears of spikes).
 //!
 //! Rings that stop yielding ears go through three fallbacks: drop collinear/repeated points,
 //! cut off local self-intersections, split along any valid diagonal.
@@ -19,11 +20,6 @@ use super::zorder::{ZHash, ZIndex, bigmin, box_codes, code, in_box};
 /// Rings with more vertices than this use the z-order hash (below it, a plain walk is faster).
 pub(super) const HASH_THRESHOLD: usize = 80;
 
-/// Rings with up to this many vertices walk round with a linked z-order list; larger ones are
-/// sliced from a queue with the sorted z-order index, whose cost stays near-linear where
-/// walking round long reflex stretches and scanning thin ears' code ranges grow quadratically.
-pub(super) const LINKED_MAX: usize = 1 << 15;
-
 /// Nodes the walk may visit per node of the ring before it hands the ring to the queue: z-order
 /// list steps, and two for each corner visited (it reads three nodes). About 33 on real outlines
 /// (water, 2,523 vertices), thousands on the thin ears of a spiky star, where the walk took
@@ -33,6 +29,46 @@ pub(super) const LINKED_MAX: usize = 1 << 15;
 /// water-huge2's stuck rings went to the queue, whose other order of ears covered 0.0025 too
 /// much where earcut's walk (and ours at 96) covers 0.0022.
 const WALK_STEPS_PER_NODE: usize = 96;
+
+/// Nodes of a ring that get the full [`WALK_STEPS_PER_NODE`]; each node beyond adds
+/// [`WALK_STEPS_PER_LARGE_NODE`]. On a 10⁶-point star or wavy ring the walk is wasted work
+/// before the queue takes over (96 a node cost 0.4 s of 1.1); on a checkerboard of touching
+/// holes the walk is what works: the queue's order of ears left rings where no corner was an
+/// ear, and splitting those took 25 s on 130 × 130 squares (with this budget, 0.5 s, exact;
+/// earcut 0.9 s).
+const WALK_FULL_BUDGET_NODES: usize = 1 << 15;
+
+/// The walk's budget per node beyond [`WALK_FULL_BUDGET_NODES`].
+const WALK_STEPS_PER_LARGE_NODE: usize = 8;
+
+/// How many nodes the walk may visit on a ring before the queue takes it over.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct WalkBudget {
+    per_node: usize,
+    per_large_node: usize,
+    base: usize,
+}
+
+impl WalkBudget {
+    /// See [`WALK_STEPS_PER_NODE`] and [`WALK_FULL_BUDGET_NODES`].
+    pub const DEFAULT: Self =
+        Self { per_node: WALK_STEPS_PER_NODE, per_large_node: WALK_STEPS_PER_LARGE_NODE, base: 4096 };
+
+    /// No walk on hashed rings: every one goes to the queue at once (tests of the queue).
+    #[cfg(test)]
+    pub const NONE: Self = Self { per_node: 0, per_large_node: 0, base: 0 };
+
+    fn for_ring(self, size: usize) -> usize {
+        let full = size.min(WALK_FULL_BUDGET_NODES);
+        self.per_node * full + self.per_large_node * (size - full) + self.base
+    }
+}
+
+impl Default for WalkBudget {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
 
 /// A counter-clockwise triangle (a, b, c): a convex corner tested as an ear.
 #[derive(Clone, Copy)]
@@ -119,23 +155,20 @@ enum Verdict {
     BlockedBy(u32),
 }
 
-/// Which fallback a ring is on.
+/// How a ring waiting to be sliced is to be sliced.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub(super) enum Pass {
-    Ears,
-    /// Ears, from the queue whatever the ring's size: the walk gave up on it.
-    Queued,
-    Filtered,
-    Cured,
+    /// Walking round it, earcut's way.
+    Walk,
+    /// From the queue: the walk spent its budget on it.
+    Queue,
 }
 
 /// Slices rings into triangles, appending vertex-index triples (counter-clockwise) to `out`.
 pub(super) struct Slicer<'a> {
     pub rings: &'a mut Rings,
     pub hash: Option<ZHash>,
-    /// Whether a hashed ring is sliced by walking round it with a linked z-order list (earcut's
-    /// way, fastest up to [`LINKED_MAX`] nodes) rather than from a queue with the sorted index.
-    pub linked: bool,
+    pub walk_budget: WalkBudget,
     pub out: &'a mut Vec<u32>,
     /// The ring's nodes by Morton code, for jumps into the z-order list; reused between calls.
     pub index: &'a mut ZIndex,
@@ -151,30 +184,30 @@ impl Slicer<'_> {
         // An explicit stack instead of recursion: degenerate input can split many times.
         let mut jobs = std::mem::take(self.jobs);
         jobs.clear();
-        jobs.push((start, Pass::Ears));
+        jobs.push((start, Pass::Walk));
         while let Some((ring, pass)) = jobs.pop() {
             self.slice(ring, pass, &mut jobs);
         }
         *self.jobs = jobs;
     }
 
-    /// Clips ears of the ring of `start` until three nodes are left or none is found (the
-    /// walk up to [`LINKED_MAX`] nodes, see [`Self::walk`]). Above, nodes are tested from a
-    /// queue: first the whole ring in order, then only the neighbours of
-    /// clipped ears (the only corners whose shape changed), with a whole round again whenever
-    /// the queue runs dry after a clip (a corner can also become an ear when the last reflex
-    /// node inside it goes). Walking the ring round after round instead (earcut) costs a pass
-    /// over every long reflex stretch per round: 512 million steps for a wavy 10⁶-gon.
+    /// Clips ears of the ring of `start` until three nodes are left or none is found: by
+    /// [`Self::walk`], or from a queue once the walk has spent its budget on the ring. The queue
+    /// tests first the whole ring in order, then only the neighbours of clipped ears (the only
+    /// corners whose shape changed), with a whole round again whenever the queue runs dry after
+    /// a clip (a corner can also become an ear when the last reflex node inside it goes).
+    /// Walking the ring round after round instead (earcut) costs a pass over every long reflex
+    /// stretch per round: 512 million steps for a wavy 10⁶-gon. A ring on which the queue finds
+    /// no ear goes through a fallback (see [`Self::fall_back`]) and back to the walk.
     fn slice(&mut self, start: u32, pass: Pass, jobs: &mut Vec<(u32, Pass)>) {
         if start == NIL {
             return;
         }
-        if pass != Pass::Queued && (self.linked || self.hash.is_none()) {
+        if pass == Pass::Walk {
             self.walk(start, jobs);
             return;
         }
-        let pass = if pass == Pass::Queued { Pass::Ears } else { pass };
-        // Every pass: the fallbacks' cuts can turn convex corners reflex again.
+        // Built afresh each time: the walk's fallbacks may have cut the ring since.
         self.index_curve(start);
         let mut queue = std::mem::take(self.queue);
         queue.clear();
@@ -183,7 +216,7 @@ impl Slicer<'_> {
         while size > 2 {
             let Some(ear) = queue.pop_front() else {
                 if !clipped {
-                    self.fall_back(last, pass, jobs);
+                    self.fall_back(last, jobs);
                     break;
                 }
                 clipped = false;
@@ -196,7 +229,9 @@ impl Slicer<'_> {
             }
             if std::mem::replace(&mut skip, NIL) == ear {
                 // Not right after its neighbour: clipping from the same spot again makes fans
-                // of slivers.
+                // of slivers (without this, a 10⁶-point spiky star took 2.1 s instead of 0.75,
+                // and 100 × 100 touching squares, whose rings reach the queue, 0.87 s instead
+                // of 0.17).
                 self.enqueue(ear, &mut queue);
                 continue;
             }
@@ -214,7 +249,7 @@ impl Slicer<'_> {
         *self.queue = queue;
     }
 
-    /// [`Self::slice`] for rings up to [`LINKED_MAX`] nodes, as earcut does it: round the ring
+    /// [`Self::slice`] as earcut does it: round the ring
     /// from `start`, clipping each ear met and going on from its next neighbour, whose corner
     /// just changed (the `earcut` crate's way: the same triangles as earcut on rings bridged
     /// alike, and a fifth faster on water-huge than going on two nodes further, mapbox's way,
@@ -231,7 +266,7 @@ impl Slicer<'_> {
         };
         // Nodes visited (see WALK_STEPS_PER_NODE) before the ring goes to the queue instead
         // (hashed rings only: below the hash threshold the walk is cheap whatever it does).
-        let budget = WALK_STEPS_PER_NODE * size + 4096;
+        let budget = self.walk_budget.for_ring(size);
         let mut steps = 0;
         let mut convex = hash.is_some() && self.rings.is_convex(start);
         let (mut ear, mut stop, mut cured) = (start, start, false);
@@ -244,7 +279,7 @@ impl Slicer<'_> {
             let is_ear = match &hash {
                 _ if convex => self.rings.area(prev, ear, next) > 0.0,
                 Some(_) if steps > budget => {
-                    jobs.push((ear, Pass::Queued));
+                    jobs.push((ear, Pass::Queue));
                     return;
                 }
                 Some(_) => match self.is_ear_linked(ear, &mut steps) {
@@ -311,22 +346,22 @@ impl Slicer<'_> {
         }
     }
 
-    /// The next pass for a ring that yields no more ears. A fallback that changes nothing would
-    /// leave a ring on which the pass just made fails again: the next fallback follows at once
-    /// (on crossing input this saved three of every five passes, each a z-order rebuild and a
-    /// round of ear tests).
-    fn fall_back(&mut self, ear: u32, pass: Pass, jobs: &mut Vec<(u32, Pass)>) {
+    /// Changes a ring on which the queue found no ear, and hands it back to the walk: drops
+    /// collinear and repeated points, else cures local crossings, else splits it. The walk
+    /// starts afresh on what is left, with its own fallbacks; on touching holes its order of
+    /// ears gets through where the queue's stopped again (100 × 100 touching squares: 0.17 s;
+    /// left with the queue, whose rings then had to be split, 0.83 s, and 43 s on 150 × 150).
+    /// Every fallback removes nodes or splits, so the hand-overs end.
+    fn fall_back(&mut self, ear: u32, jobs: &mut Vec<(u32, Pass)>) {
         let (filtered, changed) = self.rings.filter_changed(ear, NIL);
-        if pass == Pass::Ears && changed {
-            jobs.push((filtered, Pass::Filtered));
+        if changed {
+            jobs.push((filtered, Pass::Walk));
             return;
         }
-        if pass != Pass::Cured {
-            let (cured, changed) = self.cure_local_intersections(filtered);
-            if changed {
-                jobs.push((cured, Pass::Cured));
-                return;
-            }
+        let (cured, changed) = self.cure_local_intersections(filtered);
+        if changed {
+            jobs.push((cured, Pass::Walk));
+            return;
         }
         self.split(filtered, jobs);
     }
@@ -565,8 +600,8 @@ impl Slicer<'_> {
     fn split(&mut self, start: u32, jobs: &mut Vec<(u32, Pass)>) {
         if let Some((a, b)) = self.find_diagonal(start) {
             let (a, c) = self.cut(a, b, false);
-            jobs.push((a, Pass::Ears));
-            jobs.push((c, Pass::Ears));
+            jobs.push((a, Pass::Walk));
+            jobs.push((c, Pass::Walk));
         }
     }
 
@@ -580,7 +615,7 @@ impl Slicer<'_> {
         let (a, c) = self.cut(a, b, true);
         let (smaller, larger) = if self.rings.smaller_ring(a, c) { (a, c) } else { (c, a) };
         self.rings.z_unlink_ring(smaller);
-        jobs.push((smaller, Pass::Ears));
+        jobs.push((smaller, Pass::Walk));
         Some(larger)
     }
 

@@ -18,7 +18,7 @@ mod nesting;
 mod ring_order;
 mod zorder;
 
-use ear::{HASH_THRESHOLD, LINKED_MAX, Slicer};
+use ear::{HASH_THRESHOLD, Slicer};
 use linked::{NIL, Rings, signed_area};
 use nesting::RingShape;
 use std::ops::Range;
@@ -196,6 +196,7 @@ pub struct Triangulator {
     holes: Vec<u32>,
     bands: holes::Bands,
     order: ring_order::RingOrder,
+    walk_budget: ear::WalkBudget,
     ranges: Vec<Range<usize>>,
     jobs: Vec<(u32, ear::Pass)>,
     queue: std::collections::VecDeque<u32>,
@@ -370,7 +371,7 @@ impl Triangulator {
         Slicer {
             rings: &mut self.rings,
             hash,
-            linked: total <= LINKED_MAX,
+            walk_budget: self.walk_budget,
             out,
             index: &mut self.zindex,
             jobs: &mut self.jobs,
