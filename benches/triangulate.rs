@@ -116,24 +116,6 @@ fn squares(count: usize) -> Vec<Vec<[f64; 2]>> {
         .collect()
 }
 
-/// A `side` × `side` checkerboard of unit squares in earcut's flat layout, the dark squares
-/// holes touching at their corners: 33,804 vertices at 130.
-fn checkerboard(side: u32) -> (Vec<f64>, Vec<usize>) {
-    let s = f64::from(side);
-    let mut coords = vec![0.0, 0.0, s, 0.0, s, s, 0.0, s];
-    let mut starts = Vec::new();
-    for i in 0..side {
-        for j in 0..side {
-            if (i + j) % 2 == 0 {
-                starts.push(coords.len() / 2);
-                let (x, y) = (f64::from(i), f64::from(j));
-                coords.extend_from_slice(&[x, y, x, y + 1.0, x + 1.0, y + 1.0, x + 1.0, y]);
-            }
-        }
-    }
-    (coords, starts)
-}
-
 fn scale(c: &mut Criterion) {
     let mut group = c.benchmark_group("scale");
     group.sample_size(10);
@@ -154,7 +136,7 @@ fn scale(c: &mut Criterion) {
         b.iter(|| ours.rings(&rings).unwrap().indices.len())
     });
     // Touching holes at scale: earcut takes about 0.9 s here.
-    let (coords, starts) = checkerboard(130);
+    let (coords, starts) = earcut_fixtures::flat(&earcut_fixtures::checkerboard(130));
     let mut out = Vec::new();
     group.bench_function(BenchmarkId::new("indra", "checkerboard-130"), |b| {
         b.iter(|| {

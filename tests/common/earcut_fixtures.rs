@@ -1,6 +1,7 @@
 //! earcut's fixture polygons (`tests/fixtures/earcut/`, ISC, see its NOTICE.md), read as rings
 //! or in earcut's flat layout, turned, and as the `earcut` crate triangulates them. Shared by
-//! `tests/suite/triangulate.rs`, `benches/triangulate.rs` and `examples/triangulate_deviation.rs`.
+//! `tests/suite/triangulate.rs`, `benches/triangulate.rs`, `examples/triangulate_deviation.rs`
+//! and the triangulator's unit tests; with them, a generated input of touching holes.
 #![allow(dead_code)]
 
 /// One ring of [x, y] points.
@@ -46,4 +47,18 @@ pub fn earcut_triangles(coords: &[f64], starts: &[usize]) -> Vec<u32> {
     let mut indices = Vec::new();
     earcut::Earcut::new().earcut(points.iter().copied(), &holes, &mut indices);
     indices
+}
+
+/// A `side` × `side` checkerboard of unit squares, the dark ones holes touching at their
+/// corners (ring 0 the outer square, then the holes, in earcut's orientation-free layout).
+pub fn checkerboard(side: u32) -> Vec<Ring> {
+    let s = f64::from(side);
+    let mut rings = vec![vec![[0.0, 0.0], [s, 0.0], [s, s], [0.0, s]]];
+    for i in 0..side {
+        for j in (0..side).filter(|j| (i + j) % 2 == 0) {
+            let (x, y) = (f64::from(i), f64::from(j));
+            rings.push(vec![[x, y], [x, y + 1.0], [x + 1.0, y + 1.0], [x + 1.0, y]]);
+        }
+    }
+    rings
 }

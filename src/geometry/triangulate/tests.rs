@@ -1,5 +1,8 @@
 use super::*;
 
+#[path = "../../../tests/common/earcut_fixtures.rs"]
+mod earcut_fixtures;
+
 fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<[f64; 2]> {
     // Clockwise, as the sample lists its test data.
     vec![[x0, y0], [x0, y1], [x1, y1], [x1, y0]]
@@ -354,24 +357,14 @@ fn single_points_inside_are_steiner_vertices_of_the_mesh() {
 #[test]
 fn touching_holes_are_exact_from_the_queue() {
     for side in [13, 19, 20, 23, 28] {
-        let s = f64::from(side);
-        let mut coords = vec![0.0, 0.0, s, 0.0, s, s, 0.0, s];
-        let mut starts = Vec::new();
-        for i in 0..side {
-            for j in 0..side {
-                if (i + j) % 2 == 0 {
-                    starts.push(coords.len() / 2);
-                    let (x, y) = (f64::from(i), f64::from(j));
-                    coords.extend_from_slice(&[x, y, x, y + 1.0, x + 1.0, y + 1.0, x + 1.0, y]);
-                }
-            }
-        }
+        let rings = earcut_fixtures::checkerboard(side);
+        let (coords, starts) = earcut_fixtures::flat(&rings);
         let mut triangulator = Triangulator { walk_budget: ear::WalkBudget::NONE, ..Triangulator::default() };
         let mut indices = Vec::new();
         triangulator.flat(&coords, &starts, &mut indices).unwrap();
-        let positions: Vec<[f64; 2]> = coords.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
+        let positions: Vec<[f64; 2]> = rings.concat();
         let area = triangle_area(&positions, &indices);
-        let expected = s * s - starts.len() as f64;
+        let expected = f64::from(side * side) - (rings.len() - 1) as f64;
         assert!(
             (area - expected).abs() <= 1e-9 * expected,
             "{side} x {side}: triangles cover {area}, the polygon {expected}"
