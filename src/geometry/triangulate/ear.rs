@@ -14,7 +14,7 @@
 
 use std::collections::VecDeque;
 
-use super::linked::{NIL, Rings, area, greatest, least, mark};
+use super::linked::{NIL, Node, Rings, area, greatest, least, mark};
 use super::zorder::{ZHash, ZIndex, bigmin, box_codes, code, in_box};
 
 /// Rings with more vertices than this use the z-order hash (below it, a plain walk is faster).
@@ -41,8 +41,9 @@ const WALK_FULL_BUDGET_NODES: usize = 1 << 15;
 /// The walk's budget per node beyond [`WALK_FULL_BUDGET_NODES`].
 const WALK_STEPS_PER_LARGE_NODE: usize = 8;
 
-/// How many nodes the walk may visit on a ring before the queue takes it over.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// How many nodes the walk may visit on a ring before the queue takes it over (by default
+/// [`WALK_STEPS_PER_NODE`] and [`WALK_STEPS_PER_LARGE_NODE`] a node, plus 4,096).
+#[derive(Clone, Copy)]
 pub(super) struct WalkBudget {
     per_node: usize,
     per_large_node: usize,
@@ -50,10 +51,6 @@ pub(super) struct WalkBudget {
 }
 
 impl WalkBudget {
-    /// See [`WALK_STEPS_PER_NODE`] and [`WALK_FULL_BUDGET_NODES`].
-    pub const DEFAULT: Self =
-        Self { per_node: WALK_STEPS_PER_NODE, per_large_node: WALK_STEPS_PER_LARGE_NODE, base: 4096 };
-
     /// No walk on hashed rings: every one goes to the queue at once (tests of the queue).
     #[cfg(test)]
     pub const NONE: Self = Self { per_node: 0, per_large_node: 0, base: 0 };
@@ -66,7 +63,7 @@ impl WalkBudget {
 
 impl Default for WalkBudget {
     fn default() -> Self {
-        Self::DEFAULT
+        Self { per_node: WALK_STEPS_PER_NODE, per_large_node: WALK_STEPS_PER_LARGE_NODE, base: 4096 }
     }
 }
 
@@ -98,6 +95,16 @@ struct Corner {
 }
 
 impl Corner {
+    /// The corner (a, b, c) as a candidate ear; `None` if reflex or flat.
+    #[inline]
+    fn of(a: &Node, b: &Node, c: &Node) -> Option<Self> {
+        (area(a, b, c) > 0.0).then(|| Self {
+            triangle: Triangle { a: [a.x, a.y], b: [b.x, b.y], c: [c.x, c.y] },
+            min: [min3(a.x, b.x, c.x), min3(a.y, b.y, c.y)],
+            max: [max3(a.x, b.x, c.x), max3(a.y, b.y, c.y)],
+        })
+    }
+
     /// Whether a point lies in or on the triangle (bounding box first) and is not a copy of a
     /// (bridges duplicate points).
     #[inline]
@@ -390,12 +397,7 @@ impl Slicer<'_> {
     #[inline]
     fn corner(&self, ear: u32) -> Option<Corner> {
         let r = &*self.rings;
-        let (a, b, c) = (r.get(r.prev(ear)), r.get(ear), r.get(r.next(ear)));
-        (area(a, b, c) > 0.0).then(|| Corner {
-            triangle: Triangle { a: [a.x, a.y], b: [b.x, b.y], c: [c.x, c.y] },
-            min: [min3(a.x, b.x, c.x), min3(a.y, b.y, c.y)],
-            max: [max3(a.x, b.x, c.x), max3(a.y, b.y, c.y)],
-        })
+        Corner::of(r.get(r.prev(ear)), r.get(ear), r.get(r.next(ear)))
     }
 
     /// Whether node `p` blocks the ear: it lies in or on the triangle and is reflex or flat
@@ -434,14 +436,7 @@ impl Slicer<'_> {
         let r = &*self.rings;
         let c = r.next(ear);
         let (na, nb, nc) = (r.get(r.prev(ear)), r.get(ear), r.get(c));
-        if area(na, nb, nc) <= 0.0 {
-            return Verdict::Reflex;
-        }
-        let corner = Corner {
-            triangle: Triangle { a: [na.x, na.y], b: [nb.x, nb.y], c: [nc.x, nc.y] },
-            min: [min3(na.x, nb.x, nc.x), min3(na.y, nb.y, nc.y)],
-            max: [max3(na.x, nb.x, nc.x), max3(na.y, nb.y, nc.y)],
-        };
+        let Some(corner) = Corner::of(na, nb, nc) else { return Verdict::Reflex };
         // From the corners' codes: quantising the box's corners again was a sixth of the walk.
         let (min_z, max_z) = box_codes(na.z, nb.z, nc.z);
         // Whether a node blocks the ear: in or on the triangle (a copy of its first corner

@@ -73,7 +73,7 @@ impl Bands {
 /// The outer ring, linked first into the arena: nodes `0..size`, each followed by the next
 /// (the last by the first).
 pub(super) struct OuterRing {
-    /// A node of it.
+    /// Its start node (`link_ring`'s answer), where earcut's scans of the ring begin.
     pub node: u32,
     pub size: u32,
     /// Its lowest and highest y.
@@ -253,7 +253,7 @@ fn find_bridge(rings: &Rings, hole: u32, bands: &Bands, order: &mut RingOrder) -
                     qx = x;
                     crossings.clear();
                 }
-                // On the ray's side of the edge, its left end.
+                // Its left end: where a bridge to this crossing goes.
                 crossings.push((p, m));
             }
         }
