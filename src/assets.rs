@@ -5,6 +5,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use crate::files::{FileError, FileRules, LoadWait};
+
 mod embedded {
     include!(concat!(env!("OUT_DIR"), "/embedded.rs"));
 }
@@ -61,19 +63,61 @@ pub struct Assets {
     root: Option<PathBuf>,
     /// Shader file name → the text to use instead of the disk or the embedded copy.
     pinned: Arc<BTreeMap<String, Asset>>,
+    /// Where the files that parameters name may be.
+    files: FileRules,
+    /// Whether a step waits for the files it asks for.
+    load_wait: LoadWait,
 }
 
 impl Assets {
     /// Looks for assets under `root`; `None` uses the embedded copies only.
+    /// Files that parameters name may lie under `root` only (see [`Assets::allowing`]).
     pub fn new(root: Option<PathBuf>) -> Self {
-        Self { root, pinned: Arc::default() }
+        let files = FileRules::new(root.clone());
+        Self { root, pinned: Arc::default(), files, load_wait: LoadWait::default() }
+    }
+
+    /// The built-in shaders and scenes only, with these assets' file rules and load mode (what a
+    /// show falls back to when a file on disk is broken at start-up).
+    pub fn builtin_only(&self) -> Self {
+        Self { root: None, pinned: Arc::default(), ..self.clone() }
+    }
+
+    /// These assets with files under `folder` open to file parameters too (`/`: any file).
+    pub fn allowing(&self, folder: impl Into<PathBuf>) -> Self {
+        Self { files: self.files.allowing(folder), ..self.clone() }
+    }
+
+    /// These assets with file loads running as `wait` says (a live show loads in the background).
+    pub fn with_load_wait(&self, wait: LoadWait) -> Self {
+        Self { load_wait: wait, ..self.clone() }
+    }
+
+    /// Where the files that parameters name may be.
+    pub fn file_rules(&self) -> &FileRules {
+        &self.files
+    }
+
+    /// Whether a step waits for the files it asks for.
+    pub fn load_wait(&self) -> LoadWait {
+        self.load_wait
+    }
+
+    /// The file a parameter's `name` means, beside the root or as given, if the rules allow it.
+    pub fn locate_file(&self, name: &str) -> Result<PathBuf, FileError> {
+        self.files.locate(self.root.as_deref(), name)
+    }
+
+    /// Where a parameter's `name` may be saved as a `.ext` file, if the rules allow it.
+    pub fn locate_for_saving(&self, name: &str, ext: &str) -> Result<PathBuf, FileError> {
+        self.files.locate_for_saving(self.root.as_deref(), name, ext)
     }
 
     /// These assets with shader `asset.name` pinned to `asset`'s text, whatever is on disk.
     pub fn with_shader(&self, asset: Asset) -> Self {
         let mut pinned = (*self.pinned).clone();
         pinned.insert(asset.name.clone(), asset);
-        Self { root: self.root.clone(), pinned: Arc::new(pinned) }
+        Self { pinned: Arc::new(pinned), ..self.clone() }
     }
 
     /// These assets with every shader pinned to its text now: what a running show rebuilds from
@@ -81,7 +125,7 @@ impl Assets {
     pub fn with_shaders_pinned(&self) -> Self {
         let loaded = self.names(AssetKind::Shader).into_iter().filter_map(|n| self.load(AssetKind::Shader, &n).ok());
         let pinned = loaded.map(|a| (a.name.clone(), a)).collect();
-        Self { root: self.root.clone(), pinned: Arc::new(pinned) }
+        Self { pinned: Arc::new(pinned), ..self.clone() }
     }
 
     /// The default root: `$INDRA_ROOT`, else the current folder if it has `scenes/` or `shaders/`,

@@ -2,7 +2,7 @@
 //! techniques of *Unity Graphics Programming vol.4* with wgpu.
 //!
 //! Layers, from the bottom (a layer never imports one above it; see `DESIGN.md`):
-//! [`time`], [`assets`] and [`atomic_file`] → [`gpu`] → [`graph`] → [`params`] → [`techniques`] → [`scene`] →
+//! [`time`], [`files`], [`assets`] and [`atomic_file`] → [`gpu`] → [`graph`] → [`params`] → [`techniques`] → [`scene`] →
 //! [`offscreen`] / [`app`]; `main.rs` is the command line only.
 
 #![warn(missing_docs)]
@@ -11,6 +11,7 @@ pub mod app;
 pub mod assets;
 pub mod atomic_file;
 pub mod control;
+pub mod files;
 pub mod geometry;
 
 pub mod gpu;

@@ -21,6 +21,10 @@ struct Cli {
     /// the source tree; built-in copies otherwise).
     #[arg(long, global = true)]
     root: Option<PathBuf>,
+    /// A folder whose files parameters may name (warp files, images, models), besides the root
+    /// and the scene's own folder; repeatable. `/` opens every file the process can read.
+    #[arg(long = "allow-path", value_name = "FOLDER", global = true)]
+    allow_paths: Vec<PathBuf>,
 }
 
 /// Options that pick the GPU.
@@ -56,10 +60,13 @@ enum Command {
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,indra=info,wgpu_hal=off")).init();
     let cli = Cli::parse();
-    let assets = match cli.root {
+    let mut assets = match cli.root {
         Some(root) => indra::assets::Assets::new(Some(root)),
         None => indra::assets::Assets::discover(),
     };
+    for folder in &cli.allow_paths {
+        assets = assets.allowing(folder);
+    }
     let gpu = indra::gpu::GpuOptions { backend: cli.gpu.backend, adapter: cli.gpu.adapter };
     let result = match cli.command {
         None => commands::run(&assets, &gpu, &commands::RunArgs::default()),

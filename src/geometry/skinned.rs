@@ -4,7 +4,15 @@
 //! translation / rotation / scale channels (step and linear; cubic splines use their key values
 //! linearly). Posing is plain CPU math: joint matrices for a time, linear blend skinning.
 
+use std::path::Path;
+
 use glam::{Mat4, Quat, Vec3};
+use gltf::json::validation::Checked;
+
+use crate::files::{self, FileError, FileRules};
+
+/// The most data one model may hold: its file, each buffer, and all its accessors together.
+pub const MODEL_DATA_LIMIT: u64 = 256 << 20;
 
 /// How a channel interpolates between keys.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -78,13 +86,24 @@ pub struct SkinnedMesh {
 }
 
 impl SkinnedMesh {
-    /// Reads a `.gltf` or `.glb` file; the error names the file and what is wrong.
-    pub fn load(path: &std::path::Path) -> Result<Self, String> {
-        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        precheck(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
-        let (document, buffers, _) =
-            gltf::import(path).map_err(|e| format!("{}: {}", path.display(), explain(path, e)))?;
-        Self::from_document(&document, &buffers).map_err(|e| format!("{}: {e}", path.display()))
+    /// Reads a `.gltf` or `.glb` file, its external buffers from its own folder; the error names
+    /// the file and what is wrong.
+    pub fn load(path: &Path) -> Result<Self, String> {
+        let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Self::load_confined(path, &FileRules::new([folder]))
+    }
+
+    /// Reads a `.gltf` or `.glb` file whose external buffers must lie inside `rules`' folders.
+    /// The file and every buffer are regular files of bounded size, and the data the accessors
+    /// claim is checked against [`MODEL_DATA_LIMIT`] before anything is allocated for it.
+    pub fn load_confined(path: &Path, rules: &FileRules) -> Result<Self, String> {
+        let named = |e: String| format!("{}: {e}", path.display());
+        let bytes = files::read_limited(path, MODEL_DATA_LIMIT).map_err(|e| e.to_string())?;
+        precheck(&bytes).map_err(named)?;
+        let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| named(e.to_string()))?;
+        let folder = path.parent().unwrap_or(Path::new("."));
+        let buffers = read_buffers(&gltf, folder, rules).map_err(named)?;
+        Self::from_document(&gltf.document, &buffers).map_err(named)
     }
 
     /// Reads a self-contained `.gltf` (data URIs) or `.glb` from memory.
@@ -237,7 +256,29 @@ impl SkinnedMesh {
 /// list with a primitive's POSITION index unchecked, so an out-of-range one panics.
 fn precheck(bytes: &[u8]) -> Result<(), String> {
     let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| e.to_string())?;
-    let accessors = gltf.document.as_json().accessors.len();
+    let json = gltf.document.as_json();
+    // A sparse accessor may claim any count with no data behind it: 2³¹ elements in a 1 KB file
+    // used to abort the process. What the accessors describe must fit the budget.
+    let mut claimed: u64 = 0;
+    for (i, accessor) in json.accessors.iter().enumerate() {
+        let (Checked::Valid(kind), Checked::Valid(component)) = (&accessor.type_, &accessor.component_type) else {
+            return Err(format!("accessor {i} has an unknown type"));
+        };
+        let element = (kind.multiplicity() * component.0.size()) as u64;
+        let bytes = accessor.count.0.saturating_mul(element);
+        claimed = claimed.saturating_add(bytes);
+        if claimed > MODEL_DATA_LIMIT {
+            return Err(format!(
+                "accessor {i} claims {} elements; the model's data would pass the {} MiB a model may take",
+                accessor.count.0,
+                MODEL_DATA_LIMIT >> 20
+            ));
+        }
+    }
+    if let Some(b) = json.buffers.iter().find(|b| b.byte_length.0 > MODEL_DATA_LIMIT) {
+        return Err(format!("a buffer of {} bytes; a model may take {} MiB", b.byte_length.0, MODEL_DATA_LIMIT >> 20));
+    }
+    let accessors = json.accessors.len();
     for (m, mesh) in gltf.document.as_json().meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
             let attributes = primitive.attributes.iter().map(|(semantic, a)| (format!("{semantic:?}"), a.value()));
@@ -250,27 +291,54 @@ fn precheck(bytes: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
-/// The import error in words; a missing external buffer is named (the crate's I/O error is not).
-fn explain(path: &std::path::Path, error: gltf::Error) -> String {
-    if !matches!(error, gltf::Error::Io(_)) || !path.is_file() {
-        return error.to_string();
-    }
-    let Ok(gltf) = gltf::Gltf::open(path) else { return error.to_string() };
-    let dir = path.parent().unwrap_or(std::path::Path::new("."));
-    let missing: Vec<String> = gltf
-        .buffers()
-        .filter_map(|b| match b.source() {
-            gltf::buffer::Source::Uri(uri) if !uri.starts_with("data:") && !dir.join(uri).is_file() => {
-                Some(uri.to_string())
+/// The document's buffers: the binary chunk, data URIs, and files beside the document that
+/// `rules` allow (other URI schemes are refused).
+fn read_buffers(gltf: &gltf::Gltf, folder: &Path, rules: &FileRules) -> Result<Vec<gltf::buffer::Data>, String> {
+    let mut blob = gltf.blob.clone();
+    let mut buffers = Vec::new();
+    for buffer in gltf.document.buffers() {
+        let mut data = match buffer.source() {
+            gltf::buffer::Source::Uri(uri) if !uri.starts_with("data:") => {
+                if uri.contains(':') {
+                    return Err(format!("buffer '{uri}': only files beside the model and data URIs are read"));
+                }
+                let name = folder.join(percent_decoded(uri));
+                let file = rules.locate(None, &name.to_string_lossy()).map_err(|e| match e {
+                    FileError::NotFound(_) => format!("buffer file {uri} not found beside it"),
+                    FileError::Refused(why) => format!("buffer '{uri}': {why}"),
+                })?;
+                files::read_limited(&file, MODEL_DATA_LIMIT).map_err(|e| format!("buffer {e}"))?
             }
-            _ => None,
-        })
-        .collect();
-    if missing.is_empty() {
-        error.to_string()
-    } else {
-        format!("buffer file {} not found beside it", missing.join(", "))
+            source => gltf::buffer::Data::from_source_and_blob(source, None, &mut blob).map_err(|e| e.to_string())?.0,
+        };
+        if data.len() < buffer.length() {
+            return Err(format!("buffer {} holds {} bytes, {} expected", buffer.index(), data.len(), buffer.length()));
+        }
+        data.resize(data.len().next_multiple_of(4), 0);
+        buffers.push(gltf::buffer::Data(data));
     }
+    Ok(buffers)
+}
+
+/// A URI path with its `%XX` escapes decoded (glTF URIs are URI-encoded).
+fn percent_decoded(uri: &str) -> String {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = bytes.get(i + 1..i + 3).and_then(|h| std::str::from_utf8(h).ok());
+        match (bytes[i], hex.and_then(|h| u8::from_str_radix(h, 16).ok())) {
+            (b'%', Some(byte)) => {
+                out.push(byte);
+                i += 3;
+            }
+            (byte, _) => {
+                out.push(byte);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
 }
 
 fn rest_nodes(document: &gltf::Document) -> Vec<RestNode> {
@@ -413,5 +481,37 @@ mod tests {
             let bind = holder.transform_point3(Vec3::from(*p));
             assert!((skinned - bind).length() < 1e-4, "vertex {v}: {skinned} vs {bind}");
         }
+    }
+}
+
+#[cfg(test)]
+mod budget_tests {
+    use super::*;
+
+    #[test]
+    fn accessors_claiming_more_data_than_the_budget_are_refused_before_allocating() {
+        // A sparse accessor with no data behind it, claiming 2³¹ positions.
+        let json = r#"{"asset":{"version":"2.0"},"accessors":[{"componentType":5126,"count":2147483648,
+            "type":"VEC3","sparse":{"count":1,"indices":{"bufferView":0,"componentType":5125},
+            "values":{"bufferView":0}}}],"buffers":[{"byteLength":16,
+            "uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAAAAAA=="}],
+            "bufferViews":[{"buffer":0,"byteLength":16}]}"#;
+        let e = SkinnedMesh::from_slice("sparse.gltf", json.as_bytes()).unwrap_err();
+        assert!(e.contains("sparse.gltf") && e.contains("claims 2147483648"), "{e}");
+    }
+
+    #[test]
+    fn buffers_outside_the_model_folder_or_behind_a_scheme_are_refused() {
+        let dir = std::env::temp_dir().join(format!("indra-gltf-uri-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("models")).unwrap();
+        for (uri, says) in [("../secret.bin", "outside the folders"), ("file:///etc/passwd", "only files beside")] {
+            let json = format!(r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":4,"uri":"{uri}"}}]}}"#);
+            let path = dir.join("models/escape.gltf");
+            std::fs::write(dir.join("secret.bin"), [0u8; 4]).unwrap();
+            std::fs::write(&path, json).unwrap();
+            let e = SkinnedMesh::load(&path).unwrap_err();
+            assert!(e.contains(says), "{uri}: {e}");
+        }
+        std::fs::remove_dir_all(dir).unwrap();
     }
 }

@@ -160,7 +160,7 @@ pub fn recover(
         // The last good shaders should build; if the new adapter disagrees, the built-in ones.
         log::warn!("rebuilding from the running shaders failed ({e}); using the built-in copies");
         instance
-            .rebuild_all(&gpu, &Assets::new(None), size)
+            .rebuild_all(&gpu, &assets.builtin_only(), size)
             .map_err(|e| format!("{trouble}; rebuilding failed: {e}"))?;
     }
     let mut message = format!(

@@ -5,6 +5,7 @@
 use crate::common;
 
 use crate::common::{assets, golden, gpu, render_named};
+use indra::assets::Assets;
 use indra::geometry::warp::{Corners, MeshWarp, WarpFile};
 use indra::gpu::Gpu;
 use indra::graph::{FrameGraph, GraphRuntime};
@@ -23,8 +24,11 @@ struct Node {
 
 impl Node {
     fn new(gpu: &Gpu) -> Self {
-        let assets = assets();
-        let setup = NodeSetup { gpu, assets: &assets, id: "wall", output_size: SIZE, msaa: 1 };
+        Self::with_assets(gpu, &assets())
+    }
+
+    fn with_assets(gpu: &Gpu, assets: &Assets) -> Self {
+        let setup = NodeSetup { gpu, assets, id: "wall", output_size: SIZE, msaa: 1 };
         Self { node: (warp::INFO.create)(&setup).unwrap(), params: ParamSet::new(warp::params()) }
     }
 
@@ -146,7 +150,7 @@ fn a_mesh_from_a_warp_file_moves_points_where_the_mesh_says() {
     let warp = WarpFile { corners, mesh: Some(mesh), ..Default::default() };
     let file = dir.join("wall.ron");
     std::fs::write(&file, warp.to_ron()).unwrap();
-    let mut node = Node::new(&gpu);
+    let mut node = Node::with_assets(&gpu, &assets().allowing(&dir));
     node.set("file", ParamValue::Text(Text::new(file.to_str().unwrap())));
     assert!(node.step().is_empty());
     assert_eq!(node.params.vec2("corner_tl"), [0.05, 0.95], "the file's corners became the parameters");
@@ -210,7 +214,7 @@ fn a_broken_warp_file_keeps_the_last_good_warp_and_save_writes_what_is_live() {
     let file = dir.join("wall.ron");
     let good = WarpFile { corners: Corners { bottom_left: [0.1, 0.1], ..Default::default() }, ..Default::default() };
     std::fs::write(&file, good.to_ron()).unwrap();
-    let mut node = Node::new(&gpu);
+    let mut node = Node::with_assets(&gpu, &assets().allowing(&dir));
     node.set("file", ParamValue::Text(Text::new(file.to_str().unwrap())));
     assert!(node.step().is_empty());
     assert_eq!(node.params.vec2("corner_bl"), [0.1, 0.1]);
@@ -291,7 +295,7 @@ fn mesh_points_move_where_the_pointer_puts_them_and_save_with_the_warp() {
     let gpu = gpu();
     let dir = common::sandbox("warp-edit");
     let file = dir.join("wall.ron");
-    let mut node = Node::new(&gpu);
+    let mut node = Node::with_assets(&gpu, &assets().allowing(&dir));
     let corners =
         Corners { top_left: [0.1, 0.9], top_right: [0.9, 0.95], bottom_right: [0.95, 0.1], bottom_left: [0.05, 0.0] };
     set_corners(&mut node, &corners);
@@ -326,7 +330,7 @@ fn mesh_points_move_where_the_pointer_puts_them_and_save_with_the_warp() {
     assert_eq!((mesh.columns, mesh.rows), (3, 3));
 
     // A fresh node loading the file shows the same handles and takes the mesh's size.
-    let mut again = Node::new(&gpu);
+    let mut again = Node::with_assets(&gpu, &assets().allowing(&dir));
     again.set("file", ParamValue::Text(Text::new(file.to_str().unwrap())));
     again.step();
     again.step();
@@ -365,4 +369,33 @@ fn outputs_from_the_command_line_get_the_same_warp_nodes_and_addresses() {
     let (main, projector) = (render(0), render(1));
     assert_ne!(main, projector);
     assert_eq!(&projector[..4], &[0, 0, 0, 255], "the right projector's region leaves its top-left corner black");
+}
+
+#[test]
+fn a_warp_file_outside_the_allowed_folders_is_neither_read_nor_written() {
+    let gpu = gpu();
+    let dir = common::sandbox("warp-confined");
+    let victim = dir.join("victim.conf");
+    std::fs::write(&victim, "keep me").unwrap();
+    let mut node = Node::new(&gpu);
+    node.set("file", ParamValue::Text(Text::new(victim.to_str().unwrap())));
+    let messages = node.step();
+    assert!(messages.len() == 1 && messages[0].contains("outside the folders"), "{messages:?}");
+    node.set("save", ParamValue::Trigger(true));
+    let messages = node.step();
+    assert!(messages.len() == 1 && messages[0].starts_with("warp not saved"), "{messages:?}");
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep me", "the file outside is untouched");
+
+    // Allowed folders still refuse pipes and devices, at once: the step does not wait on them.
+    let fifo = dir.join("pipe.ron");
+    assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let mut node = Node::with_assets(&gpu, &assets().allowing(&dir).allowing("/dev"));
+    for path in [fifo.to_str().unwrap(), "/dev/zero"] {
+        node.set("file", ParamValue::Text(Text::new(path)));
+        let started = std::time::Instant::now();
+        let messages = node.step();
+        assert!(messages.len() == 1 && messages[0].contains("not a regular file"), "{path}: {messages:?}");
+        assert!(started.elapsed() < std::time::Duration::from_secs(5), "{path} held the step");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
 }

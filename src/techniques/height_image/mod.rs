@@ -4,8 +4,14 @@
 //! `--set`, OSC, a scene edit) loads it.
 //!
 //! Relative paths are looked up beside `scenes/` and `shaders/` (the asset root), then in the
-//! current folder; the bundled height maps are built into the binary as a fallback.
+//! current folder, under the file rules of [`crate::files`]; the bundled height maps are built
+//! into the binary as a fallback. An image is read and decoded off the render thread, and its
+//! size is checked against the device and a memory budget before it is decoded.
 
+use std::io::Cursor;
+
+use crate::assets::Assets;
+use crate::files::{FileError, Loader};
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, PersistentTexture, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue, Text};
@@ -22,11 +28,18 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     inputs: &[],
     shaders: &[],
     create,
+    check: None,
 };
 
 /// The bundled height maps, by the path scenes use.
 const BUNDLED: &[(&str, &[u8])] =
     &[("assets/heightmaps/ridges.png", include_bytes!("../../../assets/heightmaps/ridges.png"))];
+
+/// The largest image file read.
+const IMAGE_FILE_LIMIT: u64 = 64 << 20;
+
+/// The most memory one decoded image may take (RGBA8): 8192 × 8192.
+const DECODED_LIMIT: u64 = 256 << 20;
 
 /// Parameters.
 pub fn params() -> Vec<ParamDecl> {
@@ -42,7 +55,9 @@ pub fn params() -> Vec<ParamDecl> {
 pub struct HeightImage {
     device: wgpu::Device,
     queue: wgpu::Queue,
-    root: Option<std::path::PathBuf>,
+    assets: Assets,
+    /// Images being read and decoded off the render thread.
+    loader: Loader<image::RgbaImage>,
     /// The path last asked for (loaded or not), so a bad path is reported once.
     requested: Option<String>,
     texture: PersistentTexture,
@@ -61,7 +76,8 @@ impl HeightImage {
         Self {
             device: device.clone(),
             queue: setup.gpu.queue.clone(),
-            root: setup.assets.root().map(std::path::Path::to_path_buf),
+            assets: setup.assets.clone(),
+            loader: Loader::new(setup.assets.load_wait()),
             requested: None,
             texture,
             messages: Vec::new(),
@@ -72,20 +88,48 @@ impl HeightImage {
     pub fn size(&self) -> (u32, u32) {
         (self.texture.texture.width(), self.texture.texture.height())
     }
+}
 
-    /// Reads `path` as RGBA8, or says why not.
-    fn read(&self, path: &str) -> Result<image::RgbaImage, String> {
-        let candidates = [self.root.as_ref().map(|r| r.join(path)), Some(std::path::PathBuf::from(path))];
-        let found = candidates.into_iter().flatten().find(|p| p.is_file());
-        let decoded = match (found, BUNDLED.iter().find(|(name, _)| *name == path)) {
-            (Some(file), _) => image::open(&file).map_err(|e| format!("cannot read {}: {e}", file.display()))?,
-            (None, Some((_, bytes))) => image::load_from_memory(bytes).map_err(|e| format!("bundled {path}: {e}"))?,
-            (None, None) => {
-                return Err(format!("no image at '{path}' (looked beside scenes/ and in the current folder)"));
-            }
-        };
-        Ok(decoded.to_rgba8())
+/// Reads image `name` as RGBA8 under the file rules, or says why not. The bundled height maps
+/// answer for their paths when no file is there.
+fn read_image(assets: &Assets, name: &str, max_side: u32) -> Result<image::RgbaImage, String> {
+    let bundled = BUNDLED.iter().find(|(bundled, _)| *bundled == name).map(|(_, bytes)| *bytes);
+    match (assets.locate_file(name), bundled) {
+        (Err(FileError::NotFound(_)), Some(bytes)) => decode_bounded(bytes, &format!("bundled {name}"), max_side),
+        (Err(e), _) => Err(format!("no image: {e}")),
+        (Ok(file), _) => {
+            let bytes = crate::files::read_limited(&file, IMAGE_FILE_LIMIT).map_err(|e| format!("cannot read {e}"))?;
+            decode_bounded(&bytes, &file.display().to_string(), max_side)
+        }
     }
+}
+
+/// Decodes `bytes` if the image's header says it fits a texture of at most `max_side` a side and
+/// the memory budget: a tiny file claiming a huge image is refused before it is decoded.
+pub fn decode_bounded(bytes: &[u8], name: &str, max_side: u32) -> Result<image::RgbaImage, String> {
+    let reader = || image::ImageReader::new(Cursor::new(bytes)).with_guessed_format();
+    let (width, height) = reader()
+        .map_err(|e| format!("cannot read {name}: {e}"))?
+        .into_dimensions()
+        .map_err(|e| format!("cannot read {name}: {e}"))?;
+    if width > max_side || height > max_side {
+        return Err(format!("{name} is {width}×{height} pixels; this GPU takes at most {max_side} on a side"));
+    }
+    let decoded_bytes = u64::from(width) * u64::from(height) * 4;
+    if decoded_bytes > DECODED_LIMIT {
+        return Err(format!(
+            "{name} is {width}×{height} pixels ({} MiB decoded), more than the {} MiB an image may take",
+            decoded_bytes >> 20,
+            DECODED_LIMIT >> 20
+        ));
+    }
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(max_side);
+    limits.max_image_height = Some(max_side);
+    limits.max_alloc = Some(2 * DECODED_LIMIT);
+    let mut decoder = reader().map_err(|e| format!("cannot read {name}: {e}"))?;
+    decoder.limits(limits);
+    Ok(decoder.decode().map_err(|e| format!("cannot read {name}: {e}"))?.to_rgba8())
 }
 
 fn upload(device: &wgpu::Device, queue: &wgpu::Queue, image: &image::RgbaImage) -> PersistentTexture {
@@ -104,14 +148,17 @@ impl Technique for HeightImage {
     fn step(&mut self, params: &ParamSet, _time: &FrameTime) {
         let ParamValue::Text(path) = params.get("path") else { return };
         let path = path.as_str().trim().to_string();
-        if self.requested.as_deref() == Some(path.as_str()) {
-            return;
+        if self.requested.as_deref() != Some(path.as_str()) {
+            let (assets, name) = (self.assets.clone(), path.clone());
+            let max_side = self.device.limits().max_texture_dimension_2d;
+            self.loader.request(&path, move || read_image(&assets, &name, max_side));
+            self.requested = Some(path);
         }
-        match self.read(&path) {
-            Ok(image) => self.texture = upload(&self.device, &self.queue, &image),
-            Err(e) => self.messages.push(format!("{e}; keeping the last image")),
+        match self.loader.poll() {
+            Some((_, Ok(image))) => self.texture = upload(&self.device, &self.queue, &image),
+            Some((_, Err(e))) => self.messages.push(format!("{e}; keeping the last image")),
+            None => {}
         }
-        self.requested = Some(path);
     }
 
     fn take_messages(&mut self) -> Vec<String> {
@@ -130,5 +177,50 @@ impl Technique for HeightImage {
             self.step(params, time);
         }
         graph.import_texture("height_image/image", &self.texture)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A PNG chunk: length, type, data and CRC.
+    fn chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
+        let body: Vec<u8> = kind.iter().chain(data).copied().collect();
+        let mut crc = !0u32;
+        for byte in &body {
+            crc ^= u32::from(*byte);
+            for _ in 0..8 {
+                crc = if crc & 1 == 1 { (crc >> 1) ^ 0xEDB8_8320 } else { crc >> 1 };
+            }
+        }
+        let mut out = (data.len() as u32).to_be_bytes().to_vec();
+        out.extend(body);
+        out.extend((!crc).to_be_bytes());
+        out
+    }
+
+    /// A PNG claiming `width` × `height` grey pixels, with no pixel data behind the claim.
+    fn png_header(width: u32, height: u32) -> Vec<u8> {
+        let mut header = width.to_be_bytes().to_vec();
+        header.extend(height.to_be_bytes());
+        header.extend([8, 0, 0, 0, 0]);
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        png.extend(chunk(b"IHDR", &header));
+        png.extend(chunk(b"IDAT", &[]));
+        png.extend(chunk(b"IEND", &[]));
+        png
+    }
+
+    #[test]
+    fn an_image_too_large_for_the_device_or_the_budget_is_refused_before_decoding() {
+        let e = decode_bounded(&png_header(16385, 8), "wide.png", 16384).unwrap_err();
+        assert!(e.contains("16385×8") && e.contains("at most 16384"), "{e}");
+        let e = decode_bounded(&png_header(11000, 11000), "huge.png", 16384).unwrap_err();
+        assert!(e.contains("MiB"), "{e}");
+        let e = decode_bounded(b"not an image", "junk.png", 16384).unwrap_err();
+        assert!(e.contains("junk.png"), "{e}");
+        let bundled = decode_bounded(BUNDLED[0].1, "ridges.png", 16384).unwrap();
+        assert!(bundled.width() > 1, "a real image still decodes");
     }
 }

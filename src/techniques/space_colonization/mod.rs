@@ -70,6 +70,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     inputs: &[],
     shaders: &["space_colonization.wgsl", "space_colonization_draw.wgsl", "prefix_sum.wgsl"],
     create,
+    check: None,
 };
 
 /// The colour format.
@@ -126,8 +127,12 @@ pub struct SpaceColonization {
     frames_since_reset: u64,
     last: Option<GrowthUniforms>,
     messages: Vec<String>,
-    /// Where relative model paths are looked up.
-    root: Option<std::path::PathBuf>,
+    /// Where model paths are looked up, under the file rules.
+    assets: crate::assets::Assets,
+    /// Models being read and parsed off the render thread.
+    loader: crate::files::Loader<SkinnedMesh>,
+    /// The model path being loaded, if any.
+    loading: Option<String>,
     /// The model the cloud was sampled from (it poses the nodes), if any.
     mesh: Option<Arc<SkinnedMesh>>,
     /// The last model loaded, by path (a restart does not read the file again).
@@ -163,7 +168,9 @@ impl SpaceColonization {
             frames_since_reset: 0,
             last: None,
             messages: Vec::new(),
-            root: setup.assets.root().map(std::path::Path::to_path_buf),
+            assets: setup.assets.clone(),
+            loader: crate::files::Loader::new(setup.assets.load_wait()),
+            loading: None,
             mesh: None,
             loaded: None,
         })
@@ -207,25 +214,52 @@ impl SpaceColonization {
             return;
         }
         let (cloud, skin, mesh) = match self.model_cloud(&key) {
-            Some(Ok((cloud, skin, mesh))) => (cloud, skin, Some(mesh)),
-            Some(Err(e)) => {
+            ModelCloudLoad::Ready((cloud, skin, mesh)) => (cloud, skin, Some(mesh)),
+            ModelCloudLoad::Failed(e) => {
                 self.messages.push(format!("space_colonization: {e}; growing in the sphere instead"));
                 (Cloud::lattice_sphere(key.side.clamp(2, 128) as u32, key.rng_seed()), SkinData::default(), None)
             }
-            None => (Cloud::lattice_sphere(key.side.clamp(2, 128) as u32, key.rng_seed()), SkinData::default(), None),
+            ModelCloudLoad::Sphere => {
+                (Cloud::lattice_sphere(key.side.clamp(2, 128) as u32, key.rng_seed()), SkinData::default(), None)
+            }
+            // The last cloud keeps growing until the model is read; the very first frames grow in
+            // the sphere, under no key, so the model is taken up as soon as it is there.
+            ModelCloudLoad::Pending if self.state.is_some() => return,
+            ModelCloudLoad::Pending => {
+                let sphere = Cloud::lattice_sphere(key.side.clamp(2, 128) as u32, key.rng_seed());
+                self.build_state(&key, &sphere, &SkinData::default(), None);
+                self.key = None;
+                return;
+            }
         };
+        self.build_state(&key, &cloud, &skin, mesh);
+    }
+
+    /// Seeds `cloud` and makes the GPU state growing in it, for `key`.
+    fn build_state(&mut self, key: &CloudKey, cloud: &Cloud, skin: &SkinData, mesh: Option<Arc<SkinnedMesh>>) {
         let count = key.seed_count.clamp(1, 64) as usize;
         // The sphere keeps the book's random seeds; a model's limbs each need one.
         let seeds =
             if mesh.is_some() { cloud.spread_seeds(count, key.rng_seed()) } else { cloud.seeds(count, key.rng_seed()) };
         let index_count = self.renderer.index_count;
-        self.state =
-            Some(GrowthState::new(&self.device, &self.queue, &self.kernels, &cloud, &seeds, &skin, index_count));
+        self.state = Some(GrowthState::new(&self.device, &self.queue, &self.kernels, cloud, &seeds, skin, index_count));
         self.mesh = mesh;
-        self.key = Some(key);
+        self.key = Some(key.clone());
         self.pending.clear();
         self.frames_since_reset = 0;
     }
+}
+
+/// Where the cloud of a step comes from.
+enum ModelCloudLoad {
+    /// The source is the sphere.
+    Sphere,
+    /// The model's cloud, sampled.
+    Ready(ModelCloud),
+    /// The model could not be read or sampled.
+    Failed(String),
+    /// The model is still being read.
+    Pending,
 }
 
 /// A cloud sampled inside a model, its skins and the model.
@@ -233,18 +267,35 @@ type ModelCloud = (Cloud, SkinData, Arc<SkinnedMesh>);
 
 impl SpaceColonization {
     /// The cloud inside the key's model, if the source is a model: loaded (or reused) and sampled.
-    fn model_cloud(&mut self, key: &CloudKey) -> Option<Result<ModelCloud, String>> {
-        let (path, voxels, spacing) = key.model.as_ref()?;
+    /// The file is read and parsed off the render thread; sampling is bounded by the clamped
+    /// voxel count.
+    fn model_cloud(&mut self, key: &CloudKey) -> ModelCloudLoad {
+        let Some((path, voxels, spacing)) = key.model.as_ref() else { return ModelCloudLoad::Sphere };
         let mesh = match &self.loaded {
             Some((loaded, mesh)) if loaded == path => mesh.clone(),
-            _ => match model::load(self.root.as_deref(), path) {
-                Ok(mesh) => {
-                    let mesh = Arc::new(mesh);
-                    self.loaded = Some((path.clone(), mesh.clone()));
-                    mesh
+            _ => {
+                if self.loading.as_deref() != Some(path.as_str()) {
+                    let (assets, name) = (self.assets.clone(), path.clone());
+                    self.loader.request(path, move || model::load(&assets, &name));
+                    self.loading = Some(path.clone());
                 }
-                Err(e) => return Some(Err(e)),
-            },
+                let Some((loaded, result)) = self.loader.poll() else { return ModelCloudLoad::Pending };
+                if self.loading.as_deref() == Some(loaded.as_str()) {
+                    self.loading = None;
+                }
+                match result {
+                    Ok(mesh) => {
+                        let mesh = Arc::new(mesh);
+                        self.loaded = Some((loaded.clone(), mesh.clone()));
+                        if loaded != *path {
+                            return ModelCloudLoad::Pending;
+                        }
+                        mesh
+                    }
+                    Err(e) if loaded == *path => return ModelCloudLoad::Failed(e),
+                    Err(_) => return ModelCloudLoad::Pending,
+                }
+            }
         };
         let sampling = Sampling {
             voxels: (*voxels).clamp(8, 256) as u32,
@@ -253,10 +304,10 @@ impl SpaceColonization {
         };
         let (cloud, skins) = model::cloud(&mesh, sampling);
         if cloud.attractions.is_empty() {
-            return Some(Err(format!("{path}: no volume inside the mesh (is it closed?)")));
+            return ModelCloudLoad::Failed(format!("{path}: no volume inside the mesh (is it closed?)"));
         }
         let skin = SkinData { skins, positions: mesh.positions.clone(), triangles: mesh.triangles.clone() };
-        Some(Ok((cloud, skin, mesh)))
+        ModelCloudLoad::Ready((cloud, skin, mesh))
     }
 
     /// The distance unit of the growth parameters: the sphere's 2 / side, or the model's voxel

@@ -2,10 +2,10 @@
 //! (`geometry::volume`), each attraction carrying the skin of its nearest vertex, so branches grown
 //! in the bind pose follow the animation. The bundled Rigged Figure is built into the binary.
 
-use std::path::Path;
-
 use super::cloud::{Attraction, Cloud};
 use super::growth::VertexSkin;
+use crate::assets::Assets;
+use crate::files::FileError;
 use crate::geometry::skinned::SkinnedMesh;
 use crate::geometry::volume;
 
@@ -13,15 +13,14 @@ use crate::geometry::volume;
 const BUNDLED: &[(&str, &[u8])] =
     &[("assets/models/RiggedFigure.gltf", include_bytes!("../../../assets/models/RiggedFigure.gltf"))];
 
-/// Loads `path` (beside the asset root, then the current folder, then the bundled copy).
-pub fn load(root: Option<&Path>, path: &str) -> Result<SkinnedMesh, String> {
-    let candidates = [root.map(|r| r.join(path)), Some(Path::new(path).to_path_buf())];
-    if let Some(file) = candidates.into_iter().flatten().find(|p| p.is_file()) {
-        return SkinnedMesh::load(&file);
-    }
-    match BUNDLED.iter().find(|(name, _)| *name == path) {
-        Some((name, bytes)) => SkinnedMesh::from_slice(name, bytes),
-        None => Err(format!("no model at '{path}' (looked beside scenes/ and in the current folder)")),
+/// Loads model `name` (beside the asset root, then as given, under the file rules; else the
+/// bundled copy).
+pub fn load(assets: &Assets, name: &str) -> Result<SkinnedMesh, String> {
+    let bundled = BUNDLED.iter().find(|(bundled, _)| *bundled == name);
+    match (assets.locate_file(name), bundled) {
+        (Ok(file), _) => SkinnedMesh::load_confined(&file, assets.file_rules()),
+        (Err(FileError::NotFound(_)), Some((name, bytes))) => SkinnedMesh::from_slice(name, bytes),
+        (Err(e), _) => Err(format!("no model: {e}")),
     }
 }
 

@@ -9,8 +9,9 @@
 //! good warp stays on the wall.
 
 use std::cell::RefCell;
-use std::path::PathBuf;
 
+use crate::assets::Assets;
+use crate::files::{FileError, Loader};
 use crate::geometry::warp::{Corners, EdgeBlend, Homography, MAX_MESH_SIDE, MeshWarp, Region, WarpFile};
 use crate::gpu::{BindGroupCache, GrowableBuffer, RasterDesc, ShaderError, uniform_buffer, uniform_entry};
 use crate::graph::{FrameGraph, PassContext, RasterTargets, TextureHandle};
@@ -28,6 +29,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     inputs: &["source"],
     shaders: &["warp.wgsl"],
     create,
+    check: None,
 };
 
 /// Output format: linear HDR like every node.
@@ -39,6 +41,9 @@ const BUNDLED: [(&str, &str); 3] = [
     ("warps/wall-left-half.ron", include_str!("../../../warps/wall-left-half.ron")),
     ("warps/wall-right.ron", include_str!("../../../warps/wall-right.ron")),
 ];
+
+/// The largest warp file read: a 16 × 16 mesh with blend settings is a few kilobytes.
+const WARP_FILE_LIMIT: u64 = 1 << 20;
 
 /// Triangle rows and columns per mesh cell (a smooth mesh is curved inside a cell).
 const SUBDIVISIONS: u32 = 16;
@@ -133,7 +138,10 @@ pub struct Warp {
     index_count: u32,
     device: wgpu::Device,
     queue: wgpu::Queue,
-    root: Option<PathBuf>,
+    /// Where warp files are looked up, and may be saved.
+    assets: Assets,
+    /// Warp files being read and parsed off the render thread.
+    loader: Loader<WarpFile>,
     /// The mesh in use (a regular 2×2 grid without one).
     mesh: MeshWarp,
     /// The part of the source shown at the last step, for the pointer.
@@ -222,7 +230,8 @@ impl Warp {
             index_count: 0,
             device: device.clone(),
             queue: setup.gpu.queue.clone(),
-            root: setup.assets.root().map(std::path::Path::to_path_buf),
+            assets: setup.assets.clone(),
+            loader: Loader::new(setup.assets.load_wait()),
             mesh: MeshWarp::regular(2, 2),
             applied_size: [2, 2],
             applied_point: [-1.0, 0.0, 0.0],
@@ -241,23 +250,16 @@ impl Warp {
         &self.mesh
     }
 
-    /// Where a relative warp path lives: beside `scenes/` (the asset root) if that folder holds
-    /// it, else the current folder.
-    fn resolve(&self, path: &str) -> PathBuf {
-        let beside_scenes = self.root.as_ref().map(|r| r.join(path)).filter(|p| p.is_file());
-        beside_scenes.unwrap_or_else(|| PathBuf::from(path))
+    /// Starts reading the warp file; [`Warp::take_loaded`] applies it when it is ready.
+    fn load(&mut self, path: &str) {
+        let (assets, name) = (self.assets.clone(), path.to_string());
+        self.loader.request(path, move || read_warp(&assets, &name));
     }
 
-    /// Reads the warp file; on success its values go to the parameters and its mesh is used.
-    /// The bundled example is built in, so its scene maps the same from any folder.
-    fn load(&mut self, path: &str) {
-        let file = self.resolve(path);
-        let bundled = BUNDLED.iter().find(|(name, _)| *name == path).map(|(_, text)| *text);
-        let text = match (std::fs::read_to_string(&file), bundled) {
-            (Err(_), Some(text)) if !file.exists() => Ok(text.to_string()),
-            (read, _) => read.map_err(|e| format!("cannot read warp file {}: {e}", file.display())),
-        };
-        let read = text.and_then(|text| WarpFile::parse(&file.display().to_string(), &text));
+    /// Applies a finished load: its values go to the parameters and its mesh is used; a file
+    /// that failed leaves the last good warp.
+    fn take_loaded(&mut self) {
+        let Some((_, read)) = self.loader.poll() else { return };
         match read {
             Ok(warp) => {
                 self.mesh = warp.mesh.clone().unwrap_or_else(|| MeshWarp::regular(2, 2));
@@ -271,14 +273,18 @@ impl Warp {
         }
     }
 
-    /// Writes the live values and the mesh to the warp file (atomically).
+    /// Writes the live values and the mesh to the warp file (atomically), if the file rules
+    /// allow saving there.
     fn save(&mut self, path: &str, params: &ParamSet) {
         if path.is_empty() {
             self.messages.push("warp not saved: set the node's file parameter first".into());
             return;
         }
         let warp = warp_from(params, Some(self.mesh.clone()));
-        let file = self.resolve(path);
+        let file = match self.assets.locate_for_saving(path, "ron") {
+            Ok(file) => file,
+            Err(e) => return self.messages.push(format!("warp not saved: {e}")),
+        };
         match crate::atomic_file::write(&file, warp.to_ron().as_bytes()) {
             Ok(()) => self.messages.push(format!("warp saved to {}", file.display())),
             Err(e) => self.messages.push(format!("cannot save the warp to {}: {e}", file.display())),
@@ -394,6 +400,20 @@ fn invert_mesh(mesh: &MeshWarp, target: [f32; 2]) -> Option<[f32; 2]> {
     ((p[0] - target[0]).abs() < 1e-4 && (p[1] - target[1]).abs() < 1e-4).then_some(uv)
 }
 
+/// Reads and parses warp file `name` under the file rules; the bundled examples are built in,
+/// so their scenes map the same from any folder.
+fn read_warp(assets: &Assets, name: &str) -> Result<WarpFile, String> {
+    let bundled = BUNDLED.iter().find(|(bundled, _)| *bundled == name).map(|(_, text)| *text);
+    let file = match (assets.locate_file(name), bundled) {
+        (Err(FileError::NotFound(_)), Some(text)) => return WarpFile::parse(name, text),
+        (Err(e), _) => return Err(format!("cannot read warp file: {e}")),
+        (Ok(file), _) => file,
+    };
+    let bytes = crate::files::read_limited(&file, WARP_FILE_LIMIT).map_err(|e| format!("cannot read warp file {e}"))?;
+    let text = String::from_utf8(bytes).map_err(|_| format!("cannot read warp file {}: not UTF-8", file.display()))?;
+    WarpFile::parse(&file.display().to_string(), &text)
+}
+
 /// The parameter values a warp file sets.
 fn loaded_values(warp: &WarpFile) -> Vec<(&'static str, ParamValue)> {
     let c = &warp.corners;
@@ -463,6 +483,7 @@ impl Technique for Warp {
         if (changed || params.fired("reload")) && !path.is_empty() {
             self.load(&path);
         }
+        self.take_loaded();
         if changed && path.is_empty() && self.requested.is_some() {
             self.mesh = MeshWarp::regular(2, 2);
             self.applied_size = [2, 2];

@@ -1,0 +1,232 @@
+//! Files that parameters name (warp files, height images, models, …): where they may be, and how
+//! they are read and written, whoever named them — a scene, the panel, or a message from the
+//! network.
+//!
+//! The rules, in one place so every file parameter follows them:
+//! - A name is looked up beside the asset root (the folder holding `scenes/`), then as given. The
+//!   file found must lie, links followed, inside an allowed folder: the asset root, the folder of
+//!   a scene file the show was started with, or a folder given with `--allow-path` (`/` lifts the
+//!   rule). One OSC message can then not make the show read `/etc/shadow` or a FIFO elsewhere.
+//! - Only regular files are opened, without blocking (a named pipe or a device is refused before
+//!   any read), and no more than the caller's byte limit is read.
+//! - Saving writes only inside the allowed folders, a file with the caller's extension, atomically.
+//! - Reading and decoding run on a worker thread ([`Loader`]); the render thread only polls.
+
+mod loader;
+
+pub use loader::{LoadWait, Loader};
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+/// Where the files that parameters name may be.
+#[derive(Clone, Debug, Default)]
+pub struct FileRules {
+    /// Allowed folders, as given (resolved when a file is looked up: a folder may appear later).
+    folders: Vec<PathBuf>,
+}
+
+/// Why a file could not be found or used.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum FileError {
+    /// Nothing by that name in any place looked at.
+    NotFound(String),
+    /// Found, but not to be used (outside the allowed folders, not a regular file, too large…).
+    Refused(String),
+}
+
+impl std::fmt::Display for FileError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FileError::NotFound(m) | FileError::Refused(m) => f.write_str(m),
+        }
+    }
+}
+
+impl FileRules {
+    /// Rules allowing `folders` (the asset root among them, usually).
+    pub fn new(folders: impl IntoIterator<Item = PathBuf>) -> Self {
+        Self { folders: folders.into_iter().collect() }
+    }
+
+    /// These rules with `folder` allowed too.
+    pub fn allowing(&self, folder: impl Into<PathBuf>) -> Self {
+        let mut folders = self.folders.clone();
+        folders.push(folder.into());
+        Self { folders }
+    }
+
+    /// The allowed folders, for messages.
+    pub fn folders(&self) -> &[PathBuf] {
+        &self.folders
+    }
+
+    /// The file `name` means: beside `root` first, then as given (relative to the current folder
+    /// or absolute), followed through links, if it is inside an allowed folder.
+    pub fn locate(&self, root: Option<&Path>, name: &str) -> Result<PathBuf, FileError> {
+        if name.is_empty() || name.contains('\0') {
+            return Err(FileError::NotFound("no file named".into()));
+        }
+        let candidates = [root.map(|r| r.join(name)), Some(PathBuf::from(name))];
+        let found = candidates.into_iter().flatten().find(|p| p.symlink_metadata().is_ok());
+        let Some(found) = found else {
+            let place = root.map_or(String::new(), |r| format!("beside {} and ", r.display()));
+            return Err(FileError::NotFound(format!("no file '{name}' ({place}in the current folder)")));
+        };
+        let real = found.canonicalize().map_err(|e| FileError::Refused(format!("{}: {e}", found.display())))?;
+        self.check_inside(&real, name)?;
+        Ok(real)
+    }
+
+    /// Where to save `name` (a new or existing file with extension `ext`): beside `root` when
+    /// relative, and inside an allowed folder.
+    pub fn locate_for_saving(&self, root: Option<&Path>, name: &str, ext: &str) -> Result<PathBuf, FileError> {
+        let given = Path::new(name);
+        if given.extension().and_then(|e| e.to_str()) != Some(ext) {
+            return Err(FileError::Refused(format!("'{name}' is not a .{ext} file; only .{ext} files are saved")));
+        }
+        let path = match root {
+            Some(r) if given.is_relative() => r.join(given),
+            _ => given.to_path_buf(),
+        };
+        let (Some(parent), Some(file_name)) = (path.parent(), path.file_name()) else {
+            return Err(FileError::Refused(format!("'{name}' names no file")));
+        };
+        let parent = parent
+            .canonicalize()
+            .map_err(|e| FileError::NotFound(format!("no folder for '{name}' ({}: {e})", parent.display())))?;
+        let target = parent.join(file_name);
+        // An existing file is followed through links: the place written is where it really is.
+        let real = match target.symlink_metadata() {
+            Ok(meta) if meta.file_type().is_symlink() || meta.is_file() => {
+                target.canonicalize().map_err(|e| FileError::Refused(format!("{}: {e}", target.display())))?
+            }
+            Ok(_) => return Err(FileError::Refused(format!("{} is not a regular file", target.display()))),
+            Err(_) => target,
+        };
+        self.check_inside(&real, name)?;
+        if real.extension().and_then(|e| e.to_str()) != Some(ext) {
+            return Err(FileError::Refused(format!("'{name}' leads to {}, not a .{ext} file", real.display())));
+        }
+        Ok(real)
+    }
+
+    fn check_inside(&self, real: &Path, name: &str) -> Result<(), FileError> {
+        let inside = self.folders.iter().filter_map(|f| f.canonicalize().ok()).any(|f| real.starts_with(&f));
+        if inside {
+            return Ok(());
+        }
+        let folders: Vec<String> = self.folders.iter().map(|f| f.display().to_string()).collect();
+        Err(FileError::Refused(format!(
+            "'{name}' is outside the folders the show may use ({}); start indra with --allow-path <folder> to open it",
+            if folders.is_empty() { "none".to_string() } else { folders.join(", ") }
+        )))
+    }
+}
+
+/// The bytes of `path`, if it is a regular file of at most `limit` bytes. Opened without blocking
+/// and checked after opening, so a FIFO or device swapped in after a look-up is still refused.
+pub fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, FileError> {
+    let refused = |why: String| FileError::Refused(format!("{}: {why}", path.display()));
+    let file = open_nonblocking(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => FileError::NotFound(format!("{}: no such file", path.display())),
+        _ => refused(e.to_string()),
+    })?;
+    let meta = file.metadata().map_err(|e| refused(e.to_string()))?;
+    if !meta.is_file() {
+        return Err(refused("not a regular file (a pipe, device or folder is never read)".into()));
+    }
+    if meta.len() > limit {
+        return Err(refused(format!("{} bytes, more than the {} allowed", meta.len(), limit)));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(limit + 1).read_to_end(&mut bytes).map_err(|e| refused(e.to_string()))?;
+    if bytes.len() as u64 > limit {
+        return Err(refused(format!("grew past the {limit} bytes allowed while being read")));
+    }
+    Ok(bytes)
+}
+
+#[cfg(unix)]
+fn open_nonblocking(path: &Path) -> std::io::Result<std::fs::File> {
+    use std::os::unix::fs::OpenOptionsExt;
+    std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK | libc::O_NOCTTY).open(path)
+}
+
+#[cfg(not(unix))]
+fn open_nonblocking(path: &Path) -> std::io::Result<std::fs::File> {
+    std::fs::File::open(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("indra-files-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("inside")).unwrap();
+        dir
+    }
+
+    #[test]
+    fn names_resolve_beside_the_root_and_stay_inside_the_allowed_folders() {
+        let dir = scratch("locate");
+        let root = dir.join("inside");
+        std::fs::write(root.join("a.ron"), "x").unwrap();
+        std::fs::write(dir.join("outside.ron"), "x").unwrap();
+        let rules = FileRules::new([root.clone()]);
+        assert_eq!(rules.locate(Some(&root), "a.ron").unwrap(), root.join("a.ron").canonicalize().unwrap());
+        for name in ["../outside.ron", dir.join("outside.ron").to_str().unwrap()] {
+            assert!(matches!(rules.locate(Some(&root), name), Err(FileError::Refused(_))), "{name}");
+        }
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(dir.join("outside.ron"), root.join("link.ron")).unwrap();
+            assert!(matches!(rules.locate(Some(&root), "link.ron"), Err(FileError::Refused(_))), "a link out");
+        }
+        assert!(matches!(rules.locate(Some(&root), "missing.ron"), Err(FileError::NotFound(_))));
+        let wider = rules.allowing(dir.clone());
+        assert!(wider.locate(Some(&root), "../outside.ron").is_ok());
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn saving_is_confined_to_the_allowed_folders_and_the_extension() {
+        let dir = scratch("save");
+        let root = dir.join("inside");
+        std::fs::write(dir.join("victim.conf"), "keep").unwrap();
+        let rules = FileRules::new([root.clone()]);
+        assert!(rules.locate_for_saving(Some(&root), "wall.ron", "ron").is_ok());
+        let victim = dir.join("victim.conf");
+        for name in [victim.to_str().unwrap(), "../victim.ron", "wall.conf", "/etc/passwd"] {
+            assert!(rules.locate_for_saving(Some(&root), name, "ron").is_err(), "{name}");
+        }
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(&victim, root.join("link.ron")).unwrap();
+            assert!(rules.locate_for_saving(Some(&root), "link.ron", "ron").is_err(), "a link out");
+        }
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep");
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn pipes_devices_and_large_files_are_refused_without_blocking() {
+        let dir = scratch("read");
+        let fifo = dir.join("pipe");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if made.is_ok_and(|s| s.success()) {
+            assert!(matches!(read_limited(&fifo, 1 << 20), Err(FileError::Refused(_))));
+        }
+        assert!(matches!(read_limited(Path::new("/dev/zero"), 1 << 20), Err(FileError::Refused(_))));
+        assert!(matches!(read_limited(&dir, 1 << 20), Err(FileError::Refused(_))));
+        let big = dir.join("big");
+        std::fs::write(&big, vec![7u8; 2000]).unwrap();
+        assert!(matches!(read_limited(&big, 1999), Err(FileError::Refused(_))));
+        assert_eq!(read_limited(&big, 2000).unwrap().len(), 2000);
+        assert!(matches!(read_limited(&dir.join("none"), 10), Err(FileError::NotFound(_))));
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+}
