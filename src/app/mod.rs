@@ -26,6 +26,13 @@ pub struct WindowOptions {
     pub record_video: Option<std::path::PathBuf>,
 }
 
+/// A window title showing `scene` (cut to a scene name's greatest length: the display server
+/// refuses long titles, and a refusal used to panic the window).
+pub(crate) fn window_title(scene: &str, suffix: &str) -> String {
+    let name: String = scene.chars().take(crate::scene::MAX_NAME_CHARS).collect();
+    format!("indra — {name}{suffix}")
+}
+
 /// Where takes go when `--record-video` named no file.
 pub const DEFAULT_RECORDING: &str = "indra-recording.mp4";
 

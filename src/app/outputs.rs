@@ -59,7 +59,7 @@ impl OutputWindow {
         size: (u32, u32),
     ) -> Result<Self, String> {
         let attributes = Window::default_attributes()
-            .with_title(format!("indra — {title} — output {number}"))
+            .with_title(super::window_title(title, &format!(" — output {number}")))
             .with_inner_size(winit::dpi::PhysicalSize::new(size.0, size.1));
         let window =
             Arc::new(event_loop.create_window(attributes).map_err(|e| format!("cannot open output {number}: {e}"))?);

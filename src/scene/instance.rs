@@ -166,7 +166,10 @@ impl SceneInstance {
         }
         if let Some((values, seconds)) = self.pending_morph.take() {
             let entries = values.iter().map(|&(n, p, to)| (n, p, self.params[n].target_at(p), to)).collect();
-            self.morph = Some(Morph { entries, start: time.seconds, duration: seconds });
+            // Every source refuses a non-finite duration; one that slipped through is instant
+            // rather than a morph that pins its parameters for ever.
+            let duration = if seconds.is_finite() { seconds.max(0.0) } else { 0.0 };
+            self.morph = Some(Morph { entries, start: time.seconds, duration });
         }
         if let Some(morph) = &self.morph {
             let (values, done) = morph.sample(time.seconds);

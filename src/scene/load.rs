@@ -360,6 +360,9 @@ fn corner_aliases(outputs: &[SceneOutput], nodes: &[SceneNode]) -> Vec<(String, 
     aliases
 }
 
+/// The longest scene name (it becomes the window title).
+pub const MAX_NAME_CHARS: usize = 200;
+
 /// Errors located and reported per file; the rest are counted. Locating scans the source, so a
 /// file with tens of thousands of mistakes would otherwise take quadratic time to check.
 const MAX_REPORTED_ERRORS: usize = 50;
@@ -402,6 +405,13 @@ impl Validator<'_> {
         if file.size.0 == 0 || file.size.1 == 0 || file.size.0 > 16384 || file.size.1 > 16384 {
             self.error(&["size"], format!("size {:?} must be between 1 and 16384 on each axis", file.size));
         }
+        if file.name.chars().count() > MAX_NAME_CHARS {
+            // The name reaches the window title, which the display server bounds.
+            self.error(
+                &["name"],
+                format!("the name has {} characters; at most {MAX_NAME_CHARS}", file.name.chars().count()),
+            );
+        }
         if ![1, 2, 4, 8].contains(&file.msaa) {
             self.error(&["msaa"], format!("msaa {} must be 1, 2, 4 or 8 samples per pixel", file.msaa));
         }
@@ -425,6 +435,9 @@ impl Validator<'_> {
                 self.error(&[&anchor, &anchor], format!("node id '{}' is used twice", node.id));
             }
             if let Some(built) = self.node(node, &anchor) {
+                if let Some(Err(e)) = built.technique.check.map(|check| check(&built.params)) {
+                    self.error(&[&anchor], format!("node '{}': {e}", node.id));
+                }
                 nodes.push(built);
             }
         }

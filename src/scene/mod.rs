@@ -10,7 +10,7 @@ mod schema;
 pub use error::{SceneError, SceneErrors};
 pub use instance::SceneInstance;
 pub use load::{
-    AudioMapping, BoundTrack, Scene, SceneNode, SceneOutput, check_audio, load_scene, parse_scene,
+    AudioMapping, BoundTrack, MAX_NAME_CHARS, Scene, SceneNode, SceneOutput, check_audio, load_scene, parse_scene,
     parse_value_override, resolve_target,
 };
 pub use player::{Player, SeekError};

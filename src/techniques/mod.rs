@@ -62,7 +62,14 @@ pub struct TechniqueInfo {
     pub shaders: &'static [&'static str],
     /// Builds an instance (pipelines, persistent resources).
     pub create: fn(&NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError>,
+    /// Refuses settings that are each in range but together too costly (a memory budget), in
+    /// one sentence; `indra check` and scene loading apply it, and the node keeps to the same
+    /// rule when such values arrive live.
+    pub check: Option<SettingsCheck>,
 }
+
+/// See [`TechniqueInfo::check`]: `Err` says in one sentence what does not fit.
+pub type SettingsCheck = fn(&ParamSet) -> Result<(), String>;
 
 /// What a technique gets when an instance is created.
 pub struct NodeSetup<'a> {

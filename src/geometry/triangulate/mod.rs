@@ -102,6 +102,9 @@ pub struct TriangulationReport {
     pub polygon_area: f64,
     /// Σ |triangle area| of the output.
     pub triangle_area: f64,
+    /// Σ |area| of the kept rings, outers and holes alike: the scale a polygon of no area (a
+    /// ring cancelled by its hole) measures its deviation against.
+    pub rings_area: f64,
 }
 
 impl TriangulationReport {
@@ -109,8 +112,14 @@ impl TriangulationReport {
     pub fn area_deviation(&self) -> f64 {
         let diff = (self.triangle_area - self.polygon_area).abs();
         // |…| of the polygon area: earcut's layout can list holes larger than the outer ring.
+        // A polygon of no area is measured against its rings' area: slivers of 10⁻²⁸ left where
+        // a hole cancels its outer ring are no crossing (earcut's fixture infinite-loop-jhl).
         if self.polygon_area == 0.0 {
-            if diff == 0.0 { 0.0 } else { f64::INFINITY }
+            match (diff, self.rings_area) {
+                (0.0, _) => 0.0,
+                (_, rings) if rings > 0.0 => diff / rings,
+                _ => f64::INFINITY,
+            }
         } else {
             diff / self.polygon_area.abs()
         }
@@ -297,6 +306,7 @@ impl Triangulator {
             report.outers += 1;
             report.holes += group.holes.len();
             report.polygon_area += areas[group.outer] - group.holes.iter().map(|&h| areas[h]).sum::<f64>();
+            report.rings_area += areas[group.outer] + group.holes.iter().map(|&h| areas[h]).sum::<f64>();
             hole_ranges.clear();
             hole_ranges.extend(group.holes.iter().map(|&h| ranges[kept[h]].clone()));
             hole_ranges.extend(steiner);
@@ -323,6 +333,7 @@ impl Triangulator {
             report.steiner = holes.iter().filter(|r| r.len() == 1).count();
             report.holes = holes.len() - report.steiner;
             report.polygon_area = area(outer) - holes.iter().map(area).sum::<f64>();
+            report.rings_area = area(outer) + holes.iter().map(area).sum::<f64>();
             self.group(&positions, outer.clone(), holes, &mut indices);
         }
         report.triangle_area = triangle_area(&positions, &indices);

@@ -33,6 +33,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     inputs: &[],
     shaders: &["cloth.wgsl", "cloth_render.wgsl"],
     create,
+    check: None,
 };
 
 /// The colour target format.

@@ -26,6 +26,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     inputs: &[],
     shaders: &["cube_field.wgsl"],
     create,
+    check: None,
 };
 
 /// Colour target format: linear HDR.

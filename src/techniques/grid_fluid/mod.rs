@@ -37,6 +37,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     inputs: &[],
     shaders: &["grid_fluid.wgsl"],
     create,
+    check: None,
 };
 
 /// The output format (density in R, G and B).

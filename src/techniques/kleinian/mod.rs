@@ -23,6 +23,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     inputs: &[],
     shaders: &["kleinian.wgsl"],
     create,
+    check: None,
 };
 
 /// The output format: linear HDR so that post effects (StarGlow) can follow.

@@ -22,6 +22,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     inputs: &[],
     shaders: &["poisson.wgsl", "msaa_samples.wgsl"],
     create,
+    check: Some(check_settings),
 };
 
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -85,6 +86,70 @@ impl RunKey {
             seed: p.int("seed"),
         }
     }
+}
+
+/// The most memory one run may take: its grid, and every sample it can hold on the CPU and the
+/// GPU. Each setting's range alone allows 10⁴ × 10⁴ × 10⁴ at radius 0.5, 4·10¹³ grid cells.
+pub const RUN_BUDGET: u64 = 512 << 20;
+
+impl RunKey {
+    /// The bytes a run of these settings may take at most: 4 per grid cell, and per sample its
+    /// point (8 per dimension), its instance (16) and active-list entry (8), for the most samples
+    /// r apart the box can hold (discs of radius r/2 packed into the box grown by r).
+    fn cost(&self) -> f64 {
+        let n: usize = if self.three_d { 3 } else { 2 };
+        let r = f64::from(self.radius);
+        let cell = r / (n as f64).sqrt();
+        let extent = &self.extent[..n];
+        let cells: f64 = extent.iter().map(|e| (f64::from(*e) / cell).ceil().max(1.0)).product();
+        let ball = if n == 3 {
+            4.0 / 3.0 * std::f64::consts::PI * (r / 2.0).powi(3)
+        } else {
+            std::f64::consts::PI * (r / 2.0).powi(2)
+        };
+        let samples = extent.iter().map(|e| f64::from(*e) + r).product::<f64>() / ball;
+        cells * 4.0 + samples * (8.0 * n as f64 + 24.0)
+    }
+
+    /// These settings, or with the least radius that fits [`RUN_BUDGET`] (a message says so).
+    fn within_budget(mut self) -> (Self, Option<String>) {
+        if self.cost() <= RUN_BUDGET as f64 {
+            return (self, None);
+        }
+        let asked = self.radius;
+        let (mut lo, mut hi) = (f64::from(asked), f64::from(self.extent.iter().copied().fold(1.0, f32::max)));
+        for _ in 0..60 {
+            let mid = (lo + hi) / 2.0;
+            self.radius = mid as f32;
+            if self.cost() <= RUN_BUDGET as f64 { hi = mid } else { lo = mid }
+        }
+        self.radius = hi as f32;
+        let message = format!(
+            "poisson: radius {asked} in a box of {:?} would need {:.0} MiB; sampling at radius {:.3}, the least within the {} MiB budget",
+            if self.three_d { &self.extent[..] } else { &self.extent[..2] },
+            RunKey { radius: asked, ..self.clone() }.cost() / f64::from(1u32 << 20),
+            self.radius,
+            RUN_BUDGET >> 20
+        );
+        (self, Some(message))
+    }
+}
+
+/// Refuses settings whose run would pass [`RUN_BUDGET`] (see [`TechniqueInfo::check`]).
+fn check_settings(params: &ParamSet) -> Result<(), String> {
+    let key = RunKey::of(params);
+    let cost = key.cost();
+    if cost <= RUN_BUDGET as f64 {
+        return Ok(());
+    }
+    Err(format!(
+        "radius {} in a box of {:?} ({}) needs about {:.0} MiB, more than the {} MiB a Poisson run may take: raise the radius or shrink the extent",
+        key.radius,
+        key.extent,
+        if key.three_d { "3-D" } else { "2-D" },
+        cost / f64::from(1u32 << 20),
+        RUN_BUDGET >> 20
+    ))
 }
 
 enum Sampler {
@@ -151,7 +216,10 @@ pub struct Poisson {
     /// Samples already in `instances`.
     uploaded: usize,
     key: Option<RunKey>,
+    /// The settings the sampler runs with: `key`, its radius raised to fit the budget.
+    fitted: Option<RunKey>,
     sampler: Option<Sampler>,
+    messages: Vec<String>,
     /// The first frame whose sampler steps have not run yet: frames skipped by a seek are caught
     /// up, so frame N renders the same whether reached by playing or by seeking.
     next_frame: u64,
@@ -199,7 +267,9 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         instances,
         uploaded: 0,
         key: None,
+        fitted: None,
         sampler: None,
+        messages: Vec::new(),
         next_frame: 0,
         pending: Vec::new(),
         device: device.clone(),
@@ -213,7 +283,10 @@ impl Poisson {
         let key = RunKey::of(params);
         let first = self.key.is_none();
         if first || self.key.as_ref() != Some(&key) || params.fired("restart") {
-            self.sampler = Some(Sampler::new(&key));
+            let (fitted, message) = key.clone().within_budget();
+            self.messages.extend(message);
+            self.sampler = Some(Sampler::new(&fitted));
+            self.fitted = Some(fitted);
             self.key = Some(key);
             self.uploaded = 0;
             self.next_frame = if first { 0 } else { time.frame };
@@ -234,6 +307,10 @@ impl Technique for Poisson {
         }
     }
 
+    fn take_messages(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.messages)
+    }
+
     fn add_passes<'r>(
         &'r mut self,
         graph: &mut FrameGraph<'r>,
@@ -245,7 +322,7 @@ impl Technique for Poisson {
         if self.sampler.is_none() {
             self.sync(params, time);
         }
-        let key = self.key.clone().expect("synced");
+        let key = self.fitted.clone().expect("synced");
         let sampler = self.sampler.as_ref().expect("synced");
         let count = sampler.len();
         if self.instances.reserve(&self.device, count as u64 * INSTANCE) {
@@ -350,6 +427,24 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn in_range_settings_too_large_for_memory_are_refused_by_check_and_fitted_live() {
+        let mut p = ParamSet::new(params());
+        assert!(check_settings(&p).is_ok(), "the defaults fit");
+        p.set_at(p.index("dimensions").unwrap(), crate::params::ParamValue::Enum(1));
+        p.set_at(p.index("extent").unwrap(), crate::params::ParamValue::Vec3([10000.0; 3]));
+        p.set_at(p.index("radius").unwrap(), crate::params::ParamValue::Float(0.5));
+        p.snap();
+        let e = check_settings(&p).unwrap_err();
+        assert!(e.contains("MiB") && e.contains("raise the radius"), "{e}");
+        let (fitted, message) = RunKey::of(&p).within_budget();
+        assert!(message.is_some_and(|m| m.contains("least within")));
+        assert!(fitted.cost() <= RUN_BUDGET as f64 && fitted.cost() > RUN_BUDGET as f64 * 0.99, "{}", fitted.radius);
+        // The fitted run really is small: its grid allocates within the budget.
+        let sampler = Sampler::new(&fitted);
+        assert_eq!(sampler.len(), 1);
     }
 
     #[test]

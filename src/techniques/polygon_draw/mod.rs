@@ -28,6 +28,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     inputs: &[],
     shaders: &["polygon_draw.wgsl"],
     create,
+    check: None,
 };
 
 /// Parameters; the view is the sample's orthographic camera of size 5.

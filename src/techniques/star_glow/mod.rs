@@ -32,6 +32,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     inputs: &["source"],
     shaders: &["star_glow.wgsl"],
     create,
+    check: None,
 };
 
 /// Intermediate and output format.

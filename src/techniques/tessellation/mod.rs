@@ -45,6 +45,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     inputs: &["height"],
     shaders: &["tessellation.wgsl", "tessellation_raster.wgsl", "msaa_samples.wgsl"],
     create,
+    check: None,
 };
 
 /// The colour format.

@@ -25,6 +25,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     inputs: &[],
     shaders: &["polygon_draw.wgsl"],
     create,
+    check: None,
 };
 
 /// The bundled font.
