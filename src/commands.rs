@@ -253,6 +253,18 @@ fn check_timing(start: u64, frames: u64, dt: Option<f32>) -> Result<(), String> 
     Ok(())
 }
 
+/// `assets` with the folder of scene file `name` (if it is a path to a file) open to the files
+/// its parameters name: a scene kept beside its warp files and images works from any folder.
+fn with_scene_folder(assets: &Assets, name: &str) -> Assets {
+    let path = std::path::Path::new(name);
+    match path.parent() {
+        Some(folder) if path.is_file() => {
+            assets.allowing(if folder.as_os_str().is_empty() { std::path::Path::new(".") } else { folder })
+        }
+        _ => assets.clone(),
+    }
+}
+
 /// Loads a scene and applies `--set` assignments.
 fn scene_with_sets(assets: &Assets, name: &str, sets: &[String], msaa: Option<u32>) -> Result<Scene, String> {
     let mut scene = load_scene(assets, name).map_err(|e| e.to_string())?;
@@ -272,10 +284,12 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
     if args.list_audio {
         return list_audio();
     }
+    // A live show never waits for a file a parameter names: it loads in the background.
+    let assets = &with_scene_folder(assets, &args.scene).with_load_wait(indra::files::LoadWait::Background);
     let mut notices = Vec::new();
     let mut scene = match scene_with_sets(assets, &args.scene, &args.sets, args.msaa) {
         Ok(scene) => scene,
-        Err(e) => match scene_with_sets(&Assets::new(None), &args.scene, &args.sets, args.msaa) {
+        Err(e) => match scene_with_sets(&assets.builtin_only(), &args.scene, &args.sets, args.msaa) {
             Ok(builtin) => {
                 notices.push(format!("{e}\n(running the built-in copy until the file is fixed)"));
                 builtin
@@ -328,6 +342,7 @@ fn list_audio() -> Result<(), String> {
 /// Renders a PNG sequence.
 pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<(), String> {
     check_timing(args.start, args.frames, args.dt)?;
+    let assets = &with_scene_folder(assets, &args.scene);
     let scene = scene_with_sets(assets, &args.scene, &args.sets, args.msaa)?;
     let mut script = match &args.replay {
         Some(path) => indra::control::record::read_replay(path, &scene)?,
@@ -505,7 +520,14 @@ pub fn list(assets: &Assets) -> Result<(), String> {
 
 /// Renders `frames` frames and prints per-pass GPU medians and frame time.
 pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), String> {
-    check_timing(args.start, args.frames.saturating_add(args.warmup), None)?;
+    if args.frames == 0 {
+        return Err("--frames 0 measures nothing; bench at least one frame".into());
+    }
+    if args.frames <= MAX_START && args.frames.saturating_add(args.warmup) > MAX_START {
+        return Err(format!("--warmup {} and --frames {} together pass {MAX_START} frames", args.warmup, args.frames));
+    }
+    check_timing(args.start, args.frames, None)?;
+    let assets = &with_scene_folder(assets, &args.scene);
     let scene = scene_with_sets(assets, &args.scene, &args.sets, args.msaa)?;
     scene.check_texture_budget(args.size)?;
     let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;

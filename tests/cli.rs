@@ -326,3 +326,60 @@ fn triangulate_bad_input_is_one_clear_message() {
     assert!(!o.status.success() && text(&o).contains("is too large"), "{}", text(&o));
     assert_eq!(text(&o).lines().count(), 1, "{}", text(&o));
 }
+
+#[test]
+fn in_range_values_too_large_together_and_hostile_files_get_one_sentence() {
+    let dir = temp_dir("hostile-values");
+    let scene = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/poisson_3d.ron")).unwrap();
+    let huge = dir.join("huge_poisson.ron");
+    let edited = scene
+        .replace("\"radius\": 10.0", "\"radius\": 0.5")
+        .replace("(200.0, 200.0, 200.0)", "(10000.0, 10000.0, 10000.0)");
+    std::fs::write(&huge, edited).unwrap();
+    let long_name = dir.join("long_name.ron");
+    std::fs::write(&long_name, scene.replace("\"Poisson disk 3-D\"", &format!("\"{}\"", "n".repeat(300)))).unwrap();
+    for (file, says) in [(&huge, "raise the radius"), (&long_name, "at most 200")] {
+        let o = indra(&["check", file.to_str().unwrap()]);
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(1), "{t}");
+        assert!(t.contains(says) && !t.contains("panicked") && !t.contains("memory allocation"), "{t}");
+    }
+
+    let bench = indra(&["bench", "kleinian", "--frames", "0"]);
+    assert!(bench.status.code() == Some(1) && text(&bench).contains("--frames 0"), "{}", text(&bench));
+    let warmup = indra(&["bench", "kleinian", "--frames", "10", "--warmup", "999999999999"]);
+    assert!(text(&warmup).contains("--warmup"), "{}", text(&warmup));
+
+    let out = dir.join("out");
+    let replay = |lines: &str| {
+        let file = dir.join("take.ron");
+        std::fs::write(&file, lines).unwrap();
+        let args = ["render", "kleinian_classic", "--frames", "2", "--size", "16x16", "--out", out.to_str().unwrap()];
+        indra(&[&args[..], &["--replay", file.to_str().unwrap()]].concat())
+    };
+    let device = indra(&["render", "kleinian_classic", "--replay", "/dev/zero", "--out", out.to_str().unwrap()]);
+    assert!(text(&device).contains("not a regular file"), "{}", text(&device));
+    let write = "(frame: 1, event: Write(node: \"limit_set\", param: \"hit_color\", component: None, value: [0.0, 1.0, 0.0], source: Osc))\n";
+    for (take, says) in [
+        ("(frame: 1, event: Morph(values: [], seconds: inf))\n", "not a finite number"),
+        (
+            "(frame: 1, event: Write(node: \"limit_set\", param: \"offset\", component: Some(99), value: 1.0, source: Osc))\n",
+            "no component 99",
+        ),
+        (
+            "(frame: 1, event: Write(node: \"limit_set\", param: \"iterations\", component: Some(0), value: 1.0, source: Osc))\n",
+            "no component 0",
+        ),
+    ] {
+        let o = replay(take);
+        assert!(o.status.code() == Some(1) && text(&o).contains(says), "{take}: {}", text(&o));
+    }
+    // A take whose last line a crash cut short replays up to its last complete line.
+    let cut = replay(&format!("{write}(frame: 2, event: Wri"));
+    assert!(cut.status.success(), "{}", text(&cut));
+
+    let zero_area = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/earcut/infinite-loop-jhl.json");
+    let o = indra(&["triangulate", zero_area, "--layout", "earcut"]);
+    let t = text(&o);
+    assert!(o.status.success() && !t.contains("inf") && !t.contains("crosses itself"), "{t}");
+}

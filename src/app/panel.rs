@@ -8,6 +8,16 @@ use crate::params::{ParamDecl, ParamValue, ParamWrite, Source};
 use crate::scene::{AUDIO_BANDS, AudioSource, SceneInstance};
 use crate::time::FrameTime;
 
+/// egui's fonts, with Hack (monospace) behind the proportional font: Ubuntu Light has no
+/// ●, ■ or ▶, which showed as a missing glyph on the record button.
+pub fn panel_fonts() -> egui::FontDefinitions {
+    let mut fonts = egui::FontDefinitions::default();
+    if let Some(family) = fonts.families.get_mut(&egui::FontFamily::Proportional) {
+        family.push("Hack".to_owned());
+    }
+    fonts
+}
+
 /// What the overlay shows besides parameters.
 pub struct Overlay {
     /// Whether the side panel is shown (F1 toggles).
@@ -432,6 +442,26 @@ fn timing_panel(ui: &mut egui::Ui, overlay: &Overlay) {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn every_character_the_panel_can_show_is_in_its_proportional_fonts() {
+        let fonts = panel_fonts();
+        let family = &fonts.families[&egui::FontFamily::Proportional];
+        // The panel's labels, the recording line and the status lines come from these files.
+        let sources = [include_str!("panel.rs"), include_str!("window.rs"), include_str!("../control/hub.rs")];
+        let mut symbols: Vec<char> = sources.iter().flat_map(|s| s.chars()).filter(|c| !c.is_ascii()).collect();
+        symbols.sort_unstable();
+        symbols.dedup();
+        assert!(symbols.contains(&'●'), "the record symbol is among them");
+        for symbol in symbols {
+            let covered = family.iter().any(|name| {
+                let data = &fonts.font_data[name];
+                let bytes: &[u8] = (*data.font).as_ref();
+                ttf_parser::Face::parse(bytes, data.index).is_ok_and(|f| f.glyph_index(symbol).is_some())
+            });
+            assert!(covered, "no proportional font draws {symbol}");
+        }
+    }
+
     use super::*;
 
     #[test]

@@ -3,7 +3,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, KeyEvent, WindowEvent};
@@ -19,8 +19,8 @@ use crate::control::{ControlHub, ControlOptions, RecordRequest};
 use crate::gpu::{Blit, BlitTarget, DEFAULT_STALL_TIMEOUT, Gpu, GpuOptions};
 use crate::graph::GraphRuntime;
 use crate::live::{GpuGuard, GpuState, GpuTrouble, LiveReload};
-use crate::offscreen::LiveRecorder;
 use crate::offscreen::capture::{DEFAULT_IN_FLIGHT, take_path};
+use crate::offscreen::{FinishingTake, LiveRecorder};
 use crate::params::ControlEvent;
 use crate::scene::{Player, Scene, SceneInstance};
 use crate::time::FixedClock;
@@ -57,11 +57,21 @@ struct Running {
     waiting_since: Option<Instant>,
     /// The video recording in progress.
     video: Option<LiveRecorder>,
+    /// Takes stopped whose files ffmpeg is still closing, off the render thread.
+    finishing: Vec<FinishingTake>,
+    /// When the takes of the last minute started (a flood of start/stop is refused).
+    take_starts: std::collections::VecDeque<Instant>,
     /// Where takes go (`--record-video`, else [`super::DEFAULT_RECORDING`]).
     video_base: std::path::PathBuf,
     /// The windows of the scene's other outputs (projectors).
     outputs: Vec<OutputWindow>,
 }
+
+/// The most takes started in a minute.
+const MAX_TAKES_PER_MINUTE: usize = 6;
+
+/// The most takes whose files ffmpeg may be closing at once.
+const MAX_TAKES_CLOSING: usize = 2;
 
 /// The winit handler; creates the window on `resumed`, as winit 0.30 asks.
 pub struct WindowApp {
@@ -115,7 +125,7 @@ impl WindowApp {
     fn start(&mut self, event_loop: &ActiveEventLoop) -> Result<Running, String> {
         let scene = self.scene.take().ok_or("the window was already started")?;
         let attributes = Window::default_attributes()
-            .with_title(format!("indra — {}", scene.name))
+            .with_title(super::window_title(&scene.name, ""))
             .with_inner_size(winit::dpi::PhysicalSize::new(scene.size.0, scene.size.1));
         let window =
             Arc::new(event_loop.create_window(attributes).map_err(|e| format!("cannot create a window: {e}"))?);
@@ -151,7 +161,7 @@ impl WindowApp {
                 if let Some(live) = live.as_mut() {
                     live.mark_broken(e.origin.clone().into(), e.to_string());
                 }
-                SceneInstance::new(&gpu, &Assets::new(None), scene, size)
+                SceneInstance::new(&gpu, &self.assets.builtin_only(), scene, size)
                     .map_err(|e| format!("the scene's shaders do not compile: {e}"))?
             }
         };
@@ -192,6 +202,8 @@ impl WindowApp {
             retry: None,
             waiting_since: None,
             video: None,
+            finishing: Vec::new(),
+            take_starts: std::collections::VecDeque::new(),
             outputs,
             video_base: self.options.record_video.clone().unwrap_or_else(|| super::DEFAULT_RECORDING.into()),
         })
@@ -212,8 +224,10 @@ fn recording_status(video: &LiveRecorder, dt: f32) -> String {
 /// egui's input state and renderer for `window` on `gpu` (made again on a new device).
 fn egui_parts(window: &Window, gpu: &Gpu, format: wgpu::TextureFormat) -> (egui_winit::State, egui_wgpu::Renderer) {
     let max_side = gpu.device.limits().max_texture_dimension_2d as usize;
+    let context = egui::Context::default();
+    context.set_fonts(super::panel::panel_fonts());
     let state = egui_winit::State::new(
-        egui::Context::default(),
+        context,
         egui::ViewportId::ROOT,
         window,
         Some(window.scale_factor() as f32),
@@ -229,6 +243,7 @@ impl ApplicationHandler for WindowApp {
         // The video is finished before the process ends, so the file is complete.
         if let Some(r) = self.running.as_mut() {
             r.stop_recording();
+            r.wait_for_takes();
         }
     }
 
@@ -525,8 +540,17 @@ impl Running {
         }
     }
 
-    /// Starts or stops the recording as the panel and OSC asked, in order.
+    /// Starts or stops the recording as the panel and OSC asked, in order, and reports takes
+    /// whose files are complete.
     fn act_on_record_requests(&mut self) {
+        let mut still = Vec::new();
+        for take in std::mem::take(&mut self.finishing) {
+            match take.poll() {
+                Some(report) => self.take_finished(report),
+                None => still.push(take),
+            }
+        }
+        self.finishing = still;
         let mut requests = std::mem::take(&mut self.hub.record_requests);
         if std::mem::take(&mut self.overlay.record_clicked) {
             requests.push(if self.video.is_some() { RecordRequest::Stop } else { RecordRequest::Start(None) });
@@ -540,11 +564,25 @@ impl Running {
     }
 
     /// Starts a take at the window's size and the scene's frame rate; problems go to the overlay.
+    /// At most [`MAX_TAKES_PER_MINUTE`] takes start a minute, and none while
+    /// [`MAX_TAKES_CLOSING`] are still being closed: a flood of start/stop pairs from the
+    /// network writes a few files, not hundreds.
     fn start_recording(&mut self, name: Option<&str>) {
         if let Some(video) = &self.video {
             self.overlay.report(format!("already recording to {}", video.path().display()));
             return;
         }
+        let now = Instant::now();
+        while self.take_starts.front().is_some_and(|t| now.duration_since(*t) > Duration::from_secs(60)) {
+            self.take_starts.pop_front();
+        }
+        if self.take_starts.len() >= MAX_TAKES_PER_MINUTE || self.finishing.len() >= MAX_TAKES_CLOSING {
+            self.overlay.report(format!(
+                "take not started: at most {MAX_TAKES_PER_MINUTE} takes a minute, and {MAX_TAKES_CLOSING} closing at once"
+            ));
+            return;
+        }
+        self.take_starts.push_back(now);
         let started = take_path(&self.video_base, name).and_then(|path| {
             let settings = crate::offscreen::VideoSettings {
                 path,
@@ -566,11 +604,25 @@ impl Running {
         }
     }
 
-    /// Finishes the take (waits for the frames in flight and for ffmpeg) and says how it went.
+    /// Stops the take: its last frames are read back here, and ffmpeg closes the file on a
+    /// thread of its own ([`Running::take_finished`] says how it went).
     fn stop_recording(&mut self) {
         let Some(video) = self.video.take() else { return };
         self.overlay.recording = None;
-        match video.finish(&self.gpu.device) {
+        self.finishing.push(video.finish_in_background(&self.gpu.device));
+    }
+
+    /// Waits for every take still closing (the show is ending: the files must be complete).
+    fn wait_for_takes(&mut self) {
+        for take in std::mem::take(&mut self.finishing) {
+            let report = take.wait();
+            self.take_finished(report);
+        }
+    }
+
+    /// Says how a take went.
+    fn take_finished(&mut self, report: Result<crate::offscreen::CaptureReport, crate::offscreen::VideoError>) {
+        match report {
             Ok(report) => {
                 log::info!("{report}");
                 // Lost frames are worth a warning; a clean take is just the panel's last line.
@@ -606,7 +658,7 @@ impl Running {
         }
         if report.scene_changed {
             self.hub.set_scene(self.player.instance().scene(), report.remap.as_ref());
-            self.window.set_title(&format!("indra — {}", self.player.instance().scene().name));
+            self.window.set_title(&super::window_title(&self.player.instance().scene().name, ""));
         }
     }
 

@@ -153,17 +153,37 @@ fn to_recorded(event: &ControlEvent, scene: &Scene) -> Option<RecordedEvent> {
     })
 }
 
-/// Reads a recording for `scene`: events by frame. Errors name the line.
+/// The largest recording read: hours of dense control at a few hundred bytes an event.
+const REPLAY_FILE_LIMIT: u64 = 256 << 20;
+
+/// Reads a recording for `scene`: events by frame. Errors name the line. A last line cut short
+/// (a crash mid-write: no newline after it) is left out, so the take replays up to its last
+/// complete line.
 pub fn read_replay(path: &Path, scene: &Scene) -> Result<BTreeMap<u64, Vec<ControlEvent>>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let bytes = crate::files::read_limited(path, REPLAY_FILE_LIMIT).map_err(|e| format!("cannot read {e}"))?;
+    let text = String::from_utf8_lossy(&bytes);
+    let cut_short = !text.is_empty() && !text.ends_with('\n');
+    let lines: Vec<&str> = text.lines().collect();
     let mut out: BTreeMap<u64, Vec<ControlEvent>> = BTreeMap::new();
-    for (i, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+    for (i, line) in lines.iter().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
         let at = |msg: String| format!("{}:{}: {msg}", path.display(), i + 1);
-        let rec: Recorded = ron::from_str(line).map_err(|e| at(e.to_string()))?;
+        let rec: Recorded = match ron::from_str(line) {
+            Ok(rec) => rec,
+            Err(_) if cut_short && i + 1 == lines.len() => {
+                log::warn!("{}:{}: the last line is cut short; replaying up to the line before", path.display(), i + 1);
+                break;
+            }
+            Err(e) => return Err(at(e.to_string())),
+        };
         let event = from_recorded(&rec.event, scene).map_err(at)?;
         out.entry(rec.frame).or_default().push(event);
     }
     Ok(out)
+}
+
+/// `x` if it is a finite number, else why not.
+fn finite(what: &str, x: f64) -> Result<f64, String> {
+    if x.is_finite() { Ok(x) } else { Err(format!("{what} {x} is not a finite number")) }
 }
 
 fn resolve(scene: &Scene, node: &str, param: &str) -> Result<(usize, usize), String> {
@@ -178,6 +198,9 @@ fn from_recorded(event: &RecordedEvent, scene: &Scene) -> Result<ControlEvent, S
             let (n, p) = resolve(scene, node, param)?;
             let decl = &scene.nodes[n].params.decls()[p];
             let typed = match component {
+                Some(c) if *c >= decl.ty().components() || !decl.is_smoothable() => {
+                    return Err(format!("{node}.{param} is a {} and has no component {c}", decl.ty().name()));
+                }
                 Some(_) => match value {
                     RawValue::Number(x) => crate::params::ParamValue::Float(*x as f32),
                     other => return Err(format!("component value {other:?} is not a number")),
@@ -195,10 +218,13 @@ fn from_recorded(event: &RecordedEvent, scene: &Scene) -> Result<ControlEvent, S
                     Ok((n, p, value_from_raw(raw, decl).ok_or_else(|| format!("{raw:?} does not fit {node}.{param}"))?))
                 })
                 .collect::<Result<_, String>>()?,
-            seconds: *seconds,
+            seconds: finite("morph seconds", *seconds)
+                .and_then(|s| if s >= 0.0 { Ok(s) } else { Err(format!("morph seconds {s} is negative")) })?,
         },
         RecordedEvent::ResumeTracks => ControlEvent::ResumeTracks,
-        RecordedEvent::Tempo { bpm, resync } => ControlEvent::Tempo { bpm: *bpm, resync: *resync },
-        RecordedEvent::Phase { phase, quantum } => ControlEvent::Phase { phase: *phase, quantum: *quantum },
+        RecordedEvent::Tempo { bpm, resync } => ControlEvent::Tempo { bpm: finite("bpm", *bpm)?, resync: *resync },
+        RecordedEvent::Phase { phase, quantum } => {
+            ControlEvent::Phase { phase: finite("phase", *phase)?, quantum: finite("quantum", *quantum)? }
+        }
     })
 }

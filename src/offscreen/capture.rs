@@ -248,7 +248,13 @@ impl LiveRecorder {
     }
 
     /// Waits for the frames in flight, closes the file and says how it went.
-    pub fn finish(mut self, device: &wgpu::Device) -> Result<CaptureReport, VideoError> {
+    pub fn finish(self, device: &wgpu::Device) -> Result<CaptureReport, VideoError> {
+        self.finish_in_background(device).wait()
+    }
+
+    /// Reads back the frames still in flight (a few, already rendered), then leaves encoding
+    /// them and closing the file to a thread: the frame that stops a take never waits for ffmpeg.
+    pub fn finish_in_background(mut self, device: &wgpu::Device) -> FinishingTake {
         while !self.pending.is_empty() {
             self.after_submit();
             let _ = device.poll(wgpu::PollType::wait_indefinitely());
@@ -263,11 +269,51 @@ impl LiveRecorder {
             self.counts.dropped_busy += u64::from(p.repeats);
         }
         drop(self.sender.take());
-        let written = match self.encoder.take().map(JoinHandle::join) {
-            Some(Ok(result)) => result?,
-            _ => return Err(VideoError::Settings("the encoder thread stopped unexpectedly".into())),
-        };
-        Ok(CaptureReport { path: self.path.clone(), written, counts: self.counts })
+        let (path, counts, encoder) = (self.path.clone(), self.counts, self.encoder.take());
+        let (sender, result) = std::sync::mpsc::channel();
+        let report_path = path.clone();
+        let closing = std::thread::Builder::new().name("indra-take-close".into()).spawn(move || {
+            let written = match encoder.map(JoinHandle::join) {
+                Some(Ok(result)) => result,
+                _ => Err(VideoError::Settings("the encoder thread stopped unexpectedly".into())),
+            };
+            let _ = sender.send(written.map(|written| CaptureReport { path: report_path, written, counts }));
+        });
+        if let Err(e) = closing {
+            log::warn!("no thread to close {} ({e}): it is left to ffmpeg", path.display());
+        }
+        FinishingTake { path, result }
+    }
+}
+
+/// A take being closed off the render thread: its last frames encoded, ffmpeg finishing the file.
+pub struct FinishingTake {
+    path: std::path::PathBuf,
+    result: Receiver<Result<CaptureReport, VideoError>>,
+}
+
+impl FinishingTake {
+    /// The video file.
+    pub fn path(&self) -> &std::path::Path {
+        &self.path
+    }
+
+    /// How the take went, once the file is complete (`None` while ffmpeg is still writing).
+    pub fn poll(&self) -> Option<Result<CaptureReport, VideoError>> {
+        match self.result.try_recv() {
+            Ok(report) => Some(report),
+            Err(std::sync::mpsc::TryRecvError::Empty) => None,
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => Some(Err(self.lost())),
+        }
+    }
+
+    /// Waits until the file is complete (the show is ending, or a take made off-screen).
+    pub fn wait(self) -> Result<CaptureReport, VideoError> {
+        self.result.recv().unwrap_or_else(|_| Err(self.lost()))
+    }
+
+    fn lost(&self) -> VideoError {
+        VideoError::Settings(format!("closing {} stopped unexpectedly", self.path.display()))
     }
 }
 

@@ -6,7 +6,7 @@ mod golden;
 mod renderer;
 pub mod video;
 
-pub use capture::{CaptureCounts, CaptureReport, LiveRecorder};
+pub use capture::{CaptureCounts, CaptureReport, FinishingTake, LiveRecorder};
 pub use golden::{FlipScore, GoldenCheck, flip_score};
 pub use renderer::{OffscreenRenderer, RenderError, RenderedFrame, write_png};
 pub use video::{VideoError, VideoSettings, VideoWriter};

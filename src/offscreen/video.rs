@@ -159,6 +159,12 @@ impl VideoSettings {
 
     /// The full ffmpeg command line after the program name.
     pub fn ffmpeg_args(&self) -> Result<Vec<String>, VideoError> {
+        // A video goes to a file: `http://…` or `rtmp://…` would make ffmpeg stream to the
+        // network from an option meant for a file name.
+        let named = self.path.display().to_string();
+        if named.contains("://") {
+            return Err(VideoError::Settings(format!("'{named}' is a URL; video and audio options take file names")));
+        }
         let container = default_codec(&self.path)?;
         let codec = self.codec.as_deref().unwrap_or(container);
         if !(self.fps.is_finite() && self.fps > 0.0) {
@@ -185,7 +191,7 @@ impl VideoSettings {
         .map(String::from)
         .to_vec();
         if let Some((file, offset)) = &self.audio {
-            args.extend(["-ss".into(), format!("{offset:.6}"), "-i".into(), file.display().to_string()]);
+            args.extend(["-ss".into(), format!("{offset:.6}"), "-i".into(), ffmpeg_file(file)]);
             args.extend(["-map".into(), "0:v".into(), "-map".into(), "1:a".into()]);
             let ext = self.path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
             let audio_codec: &[&str] = match ext.as_str() {
@@ -214,9 +220,15 @@ impl VideoSettings {
             // The index at the front: the file plays while it still downloads.
             args.extend(["-movflags".into(), "+faststart".into()]);
         }
-        args.push(self.path.display().to_string());
+        args.push(ffmpeg_file(&self.path));
         Ok(args)
     }
+}
+
+/// `path` as ffmpeg must read it to take it as a file: with the `file:` protocol, so that
+/// `-y.mp4` is no option and `mix:final.wav` no protocol.
+fn ffmpeg_file(path: &Path) -> String {
+    format!("file:{}", path.display())
 }
 
 impl VideoWriter {
@@ -337,7 +349,12 @@ mod tests {
         assert!(args("a.mkv").unwrap().contains("libx264"));
         assert!(args("a.mov").unwrap().contains("-c:v prores_ks -profile:v 3"));
         assert!(args("a.webm").unwrap().contains("libvpx-vp9"));
-        assert!(args("A.MP4").unwrap().ends_with("A.MP4"));
+        assert!(args("A.MP4").unwrap().ends_with(" file:A.MP4"));
+        assert!(args("-y.mp4").unwrap().ends_with(" file:-y.mp4"), "a name like an option is a file");
+        assert!(args("http://example.com/live.mp4").is_err(), "a URL is no file name");
+        let mut with_sound = settings("a.mp4");
+        with_sound.audio = Some(("mix:final.wav".into(), 0.0));
+        assert!(with_sound.ffmpeg_args().unwrap().join(" ").contains("-i file:mix:final.wav"));
         let e = args("a.gif").unwrap_err().to_string();
         assert!(e.contains(".mp4, .mov, .webm or .mkv"), "{e}");
     }
