@@ -5,19 +5,23 @@
 //! limits. Here:
 //! - headers are read into a fixed 16 KiB buffer; more is `431`, nothing is sized by the client;
 //! - only GET is served (`405` otherwise); a request that declares a body is `413`, unread;
-//! - each connection has its own thread with 2 s read and write timeouts, so a stalled client
-//!   delays nobody else; at most 32 connections are served at once, more are closed at once;
+//! - each connection has its own thread with 2 s read and write timeouts, and the whole request
+//!   head must arrive within [`HEAD_DEADLINE`] (a client sending a byte a second is cut off, not
+//!   kept for as long as it likes), so a stalled client delays nobody else; at most 32
+//!   connections are served at once and [`MAX_PER_PEER`] from one address, more are closed at
+//!   once, so one slow machine cannot take the places of the others;
 //! - one request per connection (`Connection: close`);
 //! - a `GET` that asks to upgrade to a WebSocket (RFC 6455) is handed, after the handshake, to the
 //!   server's socket handler, if it has one: at most [`MAX_SOCKETS`] at once (`503` past that),
 //!   messages capped at [`MAX_SOCKET_MESSAGE`] bytes, reads polled every [`SOCKET_POLL`].
 
+use std::collections::HashMap;
 use std::io::{Read, Write};
-use std::net::{SocketAddr, TcpListener, TcpStream};
-use std::sync::Arc;
+use std::net::{IpAddr, SocketAddr, TcpListener, TcpStream};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use tungstenite::WebSocket;
 use tungstenite::protocol::{Role, WebSocketConfig};
@@ -28,6 +32,10 @@ pub const MAX_HEAD: usize = 16 * 1024;
 pub const MAX_CONNECTIONS: usize = 32;
 /// Read and write timeout of a connection.
 pub const TIMEOUT: Duration = Duration::from_secs(2);
+/// How long the whole request head may take to arrive.
+pub const HEAD_DEADLINE: Duration = Duration::from_secs(2);
+/// Connections served at once from one address.
+pub const MAX_PER_PEER: usize = 12;
 
 /// WebSocket sessions open at once.
 pub const MAX_SOCKETS: usize = 8;
@@ -94,25 +102,49 @@ impl Drop for HttpServer {
 
 fn accept_loop(listener: &TcpListener, stop: &AtomicBool, routes: &Routes) {
     let active = Arc::new(AtomicUsize::new(0));
+    let peers: Arc<Mutex<HashMap<IpAddr, usize>>> = Arc::default();
     let sockets = Arc::new(AtomicUsize::new(0));
     while !stop.load(Ordering::Relaxed) {
-        let Ok((stream, _)) = listener.accept() else {
+        let Ok((stream, from)) = listener.accept() else {
             std::thread::sleep(Duration::from_millis(20));
             continue;
         };
-        // Past the cap the connection is closed unread: idle floods cost no threads.
-        if active.load(Ordering::Relaxed) >= MAX_CONNECTIONS {
+        // Past the caps the connection is closed unread: idle floods cost no threads.
+        if active.load(Ordering::Relaxed) >= MAX_CONNECTIONS || !take_place(&peers, from.ip()) {
             drop(stream);
             continue;
         }
         active.fetch_add(1, Ordering::Relaxed);
-        let (active, sockets, routes) = (active.clone(), sockets.clone(), routes.clone());
+        let (active, peers, sockets, routes) = (active.clone(), peers.clone(), sockets.clone(), routes.clone());
         let spawned = std::thread::Builder::new().name("indra-http-conn".into()).spawn(move || {
             serve(stream, &routes, &sockets);
             active.fetch_sub(1, Ordering::Relaxed);
+            leave_place(&peers, from.ip());
         });
         if spawned.is_err() {
             log::warn!("HTTP: cannot start a connection thread; connection dropped");
+        }
+    }
+}
+
+/// Counts a connection from `ip`, if it has fewer than [`MAX_PER_PEER`].
+fn take_place(peers: &Mutex<HashMap<IpAddr, usize>>, ip: IpAddr) -> bool {
+    let Ok(mut peers) = peers.lock() else { return false };
+    let count = peers.entry(ip).or_default();
+    if *count >= MAX_PER_PEER {
+        return false;
+    }
+    *count += 1;
+    true
+}
+
+/// Un-counts a connection from `ip`.
+fn leave_place(peers: &Mutex<HashMap<IpAddr, usize>>, ip: IpAddr) {
+    let Ok(mut peers) = peers.lock() else { return };
+    if let Some(count) = peers.get_mut(&ip) {
+        *count -= 1;
+        if *count == 0 {
+            peers.remove(&ip);
         }
     }
 }
@@ -141,6 +173,7 @@ fn serve(mut stream: TcpStream, routes: &Routes, sockets: &AtomicUsize) {
         200 => "OK",
         404 => "Not Found",
         405 => "Method Not Allowed",
+        408 => "Request Timeout",
         413 => "Content Too Large",
         503 => "Service Unavailable",
         431 => "Request Header Fields Too Large",
@@ -185,15 +218,27 @@ fn upgrade(mut stream: TcpStream, key: &str, handler: &Arc<SocketHandler>) {
     handler(WebSocket::from_raw_socket(stream, Role::Server, Some(config)));
 }
 
-/// The request head (up to the blank line), or the status to answer with.
+/// The request head (up to the blank line), or the status to answer with: `408` when it has
+/// not all arrived within [`HEAD_DEADLINE`], however steadily its bytes trickle in.
 fn read_head(stream: &mut TcpStream) -> Result<String, u16> {
+    let deadline = Instant::now() + HEAD_DEADLINE;
     let mut head = [0u8; MAX_HEAD];
     let mut len = 0;
     loop {
         if len == MAX_HEAD {
             return Err(431);
         }
-        let n = stream.read(&mut head[len..]).map_err(|_| 400u16)?;
+        let left = deadline.saturating_duration_since(Instant::now());
+        if left.is_zero() || stream.set_read_timeout(Some(left.min(TIMEOUT))).is_err() {
+            return Err(408);
+        }
+        let n = match stream.read(&mut head[len..]) {
+            Ok(n) => n,
+            Err(e) if matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut) => {
+                return Err(408);
+            }
+            Err(_) => return Err(400),
+        };
         if n == 0 {
             return Err(400);
         }

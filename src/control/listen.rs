@@ -9,6 +9,7 @@ use std::net::TcpStream;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
 use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
 
 use rosc::{OscMessage, OscPacket};
 use serde_json::{Value, json};
@@ -18,6 +19,15 @@ use tungstenite::{Message, WebSocket};
 pub const QUEUE: usize = 1024;
 /// Addresses one session may listen to.
 pub const MAX_PATHS: usize = 4096;
+/// The longest address a session may listen to (indra's are far shorter).
+pub const MAX_PATH_LEN: usize = 256;
+/// The bytes of all the addresses one session listens to together.
+pub const MAX_PATH_BYTES: usize = 64 * 1024;
+/// How often a session is pinged; a WebSocket client answers with a pong by itself.
+pub const PING_EVERY: Duration = Duration::from_secs(3);
+/// A session from which no whole message (a pong included) arrived for this long is closed:
+/// a client that stopped half-way through a frame, or vanished, frees its place.
+pub const SESSION_IDLE: Duration = Duration::from_secs(10);
 
 /// What goes out to a session.
 enum Outgoing {
@@ -100,14 +110,24 @@ impl Listeners {
         if let Ok(mut sessions) = self.sessions.lock() {
             sessions.push(Session { id, paths: paths.clone(), queue });
         }
-        while !self.closed.load(Ordering::Relaxed) {
+        let (mut heard, mut pinged) = (Instant::now(), Instant::now());
+        while !self.closed.load(Ordering::Relaxed) && heard.elapsed() < SESSION_IDLE {
             match socket.read() {
-                Ok(Message::Text(text)) => command(&text, &paths),
+                Ok(Message::Text(text)) => {
+                    heard = Instant::now();
+                    command(&text, &paths);
+                }
                 Ok(Message::Close(_)) => break,
-                Ok(_) => {}
+                Ok(_) => heard = Instant::now(),
                 Err(tungstenite::Error::Io(e))
                     if matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut) => {}
                 Err(_) => break,
+            }
+            if pinged.elapsed() >= PING_EVERY {
+                pinged = Instant::now();
+                if socket.write(Message::Ping(Vec::new().into())).is_err() {
+                    break;
+                }
             }
             if deliver(&mut socket, &outgoing).is_err() {
                 break;
@@ -128,8 +148,11 @@ fn command(text: &str, paths: &Mutex<HashSet<String>>) {
     let (Some(command), Some(path)) = (value["COMMAND"].as_str(), value["DATA"].as_str()) else { return };
     let Ok(mut paths) = paths.lock() else { return };
     match command {
-        "LISTEN" if paths.len() < MAX_PATHS => {
-            paths.insert(path.to_string());
+        "LISTEN" if path.len() <= MAX_PATH_LEN && paths.len() < MAX_PATHS => {
+            let bytes: usize = paths.iter().map(String::len).sum();
+            if bytes + path.len() <= MAX_PATH_BYTES {
+                paths.insert(path.to_string());
+            }
         }
         "IGNORE" => {
             paths.remove(path);
@@ -148,4 +171,22 @@ fn deliver(socket: &mut WebSocket<TcpStream>, outgoing: &Receiver<Outgoing>) -> 
         }
     }
     socket.flush()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn listened_addresses_are_bounded_in_length_and_in_total_bytes() {
+        let paths = Mutex::new(HashSet::new());
+        let listen = |path: &str| command(&json!({ "COMMAND": "LISTEN", "DATA": path }).to_string(), &paths);
+        listen(&format!("/{}", "a".repeat(64 * 1024)));
+        assert!(paths.lock().unwrap().is_empty(), "a 64 KiB address is refused");
+        for i in 0..MAX_PATHS {
+            listen(&format!("/indra/{i:0>240}"));
+        }
+        let held = paths.lock().unwrap().iter().map(String::len).sum::<usize>();
+        assert!(held <= MAX_PATH_BYTES && held > MAX_PATH_BYTES - MAX_PATH_LEN, "{held} bytes held");
+    }
 }

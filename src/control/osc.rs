@@ -5,7 +5,7 @@
 
 use std::collections::HashSet;
 use std::net::{SocketAddr, UdpSocket};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
@@ -56,8 +56,13 @@ impl OscCounters {
 /// Batches the receiver thread may queue for the render loop; a flood beyond it is dropped and
 /// counted, so memory stays flat however fast packets come and however slow frames are.
 pub const MAX_QUEUED: usize = 8192;
+/// Bytes the queued batches may take in memory together (see [`Batch::bytes`]): 60 KB
+/// datagrams used to fill the count bound with half a gigabyte.
+pub const MAX_QUEUED_BYTES: usize = 8 << 20;
 /// Future-tagged batches held at once; more are dropped and counted.
 pub const MAX_SCHEDULED: usize = 4096;
+/// Bytes the future-tagged batches may take together.
+pub const MAX_SCHEDULED_BYTES: usize = 8 << 20;
 /// The furthest ahead a time tag may schedule a bundle; later ones are dropped and counted.
 pub const MAX_AHEAD: Duration = Duration::from_secs(3600);
 
@@ -68,6 +73,27 @@ pub struct Batch {
     pub due: Option<SystemTime>,
     /// The messages, in packet order.
     pub messages: Vec<OscMessage>,
+}
+
+impl Batch {
+    /// The memory this batch holds, about: its strings and blobs, and a fixed cost per message
+    /// and argument.
+    pub fn bytes(&self) -> usize {
+        let argument = |a: &OscType| {
+            size_of::<OscType>()
+                + match a {
+                    OscType::String(s) => s.len(),
+                    OscType::Blob(b) => b.len(),
+                    _ => 0,
+                }
+        };
+        size_of::<Batch>()
+            + self
+                .messages
+                .iter()
+                .map(|m| size_of::<OscMessage>() + m.addr.len() + m.args.iter().map(argument).sum::<usize>())
+                .sum::<usize>()
+    }
 }
 
 /// Decodes one UDP payload into batches: a message is a batch; a bundle (with nested bundles
@@ -128,8 +154,12 @@ const RECEIVE_BUFFER_BYTES: usize = 4 << 20;
 pub struct OscReceiver {
     local: SocketAddr,
     queue: Receiver<Batch>,
+    /// Bytes of the batches in `queue` (the receiver thread adds, `drain` subtracts).
+    queued_bytes: Arc<AtomicUsize>,
     counters: Arc<OscCounters>,
     scheduled: Vec<Batch>,
+    /// Bytes of the batches in `scheduled`.
+    scheduled_bytes: usize,
     stop: Arc<AtomicBool>,
     thread: Option<JoinHandle<()>>,
     logged: Arc<Mutex<HashSet<String>>>,
@@ -145,18 +175,30 @@ impl OscReceiver {
         socket.set_read_timeout(Some(Duration::from_millis(50))).map_err(|e| e.to_string())?;
         let local = socket.local_addr().map_err(|e| e.to_string())?;
         let (tx, queue) = sync_channel(MAX_QUEUED);
+        let queued_bytes = Arc::new(AtomicUsize::new(0));
         let counters = Arc::new(OscCounters::default());
         let stop = Arc::new(AtomicBool::new(false));
         let logged = Arc::new(Mutex::new(HashSet::new()));
         let thread = {
             let (counters, stop, logged) = (counters.clone(), stop.clone(), logged.clone());
+            let queue = Queue { tx, bytes: queued_bytes.clone() };
             std::thread::Builder::new()
                 .name("indra-osc".into())
-                .spawn(move || receive_loop(&socket, &tx, &counters, &stop, &logged))
+                .spawn(move || receive_loop(&socket, &queue, &counters, &stop, &logged))
                 .map_err(|e| e.to_string())?
         };
         log::info!("OSC listening on {local}");
-        Ok(Self { local, queue, counters, scheduled: Vec::new(), stop, thread: Some(thread), logged })
+        Ok(Self {
+            local,
+            queue,
+            queued_bytes,
+            counters,
+            scheduled: Vec::new(),
+            scheduled_bytes: 0,
+            stop,
+            thread: Some(thread),
+            logged,
+        })
     }
 
     /// The bound address (useful with port 0).
@@ -174,20 +216,30 @@ impl OscReceiver {
     pub fn drain(&mut self, now: SystemTime) -> Vec<Batch> {
         let horizon = now + MAX_AHEAD;
         for batch in self.queue.try_iter() {
+            let bytes = batch.bytes();
+            self.queued_bytes.fetch_sub(bytes, Ordering::Relaxed);
             let too_late = batch.due.is_some_and(|t| t > horizon);
-            let full = batch.due.is_some_and(|t| t > now) && self.scheduled.len() >= MAX_SCHEDULED;
+            let full = batch.due.is_some_and(|t| t > now)
+                && (self.scheduled.len() >= MAX_SCHEDULED || self.scheduled_bytes + bytes > MAX_SCHEDULED_BYTES);
             if too_late || full {
                 self.counters.dropped.fetch_add(1, Ordering::Relaxed);
                 let why = if too_late { "a time tag more than an hour ahead" } else { "too many future bundles" };
                 log_once(&self.logged, why, &format!("bundle dropped: {why}"));
                 continue;
             }
+            self.scheduled_bytes += bytes;
             self.scheduled.push(batch);
         }
         let (due, later): (Vec<Batch>, Vec<Batch>) =
             self.scheduled.drain(..).partition(|b| b.due.is_none_or(|t| t <= now));
         self.scheduled = later;
+        self.scheduled_bytes -= due.iter().map(Batch::bytes).sum::<usize>();
         due
+    }
+
+    /// Bytes waiting: queued by the receiver thread and scheduled for later.
+    pub fn pending_bytes(&self) -> usize {
+        self.queued_bytes.load(Ordering::Relaxed) + self.scheduled_bytes
     }
 
     /// Logs `message` the first time its `kind` is seen.
@@ -246,9 +298,15 @@ fn describe_args(args: &[OscType]) -> String {
     parts.join(", ")
 }
 
+/// The receiver thread's end of the queue, with the bytes it holds.
+struct Queue {
+    tx: SyncSender<Batch>,
+    bytes: Arc<AtomicUsize>,
+}
+
 fn receive_loop(
     socket: &UdpSocket,
-    tx: &SyncSender<Batch>,
+    queue: &Queue,
     counters: &OscCounters,
     stop: &AtomicBool,
     logged: &Mutex<HashSet<String>>,
@@ -265,9 +323,17 @@ fn receive_loop(
                     if batch.messages.iter().any(|m| m.addr == "/indra/stats") {
                         reply_stats(socket, from, counters);
                     }
-                    match tx.try_send(batch) {
+                    let bytes = batch.bytes();
+                    let room = queue.bytes.load(Ordering::Relaxed) + bytes <= MAX_QUEUED_BYTES;
+                    if room {
+                        queue.bytes.fetch_add(bytes, Ordering::Relaxed);
+                    }
+                    match if room { queue.tx.try_send(batch) } else { Err(TrySendError::Full(batch)) } {
                         Ok(()) => {}
                         Err(TrySendError::Full(_)) => {
+                            if room {
+                                queue.bytes.fetch_sub(bytes, Ordering::Relaxed);
+                            }
                             counters.dropped.fetch_add(1, Ordering::Relaxed);
                             log_once(
                                 logged,
@@ -433,6 +499,16 @@ fn route_command(command: Command, args: &[OscType]) -> Option<Routed> {
         _ => None,
     };
     let seconds = numbers(&args[args.len().min(1)..]).and_then(|n| n.first().copied()).unwrap_or(0.0);
+    // Infinity or NaN in a command would pin what it starts (a morph that never ends): refused
+    // like a wrong argument, as parameter values are.
+    let non_finite = |a: &OscType| match a {
+        OscType::Float(x) => !x.is_finite(),
+        OscType::Double(x) => !x.is_finite(),
+        _ => false,
+    };
+    if args.iter().any(non_finite) {
+        return None;
+    }
     match command {
         Command::Resume => Some(Routed::Event(ControlEvent::ResumeTracks)),
         Command::PresetSave => name.map(Routed::SavePreset),
@@ -491,6 +567,17 @@ pub fn coerce_args(args: &[OscType], decl: &ParamDecl) -> Option<ParamValue> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn commands_with_infinite_or_nan_numbers_are_refused() {
+        let name = OscType::String("p1".into());
+        for bad in [OscType::Float(f32::INFINITY), OscType::Double(f64::NAN), OscType::Float(f32::NEG_INFINITY)] {
+            assert!(route_command(Command::PresetRecall, &[name.clone(), bad.clone()]).is_none(), "{bad:?}");
+            assert!(route_command(Command::TempoBpm, &[bad]).is_none());
+        }
+        let good = route_command(Command::PresetRecall, &[name, OscType::Float(2.0)]);
+        assert!(matches!(good, Some(Routed::RecallPreset(n, s)) if n == "p1" && s == 2.0));
+    }
 
     #[test]
     fn time_tags_after_2036_stay_in_the_future() {

@@ -100,7 +100,8 @@ pub fn subtree<'a>(tree: &'a Value, path: &str) -> Option<&'a Value> {
 /// The OSCQuery endpoint: the published tree over HTTP, value changes to listening controllers
 /// over WebSockets, and its advertisement over mDNS.
 pub struct OscQueryServer {
-    snapshot: Arc<RwLock<Value>>,
+    /// The published tree; `None` until the first frame publishes one.
+    snapshot: Arc<RwLock<Option<Value>>>,
     listeners: Arc<Listeners>,
     /// The scene changed: publish and announce it after the next frame.
     path_changed: bool,
@@ -114,18 +115,20 @@ impl OscQueryServer {
     /// over mDNS unless `addr` is loopback. The server has hard limits (see [`super::http`]):
     /// no request can exhaust memory or hold up the others. mDNS that cannot start is logged.
     pub fn start(addr: &str, osc_port: u16) -> Result<Self, String> {
-        let snapshot = Arc::new(RwLock::new(json!({ "FULL_PATH": "/", "CONTENTS": {} })));
+        let snapshot: Arc<RwLock<Option<Value>>> = Arc::default();
         let tree = snapshot.clone();
         let handler = Arc::new(move |target: &str| {
             let (path, query) = target.split_once('?').unwrap_or((target, ""));
-            let body = if query.contains("HOST_INFO") {
-                Some(host_info(osc_port))
-            } else {
-                tree.read().ok().and_then(|t| subtree(&t, path).cloned())
-            };
-            match body {
-                Some(v) => (200, v.to_string()),
-                None => (404, "{}".to_string()),
+            if query.contains("HOST_INFO") {
+                return (200, host_info(osc_port).to_string());
+            }
+            let Ok(tree) = tree.read() else { return (503, "{}".to_string()) };
+            // Until the show has built its scene there is no tree: a controller connecting at
+            // start-up is told to come back, not shown an empty show.
+            match tree.as_ref().map(|t| subtree(t, path)) {
+                None => (503, "{}".to_string()),
+                Some(Some(v)) => (200, v.to_string()),
+                Some(None) => (404, "{}".to_string()),
             }
         });
         let listeners = Arc::new(Listeners::default());
@@ -157,7 +160,7 @@ impl OscQueryServer {
     pub fn publish(&self, instance: &SceneInstance) {
         let t = tree(instance);
         if let Ok(mut s) = self.snapshot.write() {
-            *s = t;
+            *s = Some(t);
         }
     }
 

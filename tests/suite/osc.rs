@@ -347,6 +347,9 @@ fn oscquery_serves_every_parameter_with_type_range_and_value() {
     let gpu = common::gpu();
     let instance = SceneInstance::new(&gpu, &common::assets(), scene("star_glow"), (32, 32)).unwrap();
     let server = OscQueryServer::start("127.0.0.1:0", 9000).unwrap();
+    // Before the show publishes its scene, the tree is not shown as an empty one.
+    assert_eq!(http_raw(server.local_addr(), b"GET / HTTP/1.1\r\n\r\n"), 503);
+    assert_eq!(http_get(server.local_addr(), "/?HOST_INFO").0, 200);
     server.publish(&instance);
     let (status, tree) = http_get(server.local_addr(), "/");
     assert_eq!(status, 200);
@@ -421,7 +424,7 @@ fn oscquery_survives_hostile_http() {
     stalled.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
     let mut rest = Vec::new();
     let closed = stalled.read_to_end(&mut rest).is_ok();
-    assert!(closed && String::from_utf8_lossy(&rest).contains("400"), "{}", String::from_utf8_lossy(&rest));
+    assert!(closed && String::from_utf8_lossy(&rest).contains("408"), "{}", String::from_utf8_lossy(&rest));
     // A hundred idle connections: the server stays up and answers once they time out.
     let idle: Vec<_> = (0..100).map(|_| std::net::TcpStream::connect(addr).unwrap()).collect();
     std::thread::sleep(Duration::from_millis(2500));
@@ -641,4 +644,121 @@ fn oscquery_is_found_by_an_mdns_browser() {
     assert!(found(indra::control::discovery::OSCQUERY_SERVICE, server.local_addr().port()), "no _oscjson._tcp");
     assert!(found(indra::control::discovery::OSC_SERVICE, 9123), "no _osc._udp");
     let _ = browser.shutdown();
+}
+
+/// A TCP connection to `addr` from loopback address `from` (another machine on the venue network).
+fn connect_from(from: &str, addr: std::net::SocketAddr) -> std::io::Result<std::net::TcpStream> {
+    let socket = socket2::Socket::new(socket2::Domain::IPV4, socket2::Type::STREAM, None)?;
+    socket.bind(&format!("{from}:0").parse::<std::net::SocketAddr>().unwrap().into())?;
+    socket.connect(&addr.into())?;
+    Ok(socket.into())
+}
+
+#[test]
+fn slow_clients_on_one_machine_cannot_keep_oscquery_from_the_others() {
+    use std::io::Write;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let server = OscQueryServer::start("127.0.0.1:0", 9000).unwrap();
+    let addr = server.local_addr();
+    let stop = std::sync::Arc::new(AtomicBool::new(false));
+    // 32 clients at 127.0.0.2, each sending one header byte every 1.5 s, reconnecting when cut off.
+    let attack = {
+        let stop = stop.clone();
+        std::thread::spawn(move || {
+            let mut slow: Vec<Option<std::net::TcpStream>> = (0..32).map(|_| None).collect();
+            let mut cut_off = 0;
+            while !stop.load(Ordering::Relaxed) {
+                for conn in slow.iter_mut() {
+                    let alive = conn.as_mut().is_some_and(|c| c.write_all(b"X").is_ok());
+                    if !alive {
+                        cut_off += usize::from(conn.is_some());
+                        *conn = connect_from("127.0.0.2", addr).ok();
+                    }
+                }
+                std::thread::sleep(Duration::from_millis(1500));
+            }
+            cut_off
+        })
+    };
+    std::thread::sleep(Duration::from_millis(500));
+    for _ in 0..4 {
+        let started = Instant::now();
+        assert_eq!(http_get(addr, "/?HOST_INFO").0, 200, "a client on another machine is served");
+        assert!(started.elapsed() < Duration::from_secs(1), "and at once: {:?}", started.elapsed());
+        std::thread::sleep(Duration::from_millis(1000));
+    }
+    stop.store(true, Ordering::Relaxed);
+    let cut_off = attack.join().unwrap();
+    assert!(cut_off > 0, "trickling heads are cut off at the deadline");
+}
+
+#[test]
+fn websockets_stalled_mid_frame_are_closed_and_free_their_places() {
+    use std::io::{Read, Write};
+    let server = OscQueryServer::start("127.0.0.1:0", 9000).unwrap();
+    let addr = server.local_addr();
+    let url = format!("ws://{addr}/");
+    // Every place taken by a client that sends two bytes of a frame header and stops.
+    let stalled: Vec<std::net::TcpStream> = (0..indra::control::http::MAX_SOCKETS)
+        .map(|_| {
+            let mut s = std::net::TcpStream::connect(addr).unwrap();
+            write!(
+                s,
+                "GET / HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Version: 13\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n"
+            )
+            .unwrap();
+            let mut answer = [0u8; 12];
+            s.read_exact(&mut answer).unwrap();
+            assert_eq!(&answer, b"HTTP/1.1 101");
+            s.write_all(&[0x81, 0xfe]).unwrap();
+            s
+        })
+        .collect();
+    assert!(tungstenite::connect(&url).is_err(), "every place is taken");
+    let started = Instant::now();
+    let limit = indra::control::listen::SESSION_IDLE + Duration::from_secs(5);
+    let (mut socket, _) = loop {
+        match tungstenite::connect(&url) {
+            Ok(connected) => break connected,
+            Err(_) => assert!(started.elapsed() < limit, "stalled sessions kept their places"),
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    };
+    // A live client answers the pings by itself and stays past the idle limit.
+    if let tungstenite::stream::MaybeTlsStream::Plain(s) = socket.get_mut() {
+        s.set_read_timeout(Some(Duration::from_millis(100))).unwrap();
+    }
+    let stay = Instant::now();
+    while stay.elapsed() < indra::control::listen::SESSION_IDLE + Duration::from_secs(2) {
+        match socket.read() {
+            Ok(_) => {}
+            Err(tungstenite::Error::Io(e)) if e.kind() == std::io::ErrorKind::WouldBlock => {}
+            Err(e) => panic!("a live session was closed: {e}"),
+        }
+    }
+    drop(stalled);
+}
+
+#[test]
+fn the_osc_queue_is_bounded_in_bytes_under_a_flood_of_large_datagrams() {
+    let mut rx = OscReceiver::bind("127.0.0.1:0").unwrap();
+    let sender = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let big = OscPacket::Message(OscMessage {
+        addr: "/indra/limit_set/scale".into(),
+        args: vec![OscType::Blob(vec![7u8; 60_000])],
+    });
+    let bytes = rosc::encoder::encode(&big).unwrap();
+    // 400 datagrams of 60 KB (24 MB) with no frame draining them.
+    for _ in 0..400 {
+        sender.send_to(&bytes, rx.local_addr()).unwrap();
+        std::thread::sleep(Duration::from_micros(200));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    let pending = rx.pending_bytes();
+    assert!(pending <= indra::control::osc::MAX_QUEUED_BYTES, "{pending} bytes queued");
+    let [packets, _, _, _, _, _, dropped] = rx.counters().snapshot();
+    assert!(packets > 200 && dropped > 0, "{packets} packets, {dropped} dropped");
+    let drained = rx.drain(SystemTime::now());
+    assert!(!drained.is_empty());
+    assert_eq!(rx.pending_bytes(), 0, "a drain gives the bytes back");
 }
