@@ -217,3 +217,47 @@ fn projector_outputs_open_their_windows_and_follow_corner_addresses() {
         std::thread::sleep(Duration::from_millis(250));
     }
 }
+
+#[test]
+fn the_network_can_neither_name_files_outside_nor_freeze_the_show_with_them() {
+    let display = VirtualDisplay::start();
+    let dir = std::env::temp_dir().join(format!("indra-hostile-files-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let victim = dir.join("victim.conf");
+    std::fs::write(&victim, "keep me").unwrap();
+    // The pipe lies in a folder the performer opened: it is refused as no regular file.
+    let allowed = dir.join("allowed");
+    std::fs::create_dir_all(&allowed).unwrap();
+    let fifo = allowed.join("pipe.ron");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let takes = dir.join("takes");
+    let base = takes.join("show.mp4");
+    let args = ["--record-video".as_ref(), base.as_os_str(), "--allow-path".as_ref(), allowed.as_os_str()];
+    let (mut show, port) = Show::start(&display, &dir, "projection_mapping", &args);
+    show.wait_for("recording to");
+    let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let text = |p: &Path| vec![rosc::OscType::String(p.to_str().unwrap().into())];
+
+    // A pipe: refused without opening it for reading; the show goes on to the next message.
+    send(&socket, port, "/indra/wall/file", text(&fifo));
+    show.wait_for("not a regular file");
+    send(&socket, port, "/indra/wall/file", text(&victim));
+    show.wait_for("outside the folders");
+    send(&socket, port, "/indra/wall/save", vec![rosc::OscType::Int(1)]);
+    let log = show.wait_for("warp not saved");
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep me", "{log}");
+
+    // 300 start/stop pairs: a few takes, and the show still answers at once.
+    for i in 0..300 {
+        send(&socket, port, "/indra/record/start", vec![rosc::OscType::String(format!("t{i}.mp4"))]);
+        send(&socket, port, "/indra/record/stop", vec![]);
+    }
+    send(&socket, port, "/indra/wall/file", text(&dir.join("after-the-flood.ron")));
+    let started = Instant::now();
+    let log = show.wait_for("after-the-flood.ron");
+    assert!(started.elapsed() < Duration::from_secs(20), "the flood held the show {:?}", started.elapsed());
+    assert!(log.contains("take not started"), "{log}");
+    let written = std::fs::read_dir(&takes).unwrap().count();
+    assert!((1..=6).contains(&written), "{written} takes written:\n{log}");
+}
