@@ -1,9 +1,10 @@
 //! indra — a real-time visual-art engine for live VJ sets and installations, rendering the
 //! techniques of *Unity Graphics Programming vol.4* with wgpu.
 //!
-//! Layers, from the bottom (a layer never imports one above it; see `DESIGN.md`):
-//! [`time`], [`files`], [`assets`] and [`atomic_file`] → [`gpu`] → [`graph`] → [`params`] → [`techniques`] → [`scene`] →
-//! [`offscreen`] / [`app`]; `main.rs` is the command line only.
+//! Layers, from the bottom (a module imports only lower layers; `docs/architecture.md` is the
+//! map, and a test holds it to this crate): [`time`], [`files`], [`atomic_file`] → [`assets`],
+//! [`geometry`], [`gpu`], [`graph`] → [`params`] → [`techniques`] → [`scene`] → [`control`],
+//! [`live`] → [`offscreen`] → [`app`]; `main.rs` is the command line only.
 
 #![warn(missing_docs)]
 
@@ -13,7 +14,6 @@ pub mod atomic_file;
 pub mod control;
 pub mod files;
 pub mod geometry;
-
 pub mod gpu;
 pub mod graph;
 pub mod live;

@@ -3,6 +3,7 @@
 //! of disk and most of a minute. `cargo test --test suite kleinian::` runs one module. `cli.rs` stays
 //! apart: it also runs against the build without default features (tools/test-render-node).
 
+mod architecture;
 mod audio;
 mod cloth;
 #[path = "../common/mod.rs"]

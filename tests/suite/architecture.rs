@@ -1,0 +1,98 @@
+//! The architecture page (`docs/architecture.md`) against the code: its layer table lists every
+//! module of `src/` once, and every `crate::` import goes to a lower layer.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+/// The binary's files, which may use any layer.
+const BINARY: [&str; 4] = ["lib.rs", "main.rs", "commands.rs", "triangulate_cmd.rs"];
+
+/// Module → layer, from the page's table (`| 3 | `params` | … |`).
+fn layers() -> BTreeMap<String, u32> {
+    let page = std::fs::read_to_string(Path::new(ROOT).join("docs/architecture.md")).unwrap();
+    let mut layers = BTreeMap::new();
+    for row in page.lines().filter(|l| l.starts_with("| ")) {
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        let Ok(layer) = cells[1].parse::<u32>() else { continue };
+        for module in cells[2].split(',').map(|m| m.trim().trim_matches('`')) {
+            assert!(layers.insert(module.to_string(), layer).is_none(), "{module} is listed twice");
+        }
+    }
+    layers
+}
+
+/// The modules of `src/`: its folders and its files other than the binary's.
+fn modules() -> Vec<String> {
+    let mut found: Vec<String> = std::fs::read_dir(Path::new(ROOT).join("src"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir() || !BINARY.contains(&p.file_name().unwrap().to_str().unwrap()))
+        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+        .collect();
+    found.sort();
+    found
+}
+
+fn rust_files(path: &Path, out: &mut Vec<PathBuf>) {
+    if path.is_dir() {
+        for entry in std::fs::read_dir(path).unwrap() {
+            rust_files(&entry.unwrap().path(), out);
+        }
+    } else if path.extension().is_some_and(|e| e == "rs") {
+        out.push(path.to_path_buf());
+    }
+}
+
+/// The top-level modules `source` names as `crate::<module>`.
+fn imports(source: &str) -> Vec<String> {
+    source
+        .match_indices("crate::")
+        .filter(|(at, _)| !source[..*at].ends_with(|c: char| c.is_alphanumeric() || c == '_' || c == '$'))
+        .map(|(at, _)| source[at + 7..].chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect())
+        .filter(|name: &String| !name.is_empty())
+        .collect()
+}
+
+#[test]
+fn the_layer_table_lists_every_module_of_src_once() {
+    let listed: Vec<String> = layers().into_keys().collect();
+    assert_eq!(listed, modules(), "docs/architecture.md's layer table and src/ disagree");
+    let lib = std::fs::read_to_string(Path::new(ROOT).join("src/lib.rs")).unwrap();
+    let mut declared: Vec<String> =
+        lib.lines().filter_map(|l| l.strip_prefix("pub mod ")).map(|m| m.trim_end_matches(';').to_string()).collect();
+    declared.sort();
+    assert_eq!(declared, listed, "lib.rs declares other modules than the page lists");
+}
+
+#[test]
+fn every_import_goes_to_a_lower_layer() {
+    let layers = layers();
+    let mut wrong = Vec::new();
+    for (module, &layer) in &layers {
+        let dir = Path::new(ROOT).join("src").join(module);
+        let path = if dir.is_dir() { dir } else { dir.with_extension("rs") };
+        let mut files = Vec::new();
+        rust_files(&path, &mut files);
+        for file in files {
+            let source = std::fs::read_to_string(&file).unwrap();
+            for used in imports(&source).into_iter().filter(|u| u != module) {
+                match layers.get(&used) {
+                    Some(&other) if other < layer => {}
+                    other => wrong.push(format!(
+                        "{} (layer {layer}) uses crate::{used} (layer {other:?})",
+                        file.strip_prefix(ROOT).unwrap().display()
+                    )),
+                }
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "imports against the layers of docs/architecture.md:\n{}", wrong.join("\n"));
+}
+
+#[test]
+fn the_import_scan_sees_what_it_must() {
+    let source = "use crate::gpu::Gpu; $crate::no; my_crate::no; let a = crate::params::ParamSet::new();";
+    assert_eq!(imports(source), ["gpu", "params"]);
+}
