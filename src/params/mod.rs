@@ -9,6 +9,7 @@ mod morph;
 mod raw;
 mod set;
 mod track;
+mod typed;
 mod value;
 mod write;
 
@@ -18,5 +19,6 @@ pub use morph::Morph;
 pub use raw::{RawValue, coerce, raw_from_value, value_from_raw};
 pub use set::ParamSet;
 pub use track::{Interpolation, Key, LoopMode, Track, mix};
+pub use typed::{FromValue, ParamEnum, doc_text, field, option_index};
 pub use value::{Components, InputRole, ParamDecl, ParamType, ParamValue, Text};
 pub use write::{ParamWrite, Source};

@@ -29,26 +29,36 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 /// The output format: linear HDR so that post effects (StarGlow) can follow.
 pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
-/// Parameters with the book sample's C# defaults (seed-reference §2).
+crate::technique_params! {
+    /// What a limit-set node reads each step, with the book sample's C# defaults
+    /// (seed-reference §2).
+    pub struct Settings {
+        /// Maskit parameter t = (u, v); (2, 0) is the classic set, near (1.94, 0.02) it turns intricate
+        t: [f32; 2] = |n, doc| ParamDecl::new(n, ParamValue::Vec2([2.0, 0.0]), Some((-2.5, 2.5)), doc),
+        /// escape-time iteration cap per sample
+        iterations: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(500), Some((1.0, 5000.0)), doc),
+        /// fractal units per output height (zoom out)
+        scale: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.0), Some((0.01, 50.0)), doc),
+        /// fractal position of the bottom-left corner
+        offset: [f32; 2] = |n, doc| ParamDecl::new(n, ParamValue::Vec2([0.0, 0.0]), Some((-20.0, 20.0)), doc),
+        /// colour inside the limit set's disks
+        hit_color: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([1.0, 0.0, 0.0, 1.0]), None, doc),
+        /// background colour
+        back_color: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([0.5, 0.5, 0.5, 1.0]), None, doc),
+        /// jittered samples per pixel (anti-aliasing)
+        samples: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(1), Some((1.0, 64.0)), doc),
+        /// invert the plane in a circle before the test
+        circle_inversion: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(false), None, doc),
+        /// inversion circle centre
+        circle_center: [f32; 2] = |n, doc| ParamDecl::new(n, ParamValue::Vec2([0.0, 0.0]), Some((-20.0, 20.0)), doc),
+        /// inversion circle radius
+        circle_radius: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.0), Some((0.01, 20.0)), doc),
+    }
+}
+
+/// Parameters (see [`Settings`]).
 pub fn params() -> Vec<ParamDecl> {
-    use ParamValue::*;
-    vec![
-        ParamDecl::new(
-            "t",
-            Vec2([2.0, 0.0]),
-            Some((-2.5, 2.5)),
-            "Maskit parameter t = (u, v); (2, 0) is the classic set, near (1.94, 0.02) it turns intricate",
-        ),
-        ParamDecl::new("iterations", Int(500), Some((1.0, 5000.0)), "escape-time iteration cap per sample"),
-        ParamDecl::new("scale", Float(1.0), Some((0.01, 50.0)), "fractal units per output height (zoom out)"),
-        ParamDecl::new("offset", Vec2([0.0, 0.0]), Some((-20.0, 20.0)), "fractal position of the bottom-left corner"),
-        ParamDecl::new("hit_color", Color([1.0, 0.0, 0.0, 1.0]), None, "colour inside the limit set's disks"),
-        ParamDecl::new("back_color", Color([0.5, 0.5, 0.5, 1.0]), None, "background colour"),
-        ParamDecl::new("samples", Int(1), Some((1.0, 64.0)), "jittered samples per pixel (anti-aliasing)"),
-        ParamDecl::new("circle_inversion", Bool(false), None, "invert the plane in a circle before the test"),
-        ParamDecl::new("circle_center", Vec2([0.0, 0.0]), Some((-20.0, 20.0)), "inversion circle centre"),
-        ParamDecl::new("circle_radius", Float(1.0), Some((0.01, 20.0)), "inversion circle radius"),
-    ]
+    Settings::decls()
 }
 
 /// The shader's uniform block; layout checked against naga's reflection in the tests.
@@ -86,18 +96,20 @@ pub struct KleinianUniforms {
 impl KleinianUniforms {
     /// All per-frame precomputation: colours to linear, bools to flags.
     pub fn from_params(p: &ParamSet, time: &FrameTime, size: (u32, u32)) -> Self {
+        let s = Settings::read(p);
         Self {
-            t: p.vec2("t"),
-            scale: p.float("scale"),
-            iterations: p.int("iterations").max(1) as u32,
-            offset: p.vec2("offset"),
-            samples: p.int("samples").max(1) as u32,
-            inversion: u32::from(p.bool("circle_inversion")),
-            circle_center: p.vec2("circle_center"),
-            circle_radius: p.float("circle_radius"),
+            t: s.t,
+            scale: s.scale,
+            // A scene's own range may reach below the declared one.
+            iterations: s.iterations.max(1) as u32,
+            offset: s.offset,
+            samples: s.samples.max(1) as u32,
+            inversion: u32::from(s.circle_inversion),
+            circle_center: s.circle_center,
+            circle_radius: s.circle_radius,
             seed: time.seed as u32,
-            hit_color: linear_rgba(p.color("hit_color")),
-            back_color: linear_rgba(p.color("back_color")),
+            hit_color: linear_rgba(s.hit_color),
+            back_color: linear_rgba(s.back_color),
             size: [size.0, size.1],
             _pad: [0; 2],
         }

@@ -28,21 +28,45 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
-/// Parameters; defaults are the sample's 2-D scene (seed-reference §7).
+crate::param_enum! {
+    /// Whether a rectangle or a box is sampled.
+    pub enum Dimensions {
+        /// A rectangle, drawn as discs.
+        Two = "2d",
+        /// A box, drawn as spheres.
+        Three = "3d",
+    }
+}
+
+crate::technique_params! {
+    /// What a Poisson node reads each step; defaults are the sample's 2-D scene
+    /// (seed-reference §7).
+    pub struct Settings {
+        /// sample a rectangle (discs) or a box (spheres)
+        dimensions: Dimensions = |n, doc| ParamDecl::choice(n, Dimensions::OPTIONS, 0, doc),
+        /// minimum distance between samples
+        radius: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(5.0), Some((0.5, 100.0)), doc).with_unit("u"),
+        /// candidates per active sample before it retires (k)
+        attempts: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(30), Some((1.0, 200.0)), doc),
+        /// size of the box (2-D uses x, y)
+        extent: [f32; 3] = |n, doc| ParamDecl::new(n, ParamValue::Vec3([200.0; 3]), Some((1.0, 10000.0)), doc),
+        /// seed of every random choice
+        seed: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(1), Some((0.0, 1e9)), doc),
+        /// sampler steps per fixed time step
+        steps_per_step: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(2), Some((0.0, 100000.0)), doc),
+        /// drawn radius = radius × draw_scale / 2
+        draw_scale: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.0), Some((0.05, 2.0)), doc),
+        /// 3-D camera orbit
+        orbit_speed: f32 =
+            |n, doc| ParamDecl::new(n, ParamValue::Float(10.0), Some((-360.0, 360.0)), doc).with_unit("°/s"),
+        /// start sampling again from one seed point (R in the window)
+        restart: bool = |n, doc| ParamDecl::trigger(n, doc).with_role(InputRole::Key('r')),
+    }
+}
+
+/// Parameters (see [`Settings`]).
 pub fn params() -> Vec<ParamDecl> {
-    use ParamValue::*;
-    vec![
-        ParamDecl::choice("dimensions", &["2d", "3d"], 0, "sample a rectangle (discs) or a box (spheres)"),
-        ParamDecl::new("radius", Float(5.0), Some((0.5, 100.0)), "minimum distance between samples").with_unit("u"),
-        ParamDecl::new("attempts", Int(30), Some((1.0, 200.0)), "candidates per active sample before it retires (k)"),
-        ParamDecl::new("extent", Vec3([200.0, 200.0, 200.0]), Some((1.0, 10000.0)), "size of the box (2-D uses x, y)"),
-        ParamDecl::new("seed", Int(1), Some((0.0, 1e9)), "seed of every random choice"),
-        ParamDecl::new("steps_per_step", Int(2), Some((0.0, 100000.0)), "sampler steps per fixed time step"),
-        ParamDecl::new("draw_scale", Float(1.0), Some((0.05, 2.0)), "drawn radius = radius × draw_scale / 2"),
-        ParamDecl::new("orbit_speed", Float(10.0), Some((-360.0, 360.0)), "3-D camera orbit").with_unit("°/s"),
-        ParamDecl::trigger("restart", "start sampling again from one seed point (R in the window)")
-            .with_role(InputRole::Key('r')),
-    ]
+    Settings::decls()
 }
 
 /// The shader's uniform block.
@@ -76,14 +100,13 @@ struct RunKey {
 }
 
 impl RunKey {
-    fn of(p: &ParamSet) -> Self {
-        let e = p.get("extent").components();
+    fn of(p: &Settings) -> Self {
         Self {
-            three_d: p.choice("dimensions") == 1,
-            radius: p.float("radius"),
-            attempts: p.int("attempts"),
-            extent: [e[0], e[1], e[2]],
-            seed: p.int("seed"),
+            three_d: p.dimensions == Dimensions::Three,
+            radius: p.radius,
+            attempts: p.attempts,
+            extent: p.extent,
+            seed: p.seed,
         }
     }
 }
@@ -137,7 +160,7 @@ impl RunKey {
 
 /// Refuses settings whose run would pass [`RUN_BUDGET`] (see [`TechniqueInfo::check`]).
 fn check_settings(params: &ParamSet) -> Result<(), String> {
-    let key = RunKey::of(params);
+    let key = RunKey::of(&Settings::read(params));
     let cost = key.cost();
     if cost <= RUN_BUDGET as f64 {
         return Ok(());
@@ -279,10 +302,10 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
 impl Poisson {
     /// Restarts the run if its settings changed or `restart` fired (a scene's first run counts
     /// from frame 0, later ones from the frame they start in).
-    fn sync(&mut self, params: &ParamSet, time: &FrameTime) {
-        let key = RunKey::of(params);
+    fn sync(&mut self, settings: &Settings, time: &FrameTime) {
+        let key = RunKey::of(settings);
         let first = self.key.is_none();
-        if first || self.key.as_ref() != Some(&key) || params.fired("restart") {
+        if first || self.key.as_ref() != Some(&key) || settings.restart {
             let (fitted, message) = key.clone().within_budget();
             self.messages.extend(message);
             self.sampler = Some(Sampler::new(&fitted));
@@ -296,11 +319,12 @@ impl Poisson {
 
 impl Technique for Poisson {
     fn step(&mut self, params: &ParamSet, time: &FrameTime) {
-        self.sync(params, time);
+        let settings = Settings::read(params);
+        self.sync(&settings, time);
         let frames = (time.frame + 1).saturating_sub(self.next_frame);
         self.next_frame = time.frame + 1;
         let sampler = self.sampler.as_mut().expect("synced");
-        for _ in 0..frames * params.int("steps_per_step").max(0) as u64 {
+        for _ in 0..frames * settings.steps_per_step.max(0) as u64 {
             if !sampler.step() {
                 break;
             }
@@ -318,9 +342,10 @@ impl Technique for Poisson {
         time: &FrameTime,
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
+        let settings = Settings::read(params);
         // Runs (and restarts) are decided in `step`; here only a frame drawn before any step.
         if self.sampler.is_none() {
-            self.sync(params, time);
+            self.sync(&settings, time);
         }
         let key = self.fitted.clone().expect("synced");
         let sampler = self.sampler.as_ref().expect("synced");
@@ -336,7 +361,7 @@ impl Technique for Poisson {
 
         let targets = graph.create_raster_targets("poisson", FORMAT, Some(DEPTH), self.samples);
         let (w, h) = graph.texture_size(targets.color);
-        let uniforms = camera(&key, params, time, w as f32 / h as f32, count, self.samples);
+        let uniforms = camera(&key, &settings, time, w as f32 / h as f32, count, self.samples);
         let this: &'r Poisson = self;
         graph.add_pass("poisson/draw").draws_into(&targets).record(move |ctx| {
             ctx.queue.write_buffer(&this.block.buffer, 0, bytemuck::bytes_of(&uniforms));
@@ -359,17 +384,17 @@ impl Technique for Poisson {
 /// spheres drawn at its corners) fits the narrower field of view at every angle.
 fn camera(
     key: &RunKey,
-    params: &ParamSet,
+    settings: &Settings,
     time: &FrameTime,
     aspect: f32,
     count: usize,
     samples: u32,
 ) -> PoissonUniforms {
     use glam::Vec3;
-    let draw_radius = key.radius * params.float("draw_scale") / 2.0;
+    let draw_radius = key.radius * settings.draw_scale / 2.0;
     let (view_proj, right, up) = if key.three_d {
         let diagonal = Vec3::from(key.extent).length();
-        let angle = (params.float("orbit_speed") * time.seconds as f32).to_radians();
+        let angle = (settings.orbit_speed * time.seconds as f32).to_radians();
         let half_fov = 30f32.to_radians();
         let narrowest = half_fov.min((half_fov.tan() * aspect).atan());
         let distance = (diagonal / 2.0 + draw_radius) / narrowest.sin() * 1.02;
@@ -406,11 +431,12 @@ mod tests {
         let mut p = ParamSet::new(params());
         p.set_at(p.index("dimensions").unwrap(), crate::params::ParamValue::Enum(1));
         p.set_at(p.index("extent").unwrap(), crate::params::ParamValue::Vec3([200.0, 200.0, 200.0]));
-        let key = RunKey::of(&p);
+        let settings = Settings::read(&p);
+        let key = RunKey::of(&settings);
         for aspect in [16.0 / 9.0, 1.0, 9.0 / 16.0] {
             for frame in (0..7200).step_by(50) {
                 let time = FrameTime { frame, seconds: frame as f64 / 60.0, dt: 1.0 / 60.0, seed: 1 };
-                let u = camera(&key, &p, &time, aspect, 0, 1);
+                let u = camera(&key, &settings, &time, aspect, 0, 1);
                 let view_proj = glam::Mat4::from_cols_array_2d(&u.view_proj);
                 for corner in 0..8 {
                     let c = glam::Vec3::new(
@@ -439,7 +465,7 @@ mod tests {
         p.snap();
         let e = check_settings(&p).unwrap_err();
         assert!(e.contains("MiB") && e.contains("raise the radius"), "{e}");
-        let (fitted, message) = RunKey::of(&p).within_budget();
+        let (fitted, message) = RunKey::of(&Settings::read(&p)).within_budget();
         assert!(message.is_some_and(|m| m.contains("least within")));
         assert!(fitted.cost() <= RUN_BUDGET as f64 && fitted.cost() > RUN_BUDGET as f64 * 0.99, "{}", fitted.radius);
         // The fitted run really is small: its grid allocates within the budget.

@@ -4,7 +4,6 @@
 use crate::geometry::triangulate::Mesh2D;
 use crate::gpu::{GrowableBuffer, RasterDesc, ShaderError, UniformBlock};
 use crate::graph::{FrameGraph, PassContext, RasterTargets, TextureHandle};
-use crate::params::ParamSet;
 use crate::time::FrameTime;
 
 use super::super::NodeSetup;
@@ -26,10 +25,22 @@ pub struct PolygonUniforms {
     pub _pad: [f32; 3],
 }
 
+/// How a triangulated mesh is drawn: what the drawing and text nodes pass the renderer from
+/// their own settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DrawStyle {
+    /// Draw the triangle edges over the fill.
+    pub wireframe: bool,
+    /// Checker cells across the UV range.
+    pub checker: i32,
+    /// Half the view height in world units.
+    pub view_size: f32,
+}
+
 impl PolygonUniforms {
     /// The sample's orthographic camera of half-height `view_size`, centred on the origin.
-    pub fn new(params: &ParamSet, time: &FrameTime, aspect: f32) -> Self {
-        let half = params.float("view_size");
+    pub fn new(style: &DrawStyle, time: &FrameTime, aspect: f32) -> Self {
+        let half = style.view_size;
         let proj = glam::camera::lh::proj::directx::orthographic(-half * aspect, half * aspect, -half, half, -1.0, 1.0);
         // Hue = sin(0.5 t) mapped to [0, 1], full saturation.
         let hue = ((0.5 * time.seconds).sin() as f32 + 1.0) / 2.0;
@@ -38,7 +49,7 @@ impl PolygonUniforms {
         Self {
             view_proj: proj.to_cols_array_2d(),
             loop_color: [rgb[0], rgb[1], rgb[2], 1.0],
-            checker: params.int("checker") as f32,
+            checker: style.checker as f32,
             _pad: [0.0; 3],
         }
     }
@@ -144,19 +155,19 @@ impl Renderer {
         ];
     }
 
-    /// Adds pass `name` drawing the fill, the wireframe (per the `wireframe` parameter) and the
-    /// open loop into a new colour target, which it returns.
+    /// Adds pass `name` drawing the fill, the wireframe (if `style` asks) and the open loop
+    /// into a new colour target, which it returns.
     pub fn add_pass<'r>(
         &'r self,
         graph: &mut FrameGraph<'r>,
         name: &str,
-        params: &ParamSet,
+        style: &DrawStyle,
         time: &FrameTime,
     ) -> TextureHandle {
         let targets = graph.create_raster_targets(name, FORMAT, None, self.samples);
         let (w, h) = graph.texture_size(targets.color);
-        let uniforms = PolygonUniforms::new(params, time, w as f32 / h as f32);
-        let wireframe = params.bool("wireframe");
+        let uniforms = PolygonUniforms::new(style, time, w as f32 / h as f32);
+        let wireframe = style.wireframe;
         graph.add_pass(format!("{name}/draw")).draws_into(&targets).record(move |ctx| {
             self.record(ctx, &targets, &uniforms, wireframe);
         });

@@ -14,8 +14,9 @@ pub(crate) mod gpu;
 use crate::geometry::triangulate::{Mesh2D, Triangulator};
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, TextureHandle};
-use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
+use crate::params::{InputRole, ParamDecl, ParamEnum, ParamSet, ParamValue};
 use crate::time::FrameTime;
+use gpu::DrawStyle;
 
 use super::{NodeSetup, Technique, TechniqueInfo};
 
@@ -31,23 +32,53 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     check: None,
 };
 
-/// Parameters; the view is the sample's orthographic camera of size 5.
+crate::param_enum! {
+    /// What a drawing node starts with.
+    pub enum Start {
+        /// The book's nested test shapes.
+        Book = "book",
+        /// Nothing.
+        Empty = "empty",
+    }
+}
+
+crate::technique_params! {
+    /// What a drawing node reads each step; the view is the sample's orthographic camera of
+    /// size 5.
+    pub struct Settings {
+        /// where `add` puts a vertex: view position, y up
+        cursor: [f32; 2] = |n, doc| {
+            ParamDecl::new(n, ParamValue::Vec2([0.5, 0.5]), Some((0.0, 1.0)), doc).with_role(InputRole::Pointer)
+        },
+        /// append a vertex at the cursor to the polygon being drawn (left click)
+        add: bool = |n, doc| ParamDecl::trigger(n, doc).with_role(InputRole::PrimaryClick),
+        /// close the polygon being drawn and re-triangulate everything (right click)
+        close: bool = |n, doc| ParamDecl::trigger(n, doc).with_role(InputRole::SecondaryClick),
+        /// remove the last closed polygon (U in the window)
+        undo: bool = |n, doc| ParamDecl::trigger(n, doc).with_role(InputRole::Key('u')),
+        /// remove every polygon (C in the window)
+        clear: bool = |n, doc| ParamDecl::trigger(n, doc).with_role(InputRole::Key('c')),
+        /// start with the book's nested test shapes, or nothing
+        start: Start = |n, doc| ParamDecl::choice(n, Start::OPTIONS, 0, doc),
+        /// draw the triangle edges over the fill
+        wireframe: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(true), None, doc),
+        /// checker cells across the UV range
+        checker: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(8), Some((1.0, 64.0)), doc),
+        /// half the view height in world units
+        view_size: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(5.0), Some((0.5, 100.0)), doc),
+    }
+}
+
+impl Settings {
+    /// How the mesh is drawn.
+    pub fn style(&self) -> DrawStyle {
+        DrawStyle { wireframe: self.wireframe, checker: self.checker, view_size: self.view_size }
+    }
+}
+
+/// Parameters (see [`Settings`]).
 pub fn params() -> Vec<ParamDecl> {
-    use ParamValue::*;
-    vec![
-        ParamDecl::new("cursor", Vec2([0.5, 0.5]), Some((0.0, 1.0)), "where `add` puts a vertex: view position, y up")
-            .with_role(InputRole::Pointer),
-        ParamDecl::trigger("add", "append a vertex at the cursor to the polygon being drawn (left click)")
-            .with_role(InputRole::PrimaryClick),
-        ParamDecl::trigger("close", "close the polygon being drawn and re-triangulate everything (right click)")
-            .with_role(InputRole::SecondaryClick),
-        ParamDecl::trigger("undo", "remove the last closed polygon (U in the window)").with_role(InputRole::Key('u')),
-        ParamDecl::trigger("clear", "remove every polygon (C in the window)").with_role(InputRole::Key('c')),
-        ParamDecl::choice("start", &["book", "empty"], 0, "start with the book's nested test shapes, or nothing"),
-        ParamDecl::new("wireframe", Bool(true), None, "draw the triangle edges over the fill"),
-        ParamDecl::new("checker", Int(8), Some((1.0, 64.0)), "checker cells across the UV range"),
-        ParamDecl::new("view_size", Float(5.0), Some((0.5, 100.0)), "half the view height in world units"),
-    ]
+    Settings::decls()
 }
 
 /// The sample's TriangulationTest data (seed-reference §5): an outer ring, two holes, three
@@ -118,9 +149,9 @@ impl PolygonDraw {
     }
 
     /// Applies the triggers of one fixed step (each fires for exactly one step).
-    fn apply_triggers(&mut self, params: &ParamSet) {
+    fn apply_triggers(&mut self, p: &Settings) {
         let aspect = self.aspect;
-        let start = params.choice("start");
+        let start = p.start.index();
         let mut changed = false;
         if self.started != Some(start) {
             self.started = Some(start);
@@ -128,24 +159,24 @@ impl PolygonDraw {
             self.drawing.clear();
             changed = true;
         }
-        if params.fired("clear") {
+        if p.clear {
             self.polygons.clear();
             self.drawing.clear();
             changed = true;
         }
-        if params.fired("undo") && self.polygons.pop().is_some() {
+        if p.undo && self.polygons.pop().is_some() {
             changed = true;
         }
-        if params.fired("add") {
-            let [cx, cy] = params.vec2("cursor");
-            let half = f64::from(params.float("view_size"));
+        if p.add {
+            let [cx, cy] = p.cursor;
+            let half = f64::from(p.view_size);
             let world = [(f64::from(cx) * 2.0 - 1.0) * half * f64::from(aspect), (f64::from(cy) * 2.0 - 1.0) * half];
             if self.drawing.last() != Some(&world) {
                 self.drawing.push(world);
                 self.dirty = true;
             }
         }
-        if params.fired("close") {
+        if p.close {
             if self.drawing.len() >= 3 {
                 self.polygons.push(std::mem::take(&mut self.drawing));
                 changed = true;
@@ -161,7 +192,7 @@ impl PolygonDraw {
 
 impl Technique for PolygonDraw {
     fn step(&mut self, params: &ParamSet, _time: &FrameTime) {
-        self.apply_triggers(params);
+        self.apply_triggers(&Settings::read(params));
     }
 
     fn take_messages(&mut self) -> Vec<String> {
@@ -177,13 +208,14 @@ impl Technique for PolygonDraw {
     ) -> TextureHandle {
         let (w, h) = graph.output_size();
         self.aspect = w as f32 / h.max(1) as f32;
+        let settings = Settings::read(params);
         // A frame drawn before any step still shows the start shapes.
         if self.started.is_none() {
-            self.apply_triggers(params);
+            self.apply_triggers(&settings);
         }
         if std::mem::take(&mut self.dirty) {
             self.gpu.upload(&self.mesh, &self.drawing);
         }
-        self.gpu.add_pass(graph, "polygon_draw", params, time)
+        self.gpu.add_pass(graph, "polygon_draw", &settings.style(), time)
     }
 }

@@ -38,51 +38,72 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 /// Intermediate and output format.
 pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
-/// Composite types, in the order of the `composite` enum parameter.
-pub const COMPOSITE_TYPES: [&str; 5] = ["Additive", "Screen", "ColoredAdditive", "ColoredScreen", "Debug"];
-
 /// Output height at which resolution-independent streaks take the book's texel steps.
 pub const REFERENCE_HEIGHT: f32 = 1080.0;
 
 /// Most passes one frame declares: bright, 16 directions × (5 levels + accumulate), composite.
 pub const MAX_PASSES: usize = 2 + 16 * (5 + 1);
 
-/// Parameters with the sample's C# defaults and ranges (seed-reference §4).
+crate::param_enum! {
+    /// How the glow joins the source (the shader's composite type, by index).
+    pub enum Composite {
+        /// source + glow
+        Additive = "Additive",
+        /// 1 − (1 − source)(1 − glow)
+        Screen = "Screen",
+        /// source + glow × colour
+        ColoredAdditive = "ColoredAdditive",
+        /// screen with the glow tinted
+        ColoredScreen = "ColoredScreen",
+        /// the glow alone
+        Debug = "Debug",
+    }
+}
+
+crate::param_enum! {
+    /// The `layout` parameter: which pass layout to use.
+    pub enum LayoutChoice {
+        /// Fused (same output, fewer passes).
+        Auto = "Auto",
+        /// The book's pass layout.
+        Book = "Book",
+        /// One pass per level for every direction.
+        Fused = "Fused",
+    }
+}
+
+crate::technique_params! {
+    /// What a StarGlow node reads each frame, with the sample's C# defaults and ranges
+    /// (seed-reference §4).
+    pub struct Settings {
+        /// brightness subtracted before streaking (HDR: may exceed 1)
+        threshold: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.0), Some((0.0, 10.0)), doc),
+        /// gain of the bright pass; 0 switches the effect off
+        intensity: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.0), Some((0.0, 10.0)), doc),
+        /// downsampling factor of the streak textures
+        divide: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(3), Some((1.0, 20.0)), doc),
+        /// cascade levels; a streak reaches 4^iteration texels
+        iteration: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(5), Some((1.0, 5.0)), doc),
+        /// weight falloff per texel along a streak
+        attenuation: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.0), Some((0.0, 1.0)), doc),
+        /// rotation of the first streak
+        angle: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.0), Some((0.0, 360.0)), doc).with_unit("°"),
+        /// number of streak directions
+        streaks: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(4), Some((1.0, 16.0)), doc),
+        /// how the glow joins the source
+        composite: Composite = |n, doc| ParamDecl::choice(n, Composite::OPTIONS, 0, doc),
+        /// tint of the coloured composite types
+        color: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([1.0, 1.0, 1.0, 1.0]), None, doc),
+        /// pass layout; Auto is Fused (same output, fewer passes)
+        layout: LayoutChoice = |n, doc| ParamDecl::choice(n, LayoutChoice::OPTIONS, 0, doc),
+        /// streak length relative to the image (as the book at 1080p) instead of in texels
+        resolution_independent: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(true), None, doc),
+    }
+}
+
+/// Parameters (see [`Settings`]).
 pub fn params() -> Vec<ParamDecl> {
-    use ParamValue::*;
-    vec![
-        ParamDecl::new(
-            "threshold",
-            Float(1.0),
-            Some((0.0, 10.0)),
-            "brightness subtracted before streaking (HDR: may exceed 1)",
-        ),
-        ParamDecl::new(
-            "intensity",
-            Float(1.0),
-            Some((0.0, 10.0)),
-            "gain of the bright pass; 0 switches the effect off",
-        ),
-        ParamDecl::new("divide", Int(3), Some((1.0, 20.0)), "downsampling factor of the streak textures"),
-        ParamDecl::new("iteration", Int(5), Some((1.0, 5.0)), "cascade levels; a streak reaches 4^iteration texels"),
-        ParamDecl::new("attenuation", Float(1.0), Some((0.0, 1.0)), "weight falloff per texel along a streak"),
-        ParamDecl::new("angle", Float(0.0), Some((0.0, 360.0)), "rotation of the first streak").with_unit("°"),
-        ParamDecl::new("streaks", Int(4), Some((1.0, 16.0)), "number of streak directions"),
-        ParamDecl::choice("composite", &COMPOSITE_TYPES, 0, "how the glow joins the source"),
-        ParamDecl::new("color", Color([1.0, 1.0, 1.0, 1.0]), None, "tint of the coloured composite types"),
-        ParamDecl::choice(
-            "layout",
-            &["Auto", "Book", "Fused"],
-            0,
-            "pass layout; Auto is Fused (same output, fewer passes)",
-        ),
-        ParamDecl::new(
-            "resolution_independent",
-            Bool(true),
-            None,
-            "streak length relative to the image (as the book at 1080p) instead of in texels",
-        ),
-    ]
+    Settings::decls()
 }
 
 /// The shader's uniform block; layout checked against naga's reflection in the tests.
@@ -136,7 +157,15 @@ pub enum Layout {
 impl Layout {
     /// The layout the `layout` parameter asks for (`Auto` is `Fused`).
     pub fn choose(p: &ParamSet) -> Self {
-        if p.choice("layout") == 1 { Layout::Book } else { Layout::Fused }
+        Self::of(Settings::read(p).layout)
+    }
+
+    /// The layout `choice` stands for.
+    pub fn of(choice: LayoutChoice) -> Self {
+        match choice {
+            LayoutChoice::Book => Layout::Book,
+            LayoutChoice::Auto | LayoutChoice::Fused => Layout::Fused,
+        }
     }
 }
 
@@ -256,11 +285,12 @@ impl Technique for StarGlow {
         inputs: &[TextureHandle],
     ) -> TextureHandle {
         let source = inputs[0];
+        let settings = Settings::read(params);
         // A zero-effect setting adds no passes: the source goes straight through.
-        if params.float("intensity") <= 0.0 {
+        if settings.intensity <= 0.0 {
             return source;
         }
-        let plan = passes::Plan::new(params, Layout::choose(params));
+        let plan = passes::Plan::new(&settings, Layout::of(settings.layout));
         self.bind_groups.get_mut().begin_frame();
         let this: &'r StarGlow = self;
         plan.declare(this, graph, source)

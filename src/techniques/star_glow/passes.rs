@@ -2,9 +2,9 @@
 //! output, so the frame graph's pool reuses them (a book-layout frame of N streaks needs a handful
 //! of physical textures, not N × iteration).
 
-use super::{Binding, FORMAT, Kernel, Layout, StarGlow, StarGlowUniforms, streak_step};
+use super::{Binding, FORMAT, Kernel, Layout, Settings, StarGlow, StarGlowUniforms, streak_step};
 use crate::graph::{Extent, FrameGraph, PassContext, TextureDesc, TextureHandle};
-use crate::params::ParamSet;
+use crate::params::ParamEnum;
 use crate::techniques::srgb_to_linear;
 
 /// One frame's worth of StarGlow work, decided from the parameters.
@@ -31,19 +31,20 @@ struct PassSpec<'k> {
 }
 
 impl Plan {
-    pub fn new(p: &ParamSet, layout: Layout) -> Self {
-        let c = p.color("color");
+    pub fn new(p: &Settings, layout: Layout) -> Self {
+        let c = p.color;
+        // Scenes may give their own ranges: the shader's limits are kept here.
         let base = StarGlowUniforms {
             dst_size: [0; 2],
-            threshold: p.float("threshold"),
-            intensity: p.float("intensity"),
+            threshold: p.threshold,
+            intensity: p.intensity,
             offset: [0.0; 2],
-            attenuation: p.float("attenuation"),
+            attenuation: p.attenuation,
             power: 1.0,
-            composite_type: p.choice("composite"),
-            directions: p.int("streaks").clamp(1, 16) as u32,
+            composite_type: p.composite.index(),
+            directions: p.streaks.clamp(1, 16) as u32,
             first: 0,
-            divide: p.int("divide").clamp(1, 20) as u32,
+            divide: p.divide.clamp(1, 20) as u32,
             color: [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3]],
             steps: [[0.0; 4]; 16],
         };
@@ -51,9 +52,9 @@ impl Plan {
             layout,
             base,
             streaks: base.directions,
-            iteration: p.int("iteration").clamp(1, 5) as u32,
-            angle: p.float("angle"),
-            resolution_independent: p.bool("resolution_independent"),
+            iteration: p.iteration.clamp(1, 5) as u32,
+            angle: p.angle,
+            resolution_independent: p.resolution_independent,
             step_scale: 1.0,
         }
     }

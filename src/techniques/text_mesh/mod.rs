@@ -13,7 +13,7 @@ use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue, Text};
 use crate::time::FrameTime;
 
-use super::polygon_draw::gpu::Renderer;
+use super::polygon_draw::gpu::{DrawStyle, Renderer};
 use super::{NodeSetup, Technique, TechniqueInfo};
 
 /// The registry entry.
@@ -33,17 +33,27 @@ pub fn font() -> Face<'static> {
     Face::parse(epaint_default_fonts::UBUNTU_LIGHT, 0).expect("the bundled font parses")
 }
 
-/// Parameters.
+crate::technique_params! {
+    /// What a text node reads each frame.
+    pub struct Settings {
+        /// the text to mesh (one line)
+        text: Text = |n, doc| ParamDecl::text(n, "indra 808", doc),
+        /// em size in world units
+        size: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(2.0), Some((0.05, 20.0)), doc).with_unit("u"),
+        /// curve flattening tolerance
+        tolerance: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.002), Some((0.0001, 0.2)), doc).with_unit("u"),
+        /// draw the triangle edges over the fill
+        wireframe: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(true), None, doc),
+        /// checker cells across the UV range
+        checker: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(8), Some((1.0, 64.0)), doc),
+        /// half the view height in world units
+        view_size: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(2.5), Some((0.5, 100.0)), doc),
+    }
+}
+
+/// Parameters (see [`Settings`]).
 pub fn params() -> Vec<ParamDecl> {
-    use ParamValue::*;
-    vec![
-        ParamDecl::text("text", "indra 808", "the text to mesh (one line)"),
-        ParamDecl::new("size", Float(2.0), Some((0.05, 20.0)), "em size in world units").with_unit("u"),
-        ParamDecl::new("tolerance", Float(0.002), Some((0.0001, 0.2)), "curve flattening tolerance").with_unit("u"),
-        ParamDecl::new("wireframe", Bool(true), None, "draw the triangle edges over the fill"),
-        ParamDecl::new("checker", Int(8), Some((1.0, 64.0)), "checker cells across the UV range"),
-        ParamDecl::new("view_size", Float(2.5), Some((0.5, 100.0)), "half the view height in world units"),
-    ]
+    Settings::decls()
 }
 
 /// Forwards a glyph's outline into a [`RingBuilder`], scaled and offset into world units.
@@ -129,9 +139,9 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
 }
 
 impl TextMesh {
-    fn rebuild(&mut self, params: &ParamSet) {
-        let ParamValue::Text(text) = params.get("text") else { return };
-        let key = (text, params.float("size"), params.float("tolerance"));
+    fn rebuild(&mut self, p: &Settings) {
+        let key = (p.text, p.size, p.tolerance);
+        let text = p.text;
         if self.built == Some(key) {
             return;
         }
@@ -158,8 +168,11 @@ impl Technique for TextMesh {
         time: &FrameTime,
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
-        self.rebuild(params);
-        self.renderer.add_pass(graph, "text_mesh", params, time)
+        let settings = Settings::read(params);
+        self.rebuild(&settings);
+        let style =
+            DrawStyle { wireframe: settings.wireframe, checker: settings.checker, view_size: settings.view_size };
+        self.renderer.add_pass(graph, "text_mesh", &style, time)
     }
 }
 
