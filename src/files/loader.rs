@@ -1,6 +1,9 @@
 //! Loads on a worker thread: the render thread asks for a file and polls for the result, so a
 //! slow disk, a large image or a hostile file never holds a frame. Off-screen renders wait for
-//! each load instead, so a frame shows the same file whenever it is rendered.
+//! each load instead, so a frame shows the same file whenever it is rendered. A node's first
+//! load (the file its scene names) is waited for in a live show too — it is a regular file of
+//! bounded size, and the show then starts with its files in place, instead of taking them up a
+//! few frames in and overwriting what a controller set meanwhile.
 
 use std::sync::mpsc::{Receiver, RecvTimeoutError, TryRecvError};
 use std::time::Duration;
@@ -24,6 +27,8 @@ type Job<T> = Box<dyn FnOnce() -> Result<T, String> + Send>;
 /// newest is kept (a flood of paths starts one thread, not thousands).
 pub struct Loader<T> {
     wait: LoadWait,
+    /// Whether a load has finished (later ones follow `wait`).
+    first_done: bool,
     running: Option<(String, Receiver<Result<T, String>>)>,
     queued: Option<(String, Job<T>)>,
 }
@@ -31,7 +36,7 @@ pub struct Loader<T> {
 impl<T: Send + 'static> Loader<T> {
     /// A loader with no load under way.
     pub fn new(wait: LoadWait) -> Self {
-        Self { wait, running: None, queued: None }
+        Self { wait, first_done: false, running: None, queued: None }
     }
 
     /// Asks for `job`'s result, known as `key` (a path, for messages): starts it, or queues it
@@ -51,7 +56,8 @@ impl<T: Send + 'static> Loader<T> {
     /// A finished load with its key, if any (waiting for it under [`LoadWait::Finish`]).
     pub fn poll(&mut self) -> Option<(String, Result<T, String>)> {
         let (key, receiver) = self.running.as_ref()?;
-        let result = match self.wait {
+        let wait = if self.first_done { self.wait } else { LoadWait::Finish };
+        let result = match wait {
             LoadWait::Finish => match receiver.recv_timeout(WAIT_LIMIT) {
                 Ok(result) => result,
                 Err(RecvTimeoutError::Timeout) => Err(format!("{key}: still loading after {WAIT_LIMIT:?}")),
@@ -64,6 +70,7 @@ impl<T: Send + 'static> Loader<T> {
             },
         };
         let (key, _) = self.running.take().expect("checked above");
+        self.first_done = true;
         self.start_queued();
         Some((key, result))
     }
@@ -97,9 +104,26 @@ mod tests {
     }
 
     #[test]
+    fn a_background_loader_waits_for_its_first_load_only() {
+        let mut loader = Loader::new(LoadWait::Background);
+        loader.request("scene's", || {
+            std::thread::sleep(std::time::Duration::from_millis(50));
+            Ok(1)
+        });
+        assert_eq!(loader.poll(), Some(("scene's".to_string(), Ok(1))), "the first is waited for");
+        loader.request("live", || {
+            std::thread::sleep(std::time::Duration::from_millis(200));
+            Ok(2)
+        });
+        assert_eq!(loader.poll(), None, "a later one is not");
+    }
+
+    #[test]
     fn a_background_loader_keeps_only_the_newest_request_behind_the_running_one() {
         let (release, gate) = std::sync::mpsc::channel::<()>();
         let mut loader = Loader::new(LoadWait::Background);
+        loader.request("first", || Ok(-1));
+        assert!(loader.poll().is_some());
         loader.request("slow", move || {
             gate.recv().map_err(|e| e.to_string())?;
             Ok(0)
