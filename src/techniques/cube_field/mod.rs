@@ -33,36 +33,42 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
-/// Parameters; defaults follow the sample's particle system (seed-reference §4), scaled by its
-/// 0.1 transform and ×2 simulation speed into world units.
-pub fn params() -> Vec<ParamDecl> {
-    use ParamValue::*;
-    vec![
-        ParamDecl::new("rate", Float(100.0), Some((0.0, 400.0)), "cubes emitted per second").with_unit("/s"),
-        ParamDecl::new("life", Float(10.0), Some((0.1, 30.0)), "seconds each cube lives").with_unit("s"),
-        ParamDecl::new("speed", Float(1.0), Some((0.0, 10.0)), "drift towards the camera").with_unit("u/s"),
-        ParamDecl::new("spin", Float(100.0), Some((0.0, 720.0)), "rotation about each axis").with_unit("°/s"),
-        ParamDecl::new("cube_size", Float(0.1), Some((0.01, 1.0)), "edge length").with_unit("u"),
-        ParamDecl::new(
-            "emitter_size",
-            Vec2([5.0, 10.0]),
-            Some((0.1, 50.0)),
-            "width and height of the emitting rectangle",
-        ),
-        ParamDecl::new(
-            "emitter_distance",
-            Float(12.0),
-            Some((1.0, 50.0)),
-            "distance of the emitter in front of the camera",
-        ),
-        ParamDecl::new("fov", Float(30.0), Some((5.0, 120.0)), "vertical field of view").with_unit("°"),
-        ParamDecl::new("light_dir", Vec3([-0.4, 0.5, -0.75]), Some((-1.0, 1.0)), "direction towards the light"),
-        ParamDecl::new("light_intensity", Float(0.87), Some((0.0, 10.0)), "light intensity"),
+crate::technique_params! {
+    /// What a cube field reads each frame.
+    pub struct Settings {
+        /// cubes emitted per second
+        rate: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(100.0), Some((0.0, 400.0)), doc).with_unit("/s"),
+        /// seconds each cube lives
+        life: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(10.0), Some((0.1, 30.0)), doc).with_unit("s"),
+        /// drift towards the camera
+        speed: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.0), Some((0.0, 10.0)), doc).with_unit("u/s"),
+        /// rotation about each axis
+        spin: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(100.0), Some((0.0, 720.0)), doc).with_unit("°/s"),
+        /// edge length
+        cube_size: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.1), Some((0.01, 1.0)), doc).with_unit("u"),
+        /// width and height of the emitting rectangle
+        emitter_size: [f32; 2] = |n, doc| ParamDecl::new(n, ParamValue::Vec2([5.0, 10.0]), Some((0.1, 50.0)), doc),
+        /// distance of the emitter in front of the camera
+        emitter_distance: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(12.0), Some((1.0, 50.0)), doc),
+        /// vertical field of view
+        fov: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(30.0), Some((5.0, 120.0)), doc).with_unit("°"),
+        /// direction towards the light
+        light_dir: [f32; 3] = |n, doc| ParamDecl::new(n, ParamValue::Vec3([-0.4, 0.5, -0.75]), Some((-1.0, 1.0)), doc),
+        /// light intensity
+        light_intensity: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.87), Some((0.0, 10.0)), doc),
+        /// specular strength; above ~1.2 glints exceed 1.0
         // Narrow, strong highlights: single glints cross StarGlow's threshold of 1, faces do not.
-        ParamDecl::new("specular", Float(2.0), Some((0.0, 20.0)), "specular strength; above ~1.2 glints exceed 1.0"),
-        ParamDecl::new("shininess", Float(128.0), Some((1.0, 512.0)), "Blinn-Phong exponent"),
-        ParamDecl::new("color", Color([1.0, 1.0, 1.0, 1.0]), None, "cube colour"),
-    ]
+        specular: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(2.0), Some((0.0, 20.0)), doc),
+        /// Blinn-Phong exponent
+        shininess: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(128.0), Some((1.0, 512.0)), doc),
+        /// cube colour
+        color: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([1.0, 1.0, 1.0, 1.0]), None, doc),
+    }
+}
+
+/// Parameters (see [`Settings`]).
+pub fn params() -> Vec<ParamDecl> {
+    Settings::decls()
 }
 
 /// The shader's uniform block.
@@ -89,22 +95,21 @@ pub struct CubeFieldUniforms {
 
 impl CubeFieldUniforms {
     /// Camera at the origin looking down +z, y up, wgpu's [0, 1] depth.
-    pub fn from_params(p: &ParamSet, aspect: f32) -> Self {
+    pub fn from_params(p: &Settings, aspect: f32) -> Self {
         // wgpu's clip space is DirectX's: z in [0, 1], y up.
-        let proj = glam::camera::lh::proj::directx::perspective(p.float("fov").to_radians(), aspect, 0.1, 100.0);
+        let proj = glam::camera::lh::proj::directx::perspective(p.fov.to_radians(), aspect, 0.1, 100.0);
         let view = glam::camera::lh::view::look_to_mat4(glam::Vec3::ZERO, glam::Vec3::Z, glam::Vec3::Y);
-        let l = p.get("light_dir").components();
-        let light = glam::Vec3::new(l[0], l[1], l[2]).normalize_or(glam::Vec3::NEG_Z);
-        let c = p.color("color");
-        let i = p.float("light_intensity");
+        let light = glam::Vec3::from(p.light_dir).normalize_or(glam::Vec3::NEG_Z);
+        let c = p.color;
+        let i = p.light_intensity;
         Self {
             view_proj: (proj * view).to_cols_array_2d(),
             light_dir: [light.x, light.y, light.z, 0.0],
             light_color: [i, i, i, 1.0],
             albedo: [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), 1.0],
             ambient: 0.08,
-            specular: p.float("specular"),
-            shininess: p.float("shininess"),
+            specular: p.specular,
+            shininess: p.shininess,
             _pad: 0.0,
         }
     }
@@ -166,8 +171,9 @@ impl Technique for CubeField {
     ) -> TextureHandle {
         let targets = graph.create_raster_targets("cube_field", FORMAT, Some(DEPTH), self.samples);
         let (w, h) = graph.texture_size(targets.color);
-        let uniforms = CubeFieldUniforms::from_params(params, w as f32 / h as f32);
-        cubes_at(params, time, &mut self.scratch);
+        let settings = Settings::read(params);
+        let uniforms = CubeFieldUniforms::from_params(&settings, w as f32 / h as f32);
+        cubes_at(&settings, time, &mut self.scratch);
         let count = self.scratch.len() as u32;
         let this: &'r CubeField = self;
         graph.add_pass("cube_field/draw").draws_into(&targets).record(move |ctx| {

@@ -4,7 +4,7 @@
 
 use std::f32::consts::TAU;
 
-use crate::params::ParamSet;
+use super::Settings;
 use crate::time::FrameTime;
 
 /// Most cubes drawn (rate × life beyond this keeps the newest).
@@ -21,9 +21,9 @@ pub struct CubeInstance {
 }
 
 /// Fills `out` with the cubes alive at `time`.
-pub fn cubes_at(p: &ParamSet, time: &FrameTime, out: &mut Vec<CubeInstance>) {
+pub fn cubes_at(p: &Settings, time: &FrameTime, out: &mut Vec<CubeInstance>) {
     out.clear();
-    let (rate, life) = (f64::from(p.float("rate")), f64::from(p.float("life")));
+    let (rate, life) = (f64::from(p.rate), f64::from(p.life));
     if rate <= 0.0 {
         return;
     }
@@ -31,9 +31,9 @@ pub fn cubes_at(p: &ParamSet, time: &FrameTime, out: &mut Vec<CubeInstance>) {
     let newest = (now * rate).floor() as i64;
     let oldest = ((now - life) * rate).floor() as i64 + 1;
     let oldest = oldest.max(newest - MAX_CUBES as i64 + 1);
-    let [w, h] = p.vec2("emitter_size");
-    let (distance, speed, size) = (p.float("emitter_distance"), p.float("speed"), p.float("cube_size"));
-    let spin = p.float("spin").to_radians();
+    let [w, h] = p.emitter_size;
+    let (distance, speed, size) = (p.emitter_distance, p.speed, p.cube_size);
+    let spin = p.spin.to_radians();
     for i in oldest..=newest {
         let age = (now - i as f64 / rate) as f32;
         let r = |k: u64| unit_random(time.seed, i, k);
@@ -63,7 +63,7 @@ mod tests {
 
     fn at(seconds: f64, p: &ParamSet) -> Vec<CubeInstance> {
         let mut out = Vec::new();
-        cubes_at(p, &FrameTime { frame: 0, seconds, dt: 0.0, seed: 3 }, &mut out);
+        cubes_at(&super::super::Settings::read(p), &FrameTime { frame: 0, seconds, dt: 0.0, seed: 3 }, &mut out);
         out
     }
 

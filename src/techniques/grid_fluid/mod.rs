@@ -43,25 +43,41 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 /// The output format (density in R, G and B).
 pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
-/// Parameters with the sample's defaults (seed-reference §6).
+crate::technique_params! {
+    /// What a grid fluid reads each step.
+    pub struct Settings {
+        /// grid cells per side (restarts the fluid)
+        resolution: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(256), Some((16.0, 1024.0)), doc),
+        /// where the fluid is stirred: box position, y up
+        cursor: [f32; 2] = |n, doc| {
+            ParamDecl::new(n, ParamValue::Vec2([0.5, 0.5]), Some((0.0, 1.0)), doc).with_role(InputRole::Pointer)
+        },
+        /// stir while true (the left mouse button in the window)
+        drag: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(false), None, doc).with_role(InputRole::Drag),
+        /// velocity diffusion, 1e-5 box²/s
+        viscosity: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(100.0), Some((0.0, 5000.0)), doc),
+        /// density diffusion, 1e-5 box²/s
+        diffusion: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(10.0), Some((0.0, 5000.0)), doc),
+        /// how strongly cursor motion pushes the fluid
+        velocity_coef: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(4.0), Some((0.0, 50.0)), doc),
+        /// density added per second under the cursor
+        density_coef: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(6.0), Some((0.0, 100.0)), doc),
+        /// source radius, box units
+        radius: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.072), Some((0.005, 0.5)), doc),
+        /// Jacobi sweeps of the diffusion solves
+        sweeps: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(2), Some((1.0, 64.0)), doc),
+        /// Jacobi iterations of the pressure solve
+        pressure_iterations: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(40), Some((1.0, 400.0)), doc),
+        /// density lost per second (0: none)
+        dissipation: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.1), Some((0.0, 10.0)), doc),
+        /// clear the fluid (R in the window)
+        reset: bool = |n, doc| ParamDecl::trigger(n, doc).with_role(InputRole::Key('r')),
+    }
+}
+
+/// Parameters (see [`Settings`]).
 pub fn params() -> Vec<ParamDecl> {
-    use ParamValue::*;
-    vec![
-        ParamDecl::new("resolution", Int(256), Some((16.0, 1024.0)), "grid cells per side (restarts the fluid)"),
-        ParamDecl::new("cursor", Vec2([0.5, 0.5]), Some((0.0, 1.0)), "where the fluid is stirred: box position, y up")
-            .with_role(InputRole::Pointer),
-        ParamDecl::new("drag", Bool(false), None, "stir while true (the left mouse button in the window)")
-            .with_role(InputRole::Drag),
-        ParamDecl::new("viscosity", Float(100.0), Some((0.0, 5000.0)), "velocity diffusion, 1e-5 box²/s"),
-        ParamDecl::new("diffusion", Float(10.0), Some((0.0, 5000.0)), "density diffusion, 1e-5 box²/s"),
-        ParamDecl::new("velocity_coef", Float(4.0), Some((0.0, 50.0)), "how strongly cursor motion pushes the fluid"),
-        ParamDecl::new("density_coef", Float(6.0), Some((0.0, 100.0)), "density added per second under the cursor"),
-        ParamDecl::new("radius", Float(0.072), Some((0.005, 0.5)), "source radius, box units"),
-        ParamDecl::new("sweeps", Int(2), Some((1.0, 64.0)), "Jacobi sweeps of the diffusion solves"),
-        ParamDecl::new("pressure_iterations", Int(40), Some((1.0, 400.0)), "Jacobi iterations of the pressure solve"),
-        ParamDecl::new("dissipation", Float(0.1), Some((0.0, 10.0)), "density lost per second (0: none)"),
-        ParamDecl::trigger("reset", "clear the fluid (R in the window)").with_role(InputRole::Key('r')),
-    ]
+    Settings::decls()
 }
 
 /// The kernels (one pipeline per entry point) and their two layouts.
@@ -175,9 +191,9 @@ impl GridFluid {
     }
 
     /// (Re)creates zeroed fields if the resolution changed or a reset was asked for.
-    fn ensure_fields(&mut self, params: &ParamSet) {
-        let n = params.int("resolution").clamp(16, 1024) as u32;
-        if self.resolution() == n && !params.fired("reset") {
+    fn ensure_fields(&mut self, settings: &Settings) {
+        let n = settings.resolution.clamp(16, 1024) as u32;
+        if self.resolution() == n && !settings.reset {
             return;
         }
         let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
@@ -208,17 +224,18 @@ impl Technique for GridFluid {
     }
 
     fn step(&mut self, params: &ParamSet, time: &FrameTime) {
-        self.ensure_fields(params);
+        let settings = Settings::read(params);
+        self.ensure_fields(&settings);
         let n = self.resolution();
-        let cursor = params.vec2("cursor");
-        let dragging = params.bool("drag");
+        let cursor = settings.cursor;
+        let dragging = settings.drag;
         // The cursor's motion since the last step, only while dragging (a press does not jump).
         let motion = match (dragging, self.last_cursor) {
             (true, Some(last)) => [cursor[0] - last[0], cursor[1] - last[1]],
             _ => [0.0, 0.0],
         };
         self.last_cursor = dragging.then_some(cursor);
-        self.pending.extend(step_dispatches(n, params, time.dt, dragging.then_some((cursor, motion))));
+        self.pending.extend(step_dispatches(n, &settings, time.dt, dragging.then_some((cursor, motion))));
     }
 
     fn add_passes<'r>(
@@ -228,7 +245,7 @@ impl Technique for GridFluid {
         _time: &FrameTime,
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
-        self.ensure_fields(params);
+        self.ensure_fields(&Settings::read(params));
         let n = self.resolution();
         let mut dispatches = std::mem::take(&mut self.pending);
         dispatches.push(FluidDispatch::output(n));

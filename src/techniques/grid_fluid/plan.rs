@@ -2,7 +2,7 @@
 //! kernel, which field slots it reads and writes, and its coefficients. Pure CPU, so the order of
 //! the solver is testable without a GPU.
 
-use crate::params::ParamSet;
+use super::Settings;
 
 /// A field slot of N² floats in the fields buffer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -220,21 +220,21 @@ impl Plan {
 
 /// The dispatches of one fixed step of `dt` seconds on an `n`² grid, with the cursor's splat
 /// `(position, motion since the last step)` in box units when it is stirring.
-pub fn step_dispatches(n: u32, params: &ParamSet, dt: f32, source: Option<([f32; 2], [f32; 2])>) -> Vec<Planned> {
+pub fn step_dispatches(n: u32, params: &Settings, dt: f32, source: Option<([f32; 2], [f32; 2])>) -> Vec<Planned> {
     let mut plan = Plan { n, dt, out: Vec::new() };
     let cells = n as f32;
     let per_step = |coefficient: f32| dt * coefficient * 1e-5 * cells * cells;
-    let sweeps = params.int("sweeps").clamp(1, 64) as u32;
-    let pressure = params.int("pressure_iterations").clamp(1, 400) as u32;
+    let sweeps = params.sweeps.clamp(1, 64) as u32;
+    let pressure = params.pressure_iterations.clamp(1, 400) as u32;
 
     // Velocity: add, diffuse, project, self-advect, project.
     if let Some((cursor, motion)) = source {
-        let coef = params.float("velocity_coef");
+        let coef = params.velocity_coef;
         let velocity = motion.map(|m| m / dt.max(1e-6) * coef);
         let speed = (velocity[0] * velocity[0] + velocity[1] * velocity[1]).sqrt();
         let limit = if speed > MAX_IMPULSE { MAX_IMPULSE / speed } else { 1.0 };
-        let density = params.float("density_coef");
-        let radius = params.float("radius") * cells;
+        let density = params.density_coef;
+        let radius = params.radius * cells;
         plan.push(Kernel::AddSource, |d| {
             (d.src, d.dst, d.aux) = (Field::U as u32, Field::V as u32, Field::Density as u32);
             d.centre = cursor.map(|c| c * cells);
@@ -242,7 +242,7 @@ pub fn step_dispatches(n: u32, params: &ParamSet, dt: f32, source: Option<([f32;
             (d.radius, d.density) = (radius, density);
         });
     }
-    let viscosity = per_step(params.float("viscosity"));
+    let viscosity = per_step(params.viscosity);
     plan.diffuse(Field::U, Field::UTmp, viscosity, sweeps);
     plan.diffuse(Field::V, Field::VTmp, viscosity, sweeps);
     plan.walls();
@@ -255,8 +255,8 @@ pub fn step_dispatches(n: u32, params: &ParamSet, dt: f32, source: Option<([f32;
     plan.project(pressure);
 
     // Density: diffuse, advect, dissipate.
-    plan.diffuse(Field::Density, Field::DensityTmp, per_step(params.float("diffusion")), sweeps);
-    let keep = (-params.float("dissipation") * dt).exp();
+    plan.diffuse(Field::Density, Field::DensityTmp, per_step(params.diffusion), sweeps);
+    let keep = (-params.dissipation * dt).exp();
     plan.advect(Field::Density, Field::DensityTmp, keep);
     plan.copy(Field::DensityTmp, Field::Density);
     plan.out

@@ -14,7 +14,7 @@ use crate::assets::Assets;
 use crate::files::{FileError, Loader};
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, PersistentTexture, TextureHandle};
-use crate::params::{ParamDecl, ParamSet, ParamValue, Text};
+use crate::params::{ParamDecl, ParamSet, Text};
 use crate::time::FrameTime;
 
 use super::{NodeSetup, Technique, TechniqueInfo};
@@ -41,14 +41,17 @@ const IMAGE_FILE_LIMIT: u64 = 64 << 20;
 /// The most memory one decoded image may take (RGBA8): 8192 × 8192.
 const DECODED_LIMIT: u64 = 256 << 20;
 
-/// Parameters.
+crate::technique_params! {
+    /// What an image node reads each step.
+    pub struct Settings {
+        /// image file (PNG); relative to the folder holding scenes/, or the current folder
+        path: Text = |n, doc| ParamDecl::text(n, "assets/heightmaps/ridges.png", doc),
+    }
+}
+
+/// Parameters (see [`Settings`]).
 pub fn params() -> Vec<ParamDecl> {
-    vec![ParamDecl::new(
-        "path",
-        ParamValue::Text(Text::new("assets/heightmaps/ridges.png")),
-        None,
-        "image file (PNG); relative to the folder holding scenes/, or the current folder",
-    )]
+    Settings::decls()
 }
 
 /// An image node.
@@ -146,8 +149,7 @@ fn upload(device: &wgpu::Device, queue: &wgpu::Queue, image: &image::RgbaImage) 
 
 impl Technique for HeightImage {
     fn step(&mut self, params: &ParamSet, _time: &FrameTime) {
-        let ParamValue::Text(path) = params.get("path") else { return };
-        let path = path.as_str().trim().to_string();
+        let path = Settings::read(params).path.as_str().trim().to_string();
         if self.requested.as_deref() != Some(path.as_str()) {
             let (assets, name) = (self.assets.clone(), path.clone());
             let max_side = self.device.limits().max_texture_dimension_2d;

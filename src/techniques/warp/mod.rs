@@ -15,7 +15,7 @@ use crate::files::{FileError, Loader};
 use crate::geometry::warp::{Corners, EdgeBlend, Homography, MAX_MESH_SIDE, MeshWarp, Region, WarpFile};
 use crate::gpu::{BindGroupCache, GrowableBuffer, RasterDesc, ShaderError, uniform_buffer, uniform_entry};
 use crate::graph::{FrameGraph, PassContext, RasterTargets, TextureHandle};
-use crate::params::{ParamDecl, ParamSet, ParamValue};
+use crate::params::{ParamDecl, ParamSet, ParamValue, Text};
 use crate::time::FrameTime;
 
 use super::{NodeSetup, Technique, TechniqueInfo};
@@ -52,52 +52,65 @@ const SUBDIVISIONS: u32 = 16;
 /// clockwise from the top left.
 pub const CORNERS: [&str; 4] = ["corner_tl", "corner_tr", "corner_br", "corner_bl"];
 
-/// Parameters.
+crate::technique_params! {
+    /// What a warp node reads each step.
+    pub struct Settings {
+        /// where the image's top-left corner lands (view units, y up)
+        corner_tl: [f32; 2] = |n, doc| corner(n, [0.0, 1.0], doc),
+        /// where the top-right corner lands
+        corner_tr: [f32; 2] = |n, doc| corner(n, [1.0, 1.0], doc),
+        /// where the bottom-right corner lands
+        corner_br: [f32; 2] = |n, doc| corner(n, [1.0, 0.0], doc),
+        /// where the bottom-left corner lands
+        corner_bl: [f32; 2] = |n, doc| corner(n, [0.0, 0.0], doc),
+        /// lower-left of the part of the source shown
+        region_min: [f32; 2] = |n, doc| ParamDecl::new(n, ParamValue::Vec2([0.0, 0.0]), Some((0.0, 1.0)), doc),
+        /// upper-right of the part of the source shown
+        region_max: [f32; 2] = |n, doc| ParamDecl::new(n, ParamValue::Vec2([1.0, 1.0]), Some((0.0, 1.0)), doc),
+        /// soft edge on the left, as a share of the image
+        blend_left: f32 = edge_width,
+        /// soft edge on the right
+        blend_right: f32 = edge_width,
+        /// soft edge at the top
+        blend_top: f32 = edge_width,
+        /// soft edge at the bottom
+        blend_bottom: f32 = edge_width,
+        /// blend ramp exponent: 1 linear, 2 S-curve
+        blend_curve: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(2.0), Some((0.25, 8.0)), doc),
+        /// exponent on the blend weight (1: exact in linear light)
+        blend_gamma: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.0), Some((0.2, 4.0)), doc),
+        /// black raised outside the blend zones to match the overlap
+        black_lift: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.0), Some((0.0, 0.25)), doc),
+        /// draw the mesh and its control points (for lining up)
+        grid: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(false), None, doc),
+        /// mesh control points across and up; a change resamples the mesh's shape
+        mesh_size: [f32; 2] =
+            |n, doc| ParamDecl::new(n, ParamValue::Vec2([2.0, 2.0]), Some((2.0, MAX_MESH_SIDE as f32)), doc),
+        /// move mesh point (index, x, y): x, y in view units (an output window's edit mode writes it)
+        mesh_point: [f32; 3] =
+            |n, doc| ParamDecl::new(n, ParamValue::Vec3([-1.0, 0.0, 0.0]), Some((-1.0, 1024.0)), doc),
+        /// warp file (RON) to load corners, blend and mesh from; empty: none
+        file: Text = |n, doc| ParamDecl::text(n, "", doc),
+        /// read the warp file again
+        reload: bool = |n, doc| ParamDecl::trigger(n, doc),
+        /// write the live corners, blend and mesh to the warp file
+        save: bool = |n, doc| ParamDecl::trigger(n, doc),
+    }
+}
+
+/// A corner's declaration: where it lands, in view units.
+fn corner(name: &str, at: [f32; 2], doc: &str) -> ParamDecl {
+    ParamDecl::new(name, ParamValue::Vec2(at), Some((-1.0, 2.0)), doc)
+}
+
+/// A soft edge's width, as a share of the image.
+fn edge_width(name: &str, doc: &str) -> ParamDecl {
+    ParamDecl::new(name, ParamValue::Float(0.0), Some((0.0, 0.5)), doc)
+}
+
+/// Parameters (see [`Settings`]).
 pub fn params() -> Vec<ParamDecl> {
-    use ParamValue::*;
-    let corner = |name: &str, at: [f32; 2], doc: &str| ParamDecl::new(name, Vec2(at), Some((-1.0, 2.0)), doc);
-    let width = |name: &str, doc: &str| ParamDecl::new(name, Float(0.0), Some((0.0, 0.5)), doc);
-    vec![
-        corner(CORNERS[0], [0.0, 1.0], "where the image's top-left corner lands (view units, y up)"),
-        corner(CORNERS[1], [1.0, 1.0], "where the top-right corner lands"),
-        corner(CORNERS[2], [1.0, 0.0], "where the bottom-right corner lands"),
-        corner(CORNERS[3], [0.0, 0.0], "where the bottom-left corner lands"),
-        ParamDecl::new("region_min", Vec2([0.0, 0.0]), Some((0.0, 1.0)), "lower-left of the part of the source shown"),
-        ParamDecl::new("region_max", Vec2([1.0, 1.0]), Some((0.0, 1.0)), "upper-right of the part of the source shown"),
-        width("blend_left", "soft edge on the left, as a share of the image"),
-        width("blend_right", "soft edge on the right"),
-        width("blend_top", "soft edge at the top"),
-        width("blend_bottom", "soft edge at the bottom"),
-        ParamDecl::new("blend_curve", Float(2.0), Some((0.25, 8.0)), "blend ramp exponent: 1 linear, 2 S-curve"),
-        ParamDecl::new(
-            "blend_gamma",
-            Float(1.0),
-            Some((0.2, 4.0)),
-            "exponent on the blend weight (1: exact in linear light)",
-        ),
-        ParamDecl::new(
-            "black_lift",
-            Float(0.0),
-            Some((0.0, 0.25)),
-            "black raised outside the blend zones to match the overlap",
-        ),
-        ParamDecl::new("grid", Bool(false), None, "draw the mesh and its control points (for lining up)"),
-        ParamDecl::new(
-            "mesh_size",
-            Vec2([2.0, 2.0]),
-            Some((2.0, MAX_MESH_SIDE as f32)),
-            "mesh control points across and up; a change resamples the mesh's shape",
-        ),
-        ParamDecl::new(
-            "mesh_point",
-            Vec3([-1.0, 0.0, 0.0]),
-            Some((-1.0, 1024.0)),
-            "move mesh point (index, x, y): x, y in view units (an output window's edit mode writes it)",
-        ),
-        ParamDecl::text("file", "", "warp file (RON) to load corners, blend and mesh from; empty: none"),
-        ParamDecl::trigger("reload", "read the warp file again"),
-        ParamDecl::trigger("save", "write the live corners, blend and mesh to the warp file"),
-    ]
+    Settings::decls()
 }
 
 /// The shader's uniform block.
@@ -275,12 +288,12 @@ impl Warp {
 
     /// Writes the live values and the mesh to the warp file (atomically), if the file rules
     /// allow saving there.
-    fn save(&mut self, path: &str, params: &ParamSet) {
+    fn save(&mut self, path: &str, settings: &Settings) {
         if path.is_empty() {
             self.messages.push("warp not saved: set the node's file parameter first".into());
             return;
         }
-        let warp = warp_from(params, Some(self.mesh.clone()));
+        let warp = warp_from(settings, Some(self.mesh.clone()));
         let file = match self.assets.locate_for_saving(path, "ron") {
             Ok(file) => file,
             Err(e) => return self.messages.push(format!("warp not saved: {e}")),
@@ -293,8 +306,8 @@ impl Warp {
 
     /// Applies `mesh_size` (resampling the mesh's shape to the new grid) and `mesh_point` (one
     /// control point moved to a view position, through the inverse corner pin) when they change.
-    fn edit_mesh(&mut self, params: &ParamSet) {
-        let size = params.vec2("mesh_size").map(|v| (v.round() as u32).clamp(2, MAX_MESH_SIDE));
+    fn edit_mesh(&mut self, settings: &Settings) {
+        let size = settings.mesh_size.map(|v| (v.round() as u32).clamp(2, MAX_MESH_SIDE));
         let mut changed = false;
         if size != self.applied_size {
             let regular = MeshWarp::regular(size[0], size[1]);
@@ -303,7 +316,7 @@ impl Warp {
             self.applied_size = size;
             changed = true;
         }
-        let ParamValue::Vec3(point) = params.get("mesh_point") else { return };
+        let point = settings.mesh_point;
         if point != self.applied_point {
             self.applied_point = point;
             let index = point[0].round();
@@ -437,33 +450,37 @@ fn loaded_values(warp: &WarpFile) -> Vec<(&'static str, ParamValue)> {
     values
 }
 
-/// The warp the parameters describe, with `mesh`.
-pub fn warp_from(params: &ParamSet, mesh: Option<MeshWarp>) -> WarpFile {
-    let corner = |i: usize| params.vec2(CORNERS[i]);
+/// The warp the settings describe, with `mesh`.
+pub fn warp_from(s: &Settings, mesh: Option<MeshWarp>) -> WarpFile {
     WarpFile {
-        region: Region { min: params.vec2("region_min"), max: params.vec2("region_max") },
-        corners: Corners { top_left: corner(0), top_right: corner(1), bottom_right: corner(2), bottom_left: corner(3) },
-        blend: EdgeBlend {
-            left: params.float("blend_left"),
-            right: params.float("blend_right"),
-            top: params.float("blend_top"),
-            bottom: params.float("blend_bottom"),
-            curve: params.float("blend_curve"),
-            gamma: params.float("blend_gamma"),
+        region: Region { min: s.region_min, max: s.region_max },
+        corners: Corners {
+            top_left: s.corner_tl,
+            top_right: s.corner_tr,
+            bottom_right: s.corner_br,
+            bottom_left: s.corner_bl,
         },
-        black_lift: params.float("black_lift"),
+        blend: EdgeBlend {
+            left: s.blend_left,
+            right: s.blend_right,
+            top: s.blend_top,
+            bottom: s.blend_bottom,
+            curve: s.blend_curve,
+            gamma: s.blend_gamma,
+        },
+        black_lift: s.black_lift,
         mesh: mesh.filter(|m| *m != MeshWarp::regular(2, 2)),
     }
 }
 
-/// The uniforms for `params` with `mesh`.
-pub fn uniforms(params: &ParamSet, mesh: &MeshWarp) -> WarpUniforms {
-    let warp = warp_from(params, None);
+/// The uniforms for `settings` with `mesh`.
+pub fn uniforms(settings: &Settings, mesh: &MeshWarp) -> WarpUniforms {
+    let warp = warp_from(settings, None);
     let b = warp.blend;
     WarpUniforms {
         homography: warp.corners.homography().to_wgsl_columns(),
         blend: [b.left, b.right, b.top, b.bottom],
-        shape: [b.curve, b.gamma, warp.black_lift, if params.bool("grid") { 1.0 } else { 0.0 }],
+        shape: [b.curve, b.gamma, warp.black_lift, if settings.grid { 1.0 } else { 0.0 }],
         grid: [(mesh.columns - 1) as f32, (mesh.rows - 1) as f32, 0.0, 0.0],
         region: [warp.region.min[0], warp.region.min[1], warp.region.max[0], warp.region.max[1]],
     }
@@ -471,16 +488,16 @@ pub fn uniforms(params: &ParamSet, mesh: &MeshWarp) -> WarpUniforms {
 
 impl Technique for Warp {
     fn step(&mut self, params: &ParamSet, _time: &FrameTime) {
+        let settings = Settings::read(params);
         // Edits first: a file loaded in this step replaces the mesh, and its size reaches the
         // parameters only after the step.
-        let warp = warp_from(params, None);
+        let warp = warp_from(&settings, None);
         self.pin = warp.corners.homography();
         self.region = warp.region;
-        self.edit_mesh(params);
-        let ParamValue::Text(path) = params.get("file") else { return };
-        let path = path.as_str().trim().to_string();
+        self.edit_mesh(&settings);
+        let path = settings.file.as_str().trim().to_string();
         let changed = self.requested.as_deref() != Some(path.as_str());
-        if (changed || params.fired("reload")) && !path.is_empty() {
+        if (changed || settings.reload) && !path.is_empty() {
             self.load(&path);
         }
         self.take_loaded();
@@ -491,8 +508,8 @@ impl Technique for Warp {
             self.upload_mesh();
         }
         self.requested = Some(path.clone());
-        if params.fired("save") {
-            self.save(&path, params);
+        if settings.save {
+            self.save(&path, &settings);
         }
     }
 
@@ -531,7 +548,7 @@ impl Technique for Warp {
         self.source_groups.get_mut().begin_frame();
         let targets = graph.create_raster_targets("warp", FORMAT, None, self.samples);
         let Some(&source) = inputs.first() else { return targets.color };
-        let uniforms = uniforms(params, &self.mesh);
+        let uniforms = uniforms(&Settings::read(params), &self.mesh);
         let this = &*self;
         graph.add_pass("warp/draw").read(source).draws_into(&targets).record(move |ctx| {
             this.record(ctx, source, &targets, &uniforms);
@@ -564,7 +581,7 @@ mod tests {
             assert!(params.set_at(params.index(name).unwrap(), value), "{name}");
         }
         params.snap();
-        assert_eq!(warp_from(&params, None), warp);
+        assert_eq!(warp_from(&Settings::read(&params), None), warp);
     }
 
     #[test]
