@@ -97,10 +97,15 @@ macro_rules! param_enum {
             $($(#[$vmeta])* $variant),+
         }
 
+        #[allow(dead_code)]
         impl $name {
             /// The option names, in index order.
-            #[allow(dead_code)]
             $vis const OPTIONS: &'static [&'static str] = &[$($label),+];
+
+            /// This option's index (what the shader or a file takes).
+            $vis fn index(self) -> u32 {
+                self as u32
+            }
         }
 
         impl $crate::params::ParamEnum for $name {
@@ -112,7 +117,7 @@ macro_rules! param_enum {
             }
 
             fn index(self) -> u32 {
-                self as u32
+                $name::index(self)
             }
         }
 

@@ -97,7 +97,7 @@ fn one_gpu_substep_matches_the_cpu_reference() {
         );
         rig.run(10); // springs stretched, particles moving, some against the sphere
         let (prev, cur, normals) = (rig.node.previous_positions(), rig.node.positions(), rig.node.normals());
-        let u = ClothUniforms::from_params(&rig.params, &rig.time(), res);
+        let u = ClothUniforms::from_params(&indra::techniques::cloth::Settings::read(&rig.params), &rig.time(), res);
         let expected = reference::verlet_step(&u, &prev, &cur, &normals);
         rig.run(1);
         let got = rig.node.positions();

@@ -13,7 +13,7 @@ mod render;
 pub mod runner;
 mod state;
 
-pub use params::{ClothUniforms, PIN_MODES, SOLVERS, VIEWS, params, rest_pose, sphere_center, wind_force};
+pub use params::{ClothUniforms, Pin, Settings, Solver, View, params, rest_pose, sphere_center, wind_force};
 use render::{ClothView, Renderer};
 use state::State;
 
@@ -119,15 +119,15 @@ impl Cloth {
     }
 
     /// (Re)creates the buffers if the resolution or pinning changed, or a reset was asked for.
-    fn ensure_state(&mut self, p: &ParamSet) {
-        let res = p.int("resolution").clamp(4, 1024) as u32;
-        let pin = p.choice("pin");
+    fn ensure_state(&mut self, p: &Settings) {
+        let res = p.resolution.clamp(4, 1024) as u32;
+        let pin = p.pin.index();
         let fresh = self.state.as_ref().is_none_or(|s| s.res != res || s.pin != pin);
         if fresh {
             self.state = Some(State::new(&self.device, &self.renderer, res, pin));
         }
-        if fresh || p.fired("reset") {
-            let pose = rest_pose(res, p.float("rest_length"), p.float("mass"), pin);
+        if fresh || p.reset {
+            let pose = rest_pose(res, p.rest_length, p.mass, pin);
             self.state.as_mut().expect("just made").reset(&self.queue, &pose);
         }
     }
@@ -135,18 +135,19 @@ impl Cloth {
 
 impl Technique for Cloth {
     fn step(&mut self, params: &ParamSet, time: &FrameTime) {
-        self.ensure_state(params);
+        let settings = Settings::read(params);
+        self.ensure_state(&settings);
         let state = self.state.as_mut().expect("ensured");
         if state.nan.poll(&state.status_readback) {
             self.messages.push("cloth: the simulation blew up (a position became NaN or infinite); reset to the rest pose — lower the time step or stiffness, or add substeps".into());
-            let pose = rest_pose(state.res, params.float("rest_length"), params.float("mass"), state.pin);
+            let pose = rest_pose(state.res, settings.rest_length, settings.mass, state.pin);
             state.reset(&self.queue, &pose);
             self.pending.clear();
         }
         if self.pending.len() == self.uniforms.len() {
             self.pending.remove(0);
         }
-        self.pending.push(ClothUniforms::from_params(params, time, state.res));
+        self.pending.push(ClothUniforms::from_params(&settings, time, state.res));
     }
 
     fn simulates_on_gpu(&self) -> bool {
@@ -164,9 +165,10 @@ impl Technique for Cloth {
         time: &FrameTime,
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
-        self.ensure_state(params);
+        let settings = Settings::read(params);
+        self.ensure_state(&settings);
         // CPU work first: buffer rotation, bind groups and uniforms for every substep.
-        let substeps = params.int("substeps").clamp(1, 64) as u32;
+        let substeps = settings.substeps.clamp(1, 64) as u32;
         let steps = std::mem::take(&mut self.pending);
         for (slot, u) in steps.iter().enumerate() {
             self.queue.write_buffer(&self.uniforms[slot], 0, bytemuck::bytes_of(u));
@@ -174,8 +176,9 @@ impl Technique for Cloth {
         let state = self.state.as_mut().expect("ensured");
         let dispatches = state.plan(&self.device, &self.kernels.layout, &self.uniforms, &steps, substeps);
         let (w, h) = graph.output_size();
-        let view = ClothView::from_params(params, time, w as f32 / h as f32);
-        self.renderer.prepare(&self.device, &self.queue, state, &view, params.choice("view") == 1);
+        let view = ClothView::from_params(&settings, time, w as f32 / h as f32);
+        let debug = settings.view == View::Debug;
+        self.renderer.prepare(&self.device, &self.queue, state, &view, debug);
         let this: &'r Cloth = self;
         let state = this.state.as_ref().expect("ensured");
 
@@ -213,11 +216,7 @@ impl Technique for Cloth {
             state.nan.after_check(ctx.encoder, &state.status, &state.status_readback);
         });
         let targets = graph.create_raster_targets("cloth", FORMAT, Some(render::DEPTH), this.renderer.samples);
-        let mode = render::DrawMode {
-            clear: view.background,
-            debug: params.choice("view") == 1,
-            sphere: view.uniforms.sphere[3] > 0.0,
-        };
+        let mode = render::DrawMode { clear: view.background, debug, sphere: view.uniforms.sphere[3] > 0.0 };
         graph
             .add_pass("cloth/draw")
             .read_buffer(cur)

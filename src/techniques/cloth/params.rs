@@ -1,91 +1,109 @@
 //! Cloth parameters and the uniform block built from them.
 
-use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
+use crate::params::{InputRole, ParamDecl, ParamValue};
 use crate::time::FrameTime;
 
-/// Solvers, in the order of the `solver` enum parameter.
-pub const SOLVERS: [&str; 2] = ["Verlet", "XPBD"];
-/// Pin modes, in the order of the `pin` enum parameter.
-pub const PIN_MODES: [&str; 3] = ["TopRow", "TwoCorners", "None"];
-/// Views, in the order of the `view` enum parameter.
-pub const VIEWS: [&str; 2] = ["Lit", "Debug"];
+crate::param_enum! {
+    /// The cloth solver.
+    pub enum Solver {
+        /// The book's mass-spring model.
+        Verlet = "Verlet",
+        /// Stiff small-step constraints.
+        Xpbd = "XPBD",
+    }
+}
 
-/// Parameters with the sample's C# defaults (seed-reference §3). The sample's `TimeStep` is the
-/// scene's fixed `dt`: each clock step simulates exactly dt seconds in `substeps` parts.
+crate::param_enum! {
+    /// Which particles are fixed.
+    pub enum Pin {
+        /// The whole top row.
+        TopRow = "TopRow",
+        /// The top row's two corners.
+        TwoCorners = "TwoCorners",
+        /// None: the cloth falls.
+        None = "None",
+    }
+}
+
+crate::param_enum! {
+    /// What is drawn.
+    pub enum View {
+        /// The lit surface.
+        Lit = "Lit",
+        /// Particles and springs coloured by kind.
+        Debug = "Debug",
+    }
+}
+
+crate::technique_params! {
+    /// What a cloth node reads each step, with the sample's C# defaults (seed-reference §3). The
+    /// sample's `TimeStep` is the scene's fixed `dt`: each clock step simulates exactly dt
+    /// seconds in `substeps` parts.
+    pub struct Settings {
+        /// Verlet: the book's mass-spring model; XPBD: stiff small-step constraints
+        solver: Solver = |n, doc| ParamDecl::choice(n, Solver::OPTIONS, 0, doc),
+        /// particles per side (changing it resets)
+        resolution: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(128), Some((4.0, 1024.0)), doc),
+        /// solver steps per clock step (the sample's VerletIterationNum)
+        substeps: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(4), Some((1.0, 64.0)), doc),
+        /// structural spring length
+        rest_length: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.02), Some((0.001, 1.0)), doc).with_unit("m"),
+        /// Verlet spring constant
+        stiffness: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(10000.0), Some((1.0, 1e7)), doc).with_unit("N/m"),
+        /// velocity damping coefficient, applied once per particle (the sample applied it per neighbour)
+        damping: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.996), Some((0.0, 100.0)), doc).with_unit("kg/s"),
+        /// XPBD inverse stiffness; 0 = inextensible
+        compliance: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.0), Some((0.0, 1.0)), doc).with_unit("m/N"),
+        /// XPBD bending stiffness of the fabric: how hard it resists folding, whatever the resolution
+        bending: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.0), Some((0.0, 0.01)), doc).with_unit("N·m"),
+        /// XPBD long-range attachments: nothing hangs farther from its pins than at rest
+        attachments: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(true), None, doc),
+        /// mass per particle
+        mass: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.0), Some((0.001, 100.0)), doc).with_unit("kg"),
+        /// gravity
+        gravity: [f32; 3] =
+            |n, doc| ParamDecl::new(n, ParamValue::Vec3([0.0, -9.81, 0.0]), Some((-100.0, 100.0)), doc).with_unit("m/s²"),
+        /// which particles are fixed
+        pin: Pin = |n, doc| ParamDecl::choice(n, Pin::OPTIONS, 0, doc),
+        /// collide with the sphere
+        sphere: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(true), None, doc),
+        /// sphere centre at rest
+        sphere_center: [f32; 3] = |n, doc| ParamDecl::new(n, ParamValue::Vec3([0.0, 0.0, 0.0]), Some((-50.0, 50.0)), doc),
+        /// sphere radius
+        sphere_radius: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.01), Some((0.01, 20.0)), doc).with_unit("m"),
+        /// amplitude of the sphere's z oscillation
+        sphere_travel: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(4.0), Some((0.0, 50.0)), doc).with_unit("m"),
+        /// angular speed of the oscillation (the sample's 0.125 ≈ 50 s period)
+        sphere_speed: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.125), Some((0.0, 10.0)), doc).with_unit("rad/s"),
+        /// wind direction
+        wind: [f32; 3] = |n, doc| ParamDecl::new(n, ParamValue::Vec3([0.0, 0.0, 1.0]), Some((-1.0, 1.0)), doc),
+        /// wind force per particle
+        wind_strength: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.0), Some((0.0, 100.0)), doc).with_unit("N"),
+        /// how much the wind varies (smooth noise)
+        wind_gust: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.5), Some((0.0, 1.0)), doc),
+        /// lit surface, or particles and springs
+        view: View = |n, doc| ParamDecl::choice(n, View::OPTIONS, 0, doc),
+        /// cloth colour
+        color: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([0.0, 0.273, 1.0, 1.0]), None, doc),
+        /// sphere colour
+        sphere_color: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([1.0, 0.1, 0.1, 1.0]), None, doc),
+        /// background colour (Unity's default sky blue)
+        background: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([0.19, 0.3, 0.47, 1.0]), None, doc),
+        /// direction towards the light
+        light_dir: [f32; 3] = |n, doc| ParamDecl::new(n, ParamValue::Vec3([-0.3, 0.6, -0.75]), Some((-1.0, 1.0)), doc),
+        /// camera distance in front of the cloth
+        camera_distance: f32 =
+            |n, doc| ParamDecl::new(n, ParamValue::Float(10.0), Some((0.5, 100.0)), doc).with_unit("m"),
+        /// vertical field of view
+        fov: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(60.0), Some((5.0, 120.0)), doc).with_unit("°"),
+        /// put the cloth back to its rest pose (R in the window)
+        reset: bool = |n, doc| ParamDecl::trigger(n, doc).with_role(InputRole::Key('r')),
+    }
+}
+
+/// Parameters (see [`Settings`]).
 pub fn params() -> Vec<ParamDecl> {
-    use ParamValue::*;
-    vec![
-        ParamDecl::choice(
-            "solver",
-            &SOLVERS,
-            0,
-            "Verlet: the book's mass-spring model; XPBD: stiff small-step constraints",
-        ),
-        ParamDecl::new("resolution", Int(128), Some((4.0, 1024.0)), "particles per side (changing it resets)"),
-        ParamDecl::new(
-            "substeps",
-            Int(4),
-            Some((1.0, 64.0)),
-            "solver steps per clock step (the sample's VerletIterationNum)",
-        ),
-        ParamDecl::new("rest_length", Float(0.02), Some((0.001, 1.0)), "structural spring length").with_unit("m"),
-        ParamDecl::new("stiffness", Float(10000.0), Some((1.0, 1e7)), "Verlet spring constant").with_unit("N/m"),
-        ParamDecl::new(
-            "damping",
-            Float(0.996),
-            Some((0.0, 100.0)),
-            "velocity damping coefficient, applied once per particle (the sample applied it per neighbour)",
-        )
-        .with_unit("kg/s"),
-        ParamDecl::new("compliance", Float(0.0), Some((0.0, 1.0)), "XPBD inverse stiffness; 0 = inextensible")
-            .with_unit("m/N"),
-        ParamDecl::new(
-            "bending",
-            Float(0.0),
-            Some((0.0, 0.01)),
-            "XPBD bending stiffness of the fabric: how hard it resists folding, whatever the resolution",
-        )
-        .with_unit("N·m"),
-        ParamDecl::new(
-            "attachments",
-            Bool(true),
-            None,
-            "XPBD long-range attachments: nothing hangs farther from its pins than at rest",
-        ),
-        ParamDecl::new("mass", Float(1.0), Some((0.001, 100.0)), "mass per particle").with_unit("kg"),
-        ParamDecl::new("gravity", Vec3([0.0, -9.81, 0.0]), Some((-100.0, 100.0)), "gravity").with_unit("m/s²"),
-        ParamDecl::choice("pin", &PIN_MODES, 0, "which particles are fixed"),
-        ParamDecl::new("sphere", Bool(true), None, "collide with the sphere"),
-        ParamDecl::new("sphere_center", Vec3([0.0, 0.0, 0.0]), Some((-50.0, 50.0)), "sphere centre at rest"),
-        ParamDecl::new("sphere_radius", Float(1.01), Some((0.01, 20.0)), "sphere radius").with_unit("m"),
-        ParamDecl::new("sphere_travel", Float(4.0), Some((0.0, 50.0)), "amplitude of the sphere's z oscillation")
-            .with_unit("m"),
-        ParamDecl::new(
-            "sphere_speed",
-            Float(0.125),
-            Some((0.0, 10.0)),
-            "angular speed of the oscillation (the sample's 0.125 ≈ 50 s period)",
-        )
-        .with_unit("rad/s"),
-        ParamDecl::new("wind", Vec3([0.0, 0.0, 1.0]), Some((-1.0, 1.0)), "wind direction"),
-        ParamDecl::new("wind_strength", Float(0.0), Some((0.0, 100.0)), "wind force per particle").with_unit("N"),
-        ParamDecl::new("wind_gust", Float(0.5), Some((0.0, 1.0)), "how much the wind varies (smooth noise)"),
-        ParamDecl::choice("view", &VIEWS, 0, "lit surface, or particles and springs"),
-        ParamDecl::new("color", Color([0.0, 0.273, 1.0, 1.0]), None, "cloth colour"),
-        ParamDecl::new("sphere_color", Color([1.0, 0.1, 0.1, 1.0]), None, "sphere colour"),
-        ParamDecl::new(
-            "background",
-            Color([0.19, 0.3, 0.47, 1.0]),
-            None,
-            "background colour (Unity's default sky blue)",
-        ),
-        ParamDecl::new("light_dir", Vec3([-0.3, 0.6, -0.75]), Some((-1.0, 1.0)), "direction towards the light"),
-        ParamDecl::new("camera_distance", Float(10.0), Some((0.5, 100.0)), "camera distance in front of the cloth")
-            .with_unit("m"),
-        ParamDecl::new("fov", Float(60.0), Some((5.0, 120.0)), "vertical field of view").with_unit("°"),
-        ParamDecl::trigger("reset", "put the cloth back to its rest pose (R in the window)")
-            .with_role(InputRole::Key('r')),
-    ]
+    Settings::decls()
 }
 
 /// The simulation shader's uniform block.
@@ -127,29 +145,28 @@ pub struct ClothUniforms {
 
 impl ClothUniforms {
     /// The uniforms of the substeps that advance from `time` by one clock step.
-    pub fn from_params(p: &ParamSet, time: &FrameTime, res: u32) -> Self {
-        let substeps = p.int("substeps").clamp(1, 64) as f32;
-        let mass = p.float("mass");
+    pub fn from_params(p: &Settings, time: &FrameTime, res: u32) -> Self {
+        let substeps = p.substeps.clamp(1, 64) as f32;
+        let mass = p.mass;
         let dt = time.dt / substeps;
-        let g = p.get("gravity").components();
+        let g = p.gravity;
         let wind = wind_force(p, time.seconds);
         Self {
             res,
             count: res * res,
-            solver: p.choice("solver"),
-            bending: bending_share(p.float("bending"), mass, p.float("rest_length"), dt),
+            solver: p.solver.index(),
+            bending: bending_share(p.bending, mass, p.rest_length, dt),
             dt,
-            rest: p.float("rest_length"),
-            stiffness: p.float("stiffness"),
-            damping: p.float("damping"),
+            rest: p.rest_length,
+            stiffness: p.stiffness,
+            damping: p.damping,
             mass,
-            compliance: p.float("compliance"),
-            sphere_radius: if p.bool("sphere") { p.float("sphere_radius") } else { 0.0 },
-            // Attachments follow the pins: the top row (pin 0) or the two corners (pin 1).
-            attachments: if p.choice("solver") == 1 && p.bool("attachments") && p.choice("pin") < 2 {
-                p.choice("pin") + 1
-            } else {
-                0
+            compliance: p.compliance,
+            sphere_radius: if p.sphere { p.sphere_radius } else { 0.0 },
+            // Attachments follow the pins: the top row (1) or the two corners (2).
+            attachments: match (p.solver, p.attachments, p.pin) {
+                (Solver::Xpbd, true, Pin::TopRow | Pin::TwoCorners) => p.pin.index() + 1,
+                _ => 0,
             },
             acceleration: [g[0], g[1], g[2], 0.0],
             sphere: {
@@ -180,20 +197,20 @@ pub fn bending_share(stiffness: f32, mass: f32, rest: f32, dt: f32) -> f32 {
 }
 
 /// The sphere's centre at clock time `seconds`: it oscillates along z as in the sample.
-pub fn sphere_center(p: &ParamSet, seconds: f64) -> [f32; 3] {
-    let c = p.get("sphere_center").components();
-    let z = c[2] + (f64::from(p.float("sphere_speed")) * seconds).cos() as f32 * p.float("sphere_travel");
+pub fn sphere_center(p: &Settings, seconds: f64) -> [f32; 3] {
+    let c = p.sphere_center;
+    let z = c[2] + (f64::from(p.sphere_speed) * seconds).cos() as f32 * p.sphere_travel;
     [c[0], c[1], z]
 }
 
 /// Wind force at clock time `seconds`: direction × strength × (1 + gust × smooth noise), the
 /// noise a sum of incommensurate sines (deterministic, no state).
-pub fn wind_force(p: &ParamSet, seconds: f64) -> [f32; 3] {
-    let d = p.get("wind").components();
+pub fn wind_force(p: &Settings, seconds: f64) -> [f32; 3] {
+    let d = p.wind;
     let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(1e-6);
     let t = seconds;
     let noise = ((t * 1.3).sin() * 0.5 + (t * 2.9 + 1.0).sin() * 0.3 + (t * 7.1 + 2.0).sin() * 0.2) as f32;
-    let s = p.float("wind_strength") * (1.0 + p.float("wind_gust") * noise);
+    let s = p.wind_strength * (1.0 + p.wind_gust * noise);
     [d[0] / len * s, d[1] / len * s, d[2] / len * s]
 }
 

@@ -1,9 +1,9 @@
 //! Drawing the cloth: the lit two-sided surface and the sphere, or the debug view.
 
+use super::Settings;
 use super::state::State;
 use crate::gpu::ShaderError;
 use crate::graph::{PassContext, RasterTargets};
-use crate::params::ParamSet;
 use crate::techniques::{NodeSetup, linear_rgba};
 use crate::time::FrameTime;
 
@@ -39,24 +39,23 @@ pub struct ClothView {
 
 impl ClothView {
     /// Camera at (0, 0, −distance) looking down +z, y up (the sample's camera at (0, 0, −10)).
-    pub fn from_params(p: &ParamSet, time: &FrameTime, aspect: f32) -> Self {
-        let eye = glam::Vec3::new(0.0, 0.0, -p.float("camera_distance"));
-        let proj = glam::camera::lh::proj::directx::perspective(p.float("fov").to_radians(), aspect, 0.05, 500.0);
+    pub fn from_params(p: &Settings, time: &FrameTime, aspect: f32) -> Self {
+        let eye = glam::Vec3::new(0.0, 0.0, -p.camera_distance);
+        let proj = glam::camera::lh::proj::directx::perspective(p.fov.to_radians(), aspect, 0.05, 500.0);
         let view = glam::camera::lh::view::look_to_mat4(eye, glam::Vec3::Z, glam::Vec3::Y);
-        let l = p.get("light_dir").components();
-        let light = glam::Vec3::new(l[0], l[1], l[2]).normalize_or(glam::Vec3::NEG_Z);
+        let light = glam::Vec3::from(p.light_dir).normalize_or(glam::Vec3::NEG_Z);
         let c = super::sphere_center(p, time.seconds);
-        let radius = if p.bool("sphere") { p.float("sphere_radius") } else { 0.0 };
-        let b = linear_rgba(p.color("background"));
-        let half_width = (p.int("resolution").max(2) - 1) as f32 * p.float("rest_length") / 2.0;
-        let mut sphere_color = linear_rgba(p.color("sphere_color"));
+        let radius = if p.sphere { p.sphere_radius } else { 0.0 };
+        let b = linear_rgba(p.background);
+        let half_width = (p.resolution.max(2) - 1) as f32 * p.rest_length / 2.0;
+        let mut sphere_color = linear_rgba(p.sphere_color);
         sphere_color[3] = aspect;
         Self {
             uniforms: ClothViewUniforms {
                 view_proj: (proj * view).to_cols_array_2d(),
                 camera: [eye.x, eye.y, eye.z, half_width],
                 light_dir: [light.x, light.y, light.z, 0.0],
-                color: linear_rgba(p.color("color")),
+                color: linear_rgba(p.color),
                 sphere_color,
                 sphere: [c[0], c[1], c[2], radius],
             },

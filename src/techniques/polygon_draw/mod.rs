@@ -14,7 +14,7 @@ pub(crate) mod gpu;
 use crate::geometry::triangulate::{Mesh2D, Triangulator};
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, TextureHandle};
-use crate::params::{InputRole, ParamDecl, ParamEnum, ParamSet, ParamValue};
+use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 use gpu::DrawStyle;
 

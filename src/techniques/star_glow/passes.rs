@@ -4,7 +4,6 @@
 
 use super::{Binding, FORMAT, Kernel, Layout, Settings, StarGlow, StarGlowUniforms, streak_step};
 use crate::graph::{Extent, FrameGraph, PassContext, TextureDesc, TextureHandle};
-use crate::params::ParamEnum;
 use crate::techniques::srgb_to_linear;
 
 /// One frame's worth of StarGlow work, decided from the parameters.
