@@ -22,7 +22,7 @@ mod params;
 pub mod reference;
 
 pub use params::{
-    CHANNELS, MSAA_MODES, PLANE_SIZE, RASTERIZERS, TessUniforms, VIEWS, camera, edge_count, frustum_planes, model,
+    Channel, Msaa, PLANE_SIZE, Rasterizer, Settings, TessUniforms, View, camera, edge_count, frustum_planes, model,
     params,
 };
 
@@ -386,8 +386,9 @@ impl Technique for Tessellation {
         self.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&u));
         self.last = Some(u);
         self.draw_groups.get_mut().begin_frame();
-        let samples = if params.choice("msaa") == 1 { self.samples } else { 1 };
-        self.drew_in_compute = params.choice("rasterizer") == 0
+        let settings = Settings::read(params);
+        let samples = if settings.msaa == Msaa::On { self.samples } else { 1 };
+        self.drew_in_compute = settings.rasterizer == Rasterizer::Compute
             && self.compute_raster.as_mut().is_some_and(|r| r.get_mut().prepare(&self.queue, size, samples, u.grid));
 
         let this: &'r Tessellation = self;

@@ -9,51 +9,99 @@ use crate::techniques::srgb_to_linear;
 /// The base plane's side, world units (Unity's Plane).
 pub const PLANE_SIZE: f32 = 10.0;
 
-/// View modes.
-pub const VIEWS: &[&str] = &["shaded", "wireframe", "level"];
-/// Multisampling choices (index 1 = 4×).
-pub const MSAA_MODES: &[&str] = &["off", "on"];
-/// How the surface is drawn (index 0: in compute, where the adapter allows).
-pub const RASTERIZERS: &[&str] = &["compute", "pipeline"];
-/// Which channel of the input is the height.
-pub const CHANNELS: &[&str] = &["red", "luminance"];
+crate::param_enum! {
+    /// What the surface shows.
+    pub enum View {
+        /// The lit surface.
+        Shaded = "shaded",
+        /// The wireframe over the shading.
+        Wireframe = "wireframe",
+        /// The tessellation level as colour.
+        Level = "level",
+    }
+}
 
-/// Parameters with the book's scene and material values (seed-reference §6).
+crate::param_enum! {
+    /// Multisampling of the surface.
+    pub enum Msaa {
+        /// One sample.
+        Off = "off",
+        /// The scene's samples.
+        On = "on",
+    }
+}
+
+crate::param_enum! {
+    /// How the surface is drawn.
+    pub enum Rasterizer {
+        /// A visibility buffer filled in compute, where the adapter allows.
+        Compute = "compute",
+        /// The hardware rasterizer.
+        Pipeline = "pipeline",
+    }
+}
+
+crate::param_enum! {
+    /// Which channel of the input is the height.
+    pub enum Channel {
+        /// Red.
+        Red = "red",
+        /// Luminance.
+        Luminance = "luminance",
+    }
+}
+
+crate::technique_params! {
+    /// What a tessellated surface reads each frame, with the book's scene and material values
+    /// (seed-reference §6).
+    pub struct Settings {
+        /// base plane quads per side (10: the book's 200 triangles)
+        grid: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(10), Some((1.0, 64.0)), doc),
+        /// target edge length on screen
+        edge_length: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(15.0), Some((1.0, 50.0)), doc).with_unit("px"),
+        /// height × this along the normal, world units
+        displacement: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.3), Some((0.0, 40.0)), doc),
+        /// displace against the normal (the sample's V/F shader)
+        inward: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(false), None, doc),
+        /// which channel of the input texture is the height
+        height_channel: Channel = |n, doc| ParamDecl::choice(n, Channel::OPTIONS, 0, doc),
+        /// shaded, wireframe over shading, or tessellation level as colour
+        view: View = |n, doc| ParamDecl::choice(n, View::OPTIONS, 0, doc),
+        /// multisampling: on uses the scene's msaa (4 samples by default); off is faster where fill is slow
+        msaa: Msaa = |n, doc| ParamDecl::choice(n, Msaa::OPTIONS, 1, doc),
+        /// compute: a visibility buffer filled in compute (fast where the raster path is narrow, as on
+        /// the H100/H200; needs 64-bit atomics, else pipeline); pipeline: the hardware rasterizer
+        rasterizer: Rasterizer = |n, doc| ParamDecl::choice(n, Rasterizer::OPTIONS, 0, doc),
+        /// camera distance from the origin
+        camera_distance: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(10.0), Some((1.0, 100.0)), doc),
+        /// camera orbit about y
+        camera_yaw: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.0), Some((-180.0, 180.0)), doc).with_unit("°"),
+        /// camera orbit elevation
+        camera_pitch: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.0), Some((-89.0, 89.0)), doc).with_unit("°"),
+        /// vertical field of view
+        fov: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(60.0), Some((10.0, 120.0)), doc).with_unit("°"),
+        /// diffuse colour (the book's is black)
+        albedo: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([0.0, 0.0, 0.0, 1.0]), None, doc),
+        /// specular colour
+        spec_color: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([1.0, 1.0, 1.0, 0.5]), None, doc),
+        /// specular exponent / 128
+        specular: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.366), Some((0.01, 1.0)), doc),
+        /// specular strength
+        gloss: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.276), Some((0.0, 1.0)), doc),
+        /// directional light intensity
+        light_intensity: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(3.2), Some((0.0, 10.0)), doc),
+        /// light elevation
+        light_pitch: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(80.0), Some((-90.0, 90.0)), doc).with_unit("°"),
+        /// light heading
+        light_yaw: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(-30.0), Some((-180.0, 180.0)), doc).with_unit("°"),
+        /// clear colour (the book's is white)
+        background: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([1.0, 1.0, 1.0, 1.0]), None, doc),
+    }
+}
+
+/// Parameters (see [`Settings`]).
 pub fn params() -> Vec<ParamDecl> {
-    use ParamValue::*;
-    vec![
-        ParamDecl::new("grid", Int(10), Some((1.0, 64.0)), "base plane quads per side (10: the book's 200 triangles)"),
-        ParamDecl::new("edge_length", Float(15.0), Some((1.0, 50.0)), "target edge length on screen").with_unit("px"),
-        ParamDecl::new("displacement", Float(0.3), Some((0.0, 40.0)), "height × this along the normal, world units"),
-        ParamDecl::new("inward", Bool(false), None, "displace against the normal (the sample's V/F shader)"),
-        ParamDecl::choice("height_channel", CHANNELS, 0, "which channel of the input texture is the height"),
-        ParamDecl::choice("view", VIEWS, 0, "shaded, wireframe over shading, or tessellation level as colour"),
-        ParamDecl::choice(
-            "msaa",
-            MSAA_MODES,
-            1,
-            "multisampling: on uses the scene's msaa (4 samples by default); off is faster where fill is slow",
-        ),
-        ParamDecl::choice(
-            "rasterizer",
-            RASTERIZERS,
-            0,
-            "compute: a visibility buffer filled in compute (fast where the raster path is narrow, as on \
-             the H100/H200; needs 64-bit atomics, else pipeline); pipeline: the hardware rasterizer",
-        ),
-        ParamDecl::new("camera_distance", Float(10.0), Some((1.0, 100.0)), "camera distance from the origin"),
-        ParamDecl::new("camera_yaw", Float(0.0), Some((-180.0, 180.0)), "camera orbit about y").with_unit("°"),
-        ParamDecl::new("camera_pitch", Float(0.0), Some((-89.0, 89.0)), "camera orbit elevation").with_unit("°"),
-        ParamDecl::new("fov", Float(60.0), Some((10.0, 120.0)), "vertical field of view").with_unit("°"),
-        ParamDecl::new("albedo", Color([0.0, 0.0, 0.0, 1.0]), None, "diffuse colour (the book's is black)"),
-        ParamDecl::new("spec_color", Color([1.0, 1.0, 1.0, 0.5]), None, "specular colour"),
-        ParamDecl::new("specular", Float(0.366), Some((0.01, 1.0)), "specular exponent / 128"),
-        ParamDecl::new("gloss", Float(0.276), Some((0.0, 1.0)), "specular strength"),
-        ParamDecl::new("light_intensity", Float(3.2), Some((0.0, 10.0)), "directional light intensity"),
-        ParamDecl::new("light_pitch", Float(80.0), Some((-90.0, 90.0)), "light elevation").with_unit("°"),
-        ParamDecl::new("light_yaw", Float(-30.0), Some((-180.0, 180.0)), "light heading").with_unit("°"),
-        ParamDecl::new("background", Color([1.0, 1.0, 1.0, 1.0]), None, "clear colour (the book's is white)"),
-    ]
+    Settings::decls()
 }
 
 /// `Tess` in `shaders/tessellation.wgsl`.
@@ -82,7 +130,7 @@ pub struct TessUniforms {
     pub patch_count: u32,
     /// Edges of the grid.
     pub edge_count: u32,
-    /// Index into [`VIEWS`].
+    /// A [`View`]'s index.
     pub view_mode: u32,
     /// Target edge length, pixels.
     pub edge_px: f32,
@@ -115,14 +163,12 @@ pub fn model() -> Mat4 {
         * Mat4::from_rotation_x((-48.0f32).to_radians())
 }
 
-/// Camera position and view-projection for `params` at `aspect`.
-pub fn camera(params: &ParamSet, aspect: f32) -> (Vec3, Mat4) {
-    let (yaw, pitch) = (params.float("camera_yaw").to_radians(), params.float("camera_pitch").to_radians());
-    let eye =
-        params.float("camera_distance") * Vec3::new(yaw.sin() * pitch.cos(), pitch.sin(), yaw.cos() * pitch.cos());
+/// Camera position and view-projection for `s` at `aspect`.
+pub fn camera(s: &Settings, aspect: f32) -> (Vec3, Mat4) {
+    let (yaw, pitch) = (s.camera_yaw.to_radians(), s.camera_pitch.to_radians());
+    let eye = s.camera_distance * Vec3::new(yaw.sin() * pitch.cos(), pitch.sin(), yaw.cos() * pitch.cos());
     let view = glam::camera::rh::view::look_at_mat4(eye, Vec3::ZERO, Vec3::Y);
-    let proj =
-        glam::camera::rh::proj::directx::perspective(params.float("fov").to_radians(), aspect.max(1e-3), 0.1, 200.0);
+    let proj = glam::camera::rh::proj::directx::perspective(s.fov.to_radians(), aspect.max(1e-3), 0.1, 200.0);
     (eye, proj * view)
 }
 
@@ -136,36 +182,34 @@ pub fn frustum_planes(view_proj: Mat4) -> [Vec4; 4] {
 impl TessUniforms {
     /// The block for `params` on an output of `size` pixels.
     pub fn from_params(params: &ParamSet, size: (u32, u32)) -> Self {
-        let grid = params.int("grid").clamp(1, 64) as u32;
-        let (eye, view_proj) = camera(params, size.0 as f32 / size.1.max(1) as f32);
-        let (pitch, yaw) = (params.float("light_pitch").to_radians(), params.float("light_yaw").to_radians());
+        let s = Settings::read(params);
+        let grid = s.grid.clamp(1, 64) as u32;
+        let (eye, view_proj) = camera(&s, size.0 as f32 / size.1.max(1) as f32);
+        let (pitch, yaw) = (s.light_pitch.to_radians(), s.light_yaw.to_radians());
         // Unity's light forward after (pitch, yaw), with z mirrored into the right-handed world.
         let light = Vec3::new(pitch.cos() * yaw.sin(), -pitch.sin(), -pitch.cos() * yaw.cos());
-        let linear = |name: &str| {
-            let c = params.color(name);
-            [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3]]
-        };
-        let sign = if params.bool("inward") { -1.0 } else { 1.0 };
+        let linear = |c: [f32; 4]| [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3]];
+        let sign = if s.inward { -1.0 } else { 1.0 };
         Self {
             model: model().to_cols_array_2d(),
             view_proj: view_proj.to_cols_array_2d(),
             planes: frustum_planes(view_proj).map(|p| p.to_array()),
             camera: eye.extend(1.0).to_array(),
             light_dir: light.extend(0.0).to_array(),
-            albedo: linear("albedo"),
-            spec_color: linear("spec_color"),
-            background: linear("background"),
+            albedo: linear(s.albedo),
+            spec_color: linear(s.spec_color),
+            background: linear(s.background),
             grid,
             patch_count: 2 * grid * grid,
             edge_count: edge_count(grid),
-            view_mode: params.choice("view"),
-            edge_px: params.float("edge_length").max(0.5),
+            view_mode: s.view.index(),
+            edge_px: s.edge_length.max(0.5),
             screen_height: size.1 as f32,
-            displacement: sign * params.float("displacement"),
-            light_intensity: params.float("light_intensity"),
-            specular: params.float("specular"),
-            gloss: params.float("gloss"),
-            luminance: u32::from(params.choice("height_channel") == 1),
+            displacement: sign * s.displacement,
+            light_intensity: s.light_intensity,
+            specular: s.specular,
+            gloss: s.gloss,
+            luminance: u32::from(s.height_channel == Channel::Luminance),
             plane_size: PLANE_SIZE,
         }
     }
