@@ -44,7 +44,7 @@ pub use cloud::{Attraction, Cloud, NONE, Node};
 pub use growth::{SkinData, VertexSkin};
 pub use model::{Sampling, load as load_model};
 pub use params::{
-    GridLayout, GrowthUniforms, MAX_CELLS, MSAA_MODES, PoseUniforms, SEARCHES, SOURCES, VIEWS, ViewUniforms, params,
+    GridLayout, GrowthUniforms, MAX_CELLS, Msaa, PoseUniforms, Search, Settings, Source, View, ViewUniforms, params,
 };
 pub use render::{TUBE_CAP_ROWS, TUBE_SIDES, tube_indices};
 
@@ -89,20 +89,15 @@ struct CloudKey {
 }
 
 impl CloudKey {
-    fn of(p: &ParamSet, seed: u64) -> Self {
+    fn of(p: &Settings, seed: u64) -> Self {
         Self {
-            source: p.choice("source"),
-            side: p.int("side"),
-            seed_count: p.int("seed_count"),
-            variation: p.int("variation"),
+            source: p.source.index(),
+            side: p.side,
+            seed_count: p.seed_count,
+            variation: p.variation,
             seed,
-            model: (p.choice("source") == 1).then(|| {
-                let path = match p.get("model") {
-                    crate::params::ParamValue::Text(t) => t.as_str().trim().to_string(),
-                    _ => String::new(),
-                };
-                (path, p.int("voxels"), p.float("spacing").to_bits())
-            }),
+            model: (p.source == Source::Model)
+                .then(|| (p.model.as_str().trim().to_string(), p.voxels, p.spacing.to_bits())),
         }
     }
 
@@ -208,9 +203,9 @@ impl SpaceColonization {
     }
 
     /// Builds the cloud and seeds if the source changed or a reset was asked for.
-    fn ensure_state(&mut self, p: &ParamSet, seed: u64) {
+    fn ensure_state(&mut self, p: &Settings, seed: u64) {
         let key = CloudKey::of(p, seed);
-        if self.state.is_some() && self.key.as_ref() == Some(&key) && !p.fired("reset") {
+        if self.state.is_some() && self.key.as_ref() == Some(&key) && !p.reset {
             return;
         }
         let (cloud, skin, mesh) = match self.model_cloud(&key) {
@@ -312,17 +307,17 @@ impl SpaceColonization {
 
     /// The distance unit of the growth parameters: the sphere's 2 / side, or the model's voxel
     /// times `unit_scale`.
-    fn unit(&self, params: &ParamSet) -> f32 {
+    fn unit(&self, params: &Settings) -> f32 {
         let base = self.state.as_ref().map_or(1.0, |s| s.unit);
-        if self.mesh.is_some() { base * params.float("unit_scale") } else { base }
+        if self.mesh.is_some() { base * params.unit_scale } else { base }
     }
 
     /// The pose uniforms and joint matrices of this frame.
-    fn pose(&self, params: &ParamSet, seconds: f64) -> (PoseUniforms, Vec<[[f32; 4]; 4]>) {
+    fn pose(&self, params: &Settings, seconds: f64) -> (PoseUniforms, Vec<[[f32; 4]; 4]>) {
         let model = params::model(params, seconds);
         let joints = match &self.mesh {
             Some(mesh) => {
-                let time = mesh.ping_pong(seconds, params.float("animation_speed"));
+                let time = mesh.ping_pong(seconds, params.animation_speed);
                 mesh.joint_matrices(time).iter().map(|m| m.to_cols_array_2d()).collect()
             }
             None => Vec::new(),
@@ -338,11 +333,11 @@ impl Technique for SpaceColonization {
     }
 
     fn step(&mut self, params: &ParamSet, time: &FrameTime) {
+        let params = &Settings::read(params);
         self.ensure_state(params, time.seed);
         let state = self.state.as_ref().expect("ensured");
-        let every = params.int("update_every").clamp(1, 5) as u64;
-        let steps =
-            if self.frames_since_reset.is_multiple_of(every) { params.int("steps").clamp(1, 16) as u32 } else { 0 };
+        let every = params.update_every.clamp(1, 5) as u64;
+        let steps = if self.frames_since_reset.is_multiple_of(every) { params.steps.clamp(1, 16) as u32 } else { 0 };
         let key = self.key.as_ref().expect("ensured");
         let hash_seed = (key.rng_seed() ^ (key.rng_seed() >> 32)) as u32;
         let u = params::growth_uniforms(params, self.unit(params), time.dt);
@@ -375,6 +370,7 @@ impl Technique for SpaceColonization {
         time: &FrameTime,
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
+        let params = &Settings::read(params);
         self.ensure_state(params, time.seed);
         let frames = std::mem::take(&mut self.pending);
         let blocks = frames.len().max(1) as u64;
@@ -397,30 +393,28 @@ impl Technique for SpaceColonization {
         let state = self.state.as_ref().expect("ensured");
         state.set_pose(&self.queue, &pose, &joints);
         let (eye, view_proj) = params::view_proj(params, w as f32 / h.max(1) as f32);
-        let light = params.get("light_dir").components();
-        let light = glam::Vec3::new(light[0], light[1], light[2]).normalize_or(glam::Vec3::Y);
-        let view_mode = params.choice("view");
+        let light = glam::Vec3::from(params.light_dir).normalize_or(glam::Vec3::Y);
         let view = ViewUniforms {
             view_proj: view_proj.to_cols_array_2d(),
             camera: [eye.x, eye.y, eye.z, 1.0],
-            color: linear_rgba(params.color("color")),
-            light: [light.x, light.y, light.z, params.float("emission")],
-            thickness: params.float("thickness"),
+            color: linear_rgba(params.color),
+            light: [light.x, light.y, light.z, params.emission],
+            thickness: params.thickness,
             seed_count: state.seed_count,
-            lit: u32::from(view_mode == 2),
-            ghost: if params.bool("show_model") && self.mesh.is_some() { 0.6 } else { 0.0 },
+            lit: u32::from(params.view == View::TubesLit),
+            ghost: if params.show_model && self.mesh.is_some() { 0.6 } else { 0.0 },
             model: pose.model,
             floor: {
-                let c = linear_rgba(params.color("floor_color"));
-                [c[0], c[1], c[2], if params.bool("floor") { 12.0 } else { 0.0 }]
+                let c = linear_rgba(params.floor_color);
+                [c[0], c[1], c[2], if params.floor { 12.0 } else { 0.0 }]
             },
         };
         let extras = Extras { floor: view.floor[3] > 0.0, mesh: view.ghost > 0.0 };
-        let samples = if params.choice("msaa") == 1 { self.renderer.samples } else { 1 };
+        let samples = if params.msaa == Msaa::On { self.renderer.samples } else { 1 };
         self.renderer.prepare(&self.device, &self.queue, self.state.as_ref().expect("ensured"), &view);
-        let b = linear_rgba(params.color("background"));
+        let b = linear_rgba(params.background);
         let clear = wgpu::Color { r: f64::from(b[0]), g: f64::from(b[1]), b: f64::from(b[2]), a: 1.0 };
-        let style = if view_mode == 0 { Style::Lines } else { Style::Tubes };
+        let style = if params.view == View::Lines { Style::Lines } else { Style::Tubes };
 
         let this: &'r SpaceColonization = self;
         let state = this.state.as_ref().expect("ensured");

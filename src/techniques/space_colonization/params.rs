@@ -1,115 +1,134 @@
 //! Space colonization parameters (the book's, with its defaults and ranges) and the uniform
 //! blocks built from them.
 
-use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
+use crate::params::{InputRole, ParamDecl, ParamValue, Text};
 
-/// Search strategies, in the order of the `search` enum parameter.
-pub const SEARCHES: [&str; 2] = ["BruteForce", "Grid"];
-/// Views, in the order of the `view` enum parameter.
-pub const VIEWS: [&str; 3] = ["Lines", "Tubes", "TubesLit"];
-/// Attraction sources, in the order of the `source` enum parameter.
-pub const SOURCES: [&str; 2] = ["Sphere", "Model"];
-/// Multisampling choices, in the order of the `msaa` enum parameter.
-pub const MSAA_MODES: [&str; 2] = ["off", "on"];
 /// Most grid cells (the cell grows past the reach before the grid grows past this).
 pub const MAX_CELLS: u32 = 1 << 21;
 
-/// Parameters with the sample's defaults (seed-reference §1). Distances are in units of the
-/// lattice's `unit` (2 / side for the sphere, as the sample measures them); the sample's growth
-/// and kill defaults of 0.2 sat below their own 0.25 minimum (bug 7) and are 0.25 here.
+crate::param_enum! {
+    /// Where the attractions are.
+    pub enum Source {
+        /// A jittered lattice sphere.
+        Sphere = "Sphere",
+        /// Inside the model's volume.
+        Model = "Model",
+    }
+}
+
+crate::param_enum! {
+    /// How each attraction finds its nearest node.
+    pub enum Search {
+        /// Every node (the sample's way).
+        BruteForce = "BruteForce",
+        /// A uniform grid.
+        Grid = "Grid",
+    }
+}
+
+crate::param_enum! {
+    /// How branches are drawn.
+    pub enum View {
+        /// Additive lines.
+        Lines = "Lines",
+        /// Tubes coloured by their normals.
+        Tubes = "Tubes",
+        /// Lit tubes with glowing tips.
+        TubesLit = "TubesLit",
+    }
+}
+
+crate::param_enum! {
+    /// Multisampling of the draw.
+    pub enum Msaa {
+        /// One sample.
+        Off = "off",
+        /// The scene's samples.
+        On = "on",
+    }
+}
+
+crate::technique_params! {
+    /// What a space colonization node reads each step, with the sample's defaults
+    /// (seed-reference §1). Distances are in units of the lattice's `unit` (2 / side for the
+    /// sphere, as the sample measures them); the sample's growth and kill defaults of 0.2 sat
+    /// below their own 0.25 minimum (bug 7) and are 0.25 here.
+    pub struct Settings {
+        /// attractions in a jittered lattice sphere, or inside the model's volume
+        source: Source = |n, doc| ParamDecl::choice(n, Source::OPTIONS, 0, doc),
+        /// lattice points per axis: side 28 gives 10,144 attractions, 126 gives 1,022,208 (restarts)
+        side: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(16), Some((8.0, 128.0)), doc),
+        /// branches to start from (restarts)
+        seed_count: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(6), Some((1.0, 64.0)), doc),
+        /// another jitter and other seeds (restarts)
+        variation: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(0), Some((0.0, 1e6)), doc),
+        /// glTF 2.0 skinned model (.gltf or .glb) for the Model source
+        model: Text = |n, doc| ParamDecl::text(n, "assets/models/RiggedFigure.gltf", doc),
+        /// model voxels along its longest side (restarts)
+        voxels: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(64), Some((16.0, 256.0)), doc),
+        /// least distance between model attractions, in voxels (restarts)
+        spacing: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.0), Some((0.5, 4.0)), doc),
+        /// model distance unit, in voxels (the sample's unitScale)
+        unit_scale: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(2.5), Some((0.5, 10.0)), doc),
+        /// speed of the model's clip, played back and forth
+        animation_speed: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.5), Some((0.0, 4.0)), doc),
+        /// draw the model's skin as a faint glow over the branches
+        show_model: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(false), None, doc),
+        /// a lit floor under the model
+        floor: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(false), None, doc),
+        /// floor colour
+        floor_color: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([0.868, 0.868, 0.868, 1.0]), None, doc),
+        /// frames between growth updates (the sample's frame)
+        update_every: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(1), Some((1.0, 5.0)), doc),
+        /// growth steps per update (the sample's iterations)
+        steps: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(1), Some((1.0, 16.0)), doc),
+        /// lightest node: grows slowest
+        mass_min: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.25), Some((0.0, 1.0)), doc),
+        /// heaviest node: grows fastest
+        mass_max: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.0), Some((0.0, 1.0)), doc),
+        /// how far an attraction reaches, in units
+        influence: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.25), Some((0.25, 3.0)), doc),
+        /// length of a new branch segment, in units
+        growth_distance: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.25), Some((0.25, 1.0)), doc),
+        /// attractions this close to a node die, in units
+        kill_distance: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.25), Some((0.25, 1.0)), doc),
+        /// how fast a new segment grows out (t per second per mass)
+        growth_speed: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(22.0), Some((0.0, 200.0)), doc),
+        /// nearest-node search: a uniform grid, or every node (the sample's)
+        search: Search = |n, doc| ParamDecl::choice(n, Search::OPTIONS, 1, doc),
+        /// additive lines, tubes coloured by normal, or lit tubes with glowing tips
+        view: View = |n, doc| ParamDecl::choice(n, View::OPTIONS, 0, doc),
+        /// tube radius
+        thickness: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.1), Some((0.001, 0.1)), doc).with_unit("m"),
+        /// line or tube colour
+        color: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([1.0, 1.0, 1.0, 1.0]), None, doc),
+        /// glow of the growing tips (lit tubes)
+        emission: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(2.0), Some((0.0, 10.0)), doc),
+        /// direction towards the light (lit tubes)
+        light_dir: [f32; 3] = |n, doc| ParamDecl::new(n, ParamValue::Vec3([-0.3, 0.8, -0.5]), Some((-1.0, 1.0)), doc),
+        /// background colour
+        background: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([0.067, 0.092, 0.132, 1.0]), None, doc),
+        /// object scale (the sphere's radius is half of it)
+        scale: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(6.0), Some((0.01, 100.0)), doc),
+        /// turn about the vertical axis
+        spin: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.0), Some((-180.0, 180.0)), doc).with_unit("°/s"),
+        /// camera position
+        camera_position: [f32; 3] =
+            |n, doc| ParamDecl::new(n, ParamValue::Vec3([0.0, 0.0, -10.0]), Some((-100.0, 100.0)), doc).with_unit("m"),
+        /// camera looks down by
+        camera_pitch: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.0), Some((-89.0, 89.0)), doc).with_unit("°"),
+        /// vertical field of view
+        fov: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(40.0), Some((5.0, 120.0)), doc).with_unit("°"),
+        /// multisampling (the scene's msaa, 4 samples by default) keeps thin branches steady
+        msaa: Msaa = |n, doc| ParamDecl::choice(n, Msaa::OPTIONS, 1, doc),
+        /// start the growth again (R in the window)
+        reset: bool = |n, doc| ParamDecl::trigger(n, doc).with_role(InputRole::Key('r')),
+    }
+}
+
+/// Parameters (see [`Settings`]).
 pub fn params() -> Vec<ParamDecl> {
-    use ParamValue::*;
-    vec![
-        ParamDecl::choice(
-            "source",
-            &SOURCES,
-            0,
-            "attractions in a jittered lattice sphere, or inside the model's volume",
-        ),
-        ParamDecl::new(
-            "side",
-            Int(16),
-            Some((8.0, 128.0)),
-            "lattice points per axis: side 28 gives 10,144 attractions, 126 gives 1,022,208 (restarts)",
-        ),
-        ParamDecl::new("seed_count", Int(6), Some((1.0, 64.0)), "branches to start from (restarts)"),
-        ParamDecl::new("variation", Int(0), Some((0.0, 1e6)), "another jitter and other seeds (restarts)"),
-        ParamDecl::text(
-            "model",
-            "assets/models/RiggedFigure.gltf",
-            "glTF 2.0 skinned model (.gltf or .glb) for the Model source",
-        ),
-        ParamDecl::new("voxels", Int(64), Some((16.0, 256.0)), "model voxels along its longest side (restarts)"),
-        ParamDecl::new(
-            "spacing",
-            Float(1.0),
-            Some((0.5, 4.0)),
-            "least distance between model attractions, in voxels (restarts)",
-        ),
-        ParamDecl::new(
-            "unit_scale",
-            Float(2.5),
-            Some((0.5, 10.0)),
-            "model distance unit, in voxels (the sample's unitScale)",
-        ),
-        ParamDecl::new(
-            "animation_speed",
-            Float(0.5),
-            Some((0.0, 4.0)),
-            "speed of the model's clip, played back and forth",
-        ),
-        ParamDecl::new("show_model", Bool(false), None, "draw the model's skin as a faint glow over the branches"),
-        ParamDecl::new("floor", Bool(false), None, "a lit floor under the model"),
-        ParamDecl::new("floor_color", Color([0.868, 0.868, 0.868, 1.0]), None, "floor colour"),
-        ParamDecl::new("update_every", Int(1), Some((1.0, 5.0)), "frames between growth updates (the sample's frame)"),
-        ParamDecl::new("steps", Int(1), Some((1.0, 16.0)), "growth steps per update (the sample's iterations)"),
-        ParamDecl::new("mass_min", Float(0.25), Some((0.0, 1.0)), "lightest node: grows slowest"),
-        ParamDecl::new("mass_max", Float(1.0), Some((0.0, 1.0)), "heaviest node: grows fastest"),
-        ParamDecl::new("influence", Float(0.25), Some((0.25, 3.0)), "how far an attraction reaches, in units"),
-        ParamDecl::new("growth_distance", Float(0.25), Some((0.25, 1.0)), "length of a new branch segment, in units"),
-        ParamDecl::new(
-            "kill_distance",
-            Float(0.25),
-            Some((0.25, 1.0)),
-            "attractions this close to a node die, in units",
-        ),
-        ParamDecl::new(
-            "growth_speed",
-            Float(22.0),
-            Some((0.0, 200.0)),
-            "how fast a new segment grows out (t per second per mass)",
-        ),
-        ParamDecl::choice("search", &SEARCHES, 1, "nearest-node search: a uniform grid, or every node (the sample's)"),
-        ParamDecl::choice(
-            "view",
-            &VIEWS,
-            0,
-            "additive lines, tubes coloured by normal, or lit tubes with glowing tips",
-        ),
-        ParamDecl::new("thickness", Float(0.1), Some((0.001, 0.1)), "tube radius").with_unit("m"),
-        ParamDecl::new("color", Color([1.0, 1.0, 1.0, 1.0]), None, "line or tube colour"),
-        ParamDecl::new("emission", Float(2.0), Some((0.0, 10.0)), "glow of the growing tips (lit tubes)"),
-        ParamDecl::new(
-            "light_dir",
-            Vec3([-0.3, 0.8, -0.5]),
-            Some((-1.0, 1.0)),
-            "direction towards the light (lit tubes)",
-        ),
-        ParamDecl::new("background", Color([0.067, 0.092, 0.132, 1.0]), None, "background colour"),
-        ParamDecl::new("scale", Float(6.0), Some((0.01, 100.0)), "object scale (the sphere's radius is half of it)"),
-        ParamDecl::new("spin", Float(0.0), Some((-180.0, 180.0)), "turn about the vertical axis").with_unit("°/s"),
-        ParamDecl::new("camera_position", Vec3([0.0, 0.0, -10.0]), Some((-100.0, 100.0)), "camera position")
-            .with_unit("m"),
-        ParamDecl::new("camera_pitch", Float(0.0), Some((-89.0, 89.0)), "camera looks down by").with_unit("°"),
-        ParamDecl::new("fov", Float(40.0), Some((5.0, 120.0)), "vertical field of view").with_unit("°"),
-        ParamDecl::choice(
-            "msaa",
-            &MSAA_MODES,
-            1,
-            "multisampling (the scene's msaa, 4 samples by default) keeps thin branches steady",
-        ),
-        ParamDecl::trigger("reset", "start the growth again (R in the window)").with_role(InputRole::Key('r')),
-    ]
+    Settings::decls()
 }
 
 /// The growth shader's uniform block (`Growth` in `shaders/space_colonization.wgsl`).
@@ -182,16 +201,16 @@ impl GridLayout {
 }
 
 /// Growth settings of one step, in local units (`unit` = the source's distance unit).
-pub fn growth_uniforms(p: &ParamSet, unit: f32, dt: f32) -> GrowthUniforms {
-    let influence = p.float("influence") * unit;
-    let kill = p.float("kill_distance") * unit;
-    let (lo, hi) = (p.float("mass_min"), p.float("mass_max"));
+pub fn growth_uniforms(p: &Settings, unit: f32, dt: f32) -> GrowthUniforms {
+    let influence = p.influence * unit;
+    let kill = p.kill_distance * unit;
+    let (lo, hi) = (p.mass_min, p.mass_max);
     GrowthUniforms {
-        brute_force: u32::from(p.choice("search") == 0),
+        brute_force: u32::from(p.search == Search::BruteForce),
         influence,
-        growth: p.float("growth_distance") * unit,
+        growth: p.growth_distance * unit,
         kill,
-        grow_step: dt * p.float("growth_speed"),
+        grow_step: dt * p.growth_speed,
         mass_min: lo.min(hi),
         mass_max: lo.max(hi),
         ..bytemuck::Zeroable::zeroed()
@@ -237,19 +256,18 @@ pub struct PoseUniforms {
 }
 
 /// The object's transform: scale, then the spin about y.
-pub fn model(p: &ParamSet, seconds: f64) -> glam::Mat4 {
-    let angle = (p.float("spin") as f64 * seconds).to_radians() as f32;
-    glam::Mat4::from_rotation_y(angle) * glam::Mat4::from_scale(glam::Vec3::splat(p.float("scale")))
+pub fn model(p: &Settings, seconds: f64) -> glam::Mat4 {
+    let angle = (p.spin as f64 * seconds).to_radians() as f32;
+    glam::Mat4::from_rotation_y(angle) * glam::Mat4::from_scale(glam::Vec3::splat(p.scale))
 }
 
 /// The camera: at `camera_position`, looking along +z tilted down by `camera_pitch` (the
 /// sample's left-handed Unity camera).
-pub fn view_proj(p: &ParamSet, aspect: f32) -> (glam::Vec3, glam::Mat4) {
-    let c = p.get("camera_position").components();
-    let eye = glam::Vec3::new(c[0], c[1], c[2]);
-    let pitch = p.float("camera_pitch").to_radians();
+pub fn view_proj(p: &Settings, aspect: f32) -> (glam::Vec3, glam::Mat4) {
+    let eye = glam::Vec3::from(p.camera_position);
+    let pitch = p.camera_pitch.to_radians();
     let forward = glam::Vec3::new(0.0, -pitch.sin(), pitch.cos());
     let view = glam::camera::lh::view::look_to_mat4(eye, forward, glam::Vec3::Y);
-    let proj = glam::camera::lh::proj::directx::perspective(p.float("fov").to_radians(), aspect, 0.05, 500.0);
+    let proj = glam::camera::lh::proj::directx::perspective(p.fov.to_radians(), aspect, 0.05, 500.0);
     (eye, proj * view)
 }
