@@ -221,7 +221,7 @@ fn preset_panel(
         ui.text_edit_singleline(&mut overlay.preset_name);
         if ui.button("save").clicked() {
             let name = overlay.preset_name.clone();
-            hub.save_preset(&name, instance);
+            hub.save_preset(&name, instance.view());
         }
     });
     ui.add(egui::Slider::new(&mut overlay.morph_seconds, 0.0..=10.0).text("morph s"));
@@ -337,7 +337,7 @@ fn audio_learn_button(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut Con
         hub.unlearn_audio(target.node, target.param, scene);
     }
     if let Some(source) = picked {
-        hub.learn_audio(target, source, instance);
+        hub.learn_audio(target, source, instance.view());
     }
 }
 

@@ -376,7 +376,7 @@ impl Running {
         self.last = now;
         self.reload();
         let mut events = std::mem::take(&mut self.ui_events);
-        events.extend(self.hub.poll(self.player.instance(), self.player.last_step().seconds));
+        events.extend(self.hub.poll(self.player.instance().view(), self.player.last_step().seconds));
         self.hub.record(self.player.now().frame, &events, self.player.instance().scene());
         self.player.apply(&events);
         self.act_on_record_requests();
@@ -447,7 +447,7 @@ impl Running {
         for (i, shown) in projected {
             self.outputs[i].present(shown, &self.gpu.queue);
         }
-        self.hub.after_frame(self.player.instance());
+        self.hub.after_frame(self.player.instance().view());
         for m in self.player.instance_mut().take_messages() {
             self.overlay.report(m);
         }

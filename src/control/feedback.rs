@@ -9,7 +9,7 @@ use rosc::{OscMessage, OscPacket, OscType};
 
 use super::address::param_address;
 use crate::params::ParamValue;
-use crate::scene::SceneInstance;
+use crate::scene::SceneView;
 
 /// Which parameter values changed since they were last seen, as the OSC messages that carry
 /// them (triggers have no value and never appear).
@@ -25,9 +25,9 @@ impl ParamChanges {
     }
 
     /// One message per parameter whose value differs from the last one seen.
-    pub fn collect(&mut self, instance: &SceneInstance) -> Vec<OscMessage> {
+    pub fn collect(&mut self, instance: SceneView<'_>) -> Vec<OscMessage> {
         let mut messages = Vec::new();
-        for (n, node) in instance.scene().nodes.iter().enumerate() {
+        for (n, node) in instance.scene.nodes.iter().enumerate() {
             let params = instance.params(n);
             for (p, decl) in params.decls().iter().enumerate() {
                 let value = params.target_at(p);

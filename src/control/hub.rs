@@ -14,7 +14,7 @@ use super::presets::PresetStore;
 use super::record::Recorder;
 use super::tempo::TempoInput;
 use crate::params::{ControlEvent, Remap, Target};
-use crate::scene::{AudioSource, Scene, SceneInstance};
+use crate::scene::{AudioSource, Scene, SceneView};
 
 /// Which control sources to open.
 #[derive(Clone, Debug)]
@@ -197,9 +197,9 @@ impl ControlHub {
 
     /// Everything that arrived since the last frame, as control events, in arrival order per
     /// source (OSC before MIDI). `seconds` is the clock time (for MIDI tempo and morphs).
-    pub fn poll(&mut self, instance: &SceneInstance, seconds: f64) -> Vec<ControlEvent> {
+    pub fn poll(&mut self, instance: SceneView<'_>, seconds: f64) -> Vec<ControlEvent> {
         let mut events = Vec::new();
-        let scene = instance.scene();
+        let scene = instance.scene;
         let batches = self.osc.as_mut().map(|o| o.drain(SystemTime::now())).unwrap_or_default();
         self.router.begin_frame();
         for batch in batches {
@@ -233,7 +233,7 @@ impl ControlHub {
         #[cfg(feature = "link")]
         if let Some(link) = self.link.as_mut() {
             let ahead = f64::from(scene.dt);
-            events.extend(link.poll(&instance.tempo(), ahead));
+            events.extend(link.poll(&instance.tempo, ahead));
         }
         events
     }
@@ -248,10 +248,10 @@ impl ControlHub {
     }
 
     /// Maps audio `source` to `target` (the panel's audio learn) and saves it.
-    pub fn learn_audio(&mut self, target: Target, source: AudioSource, instance: &SceneInstance) {
+    pub fn learn_audio(&mut self, target: Target, source: AudioSource, instance: SceneView<'_>) {
         let now = instance.params(target.node).target_at(target.param);
-        match self.audio_learn.learn(instance.scene(), target, source, &now) {
-            Ok(()) => self.rebuild_audio(instance.scene()),
+        match self.audio_learn.learn(instance.scene, target, source, &now) {
+            Ok(()) => self.rebuild_audio(instance.scene),
             Err(e) => self.notice(e),
         }
     }
@@ -311,7 +311,7 @@ impl ControlHub {
     }
 
     /// Saves the current values as preset `name`.
-    pub fn save_preset(&mut self, name: &str, instance: &SceneInstance) {
+    pub fn save_preset(&mut self, name: &str, instance: SceneView<'_>) {
         match self.presets.save(name, instance) {
             Ok(path) => log::info!("saved preset {}", path.display()),
             Err(e) => self.notice(e),
@@ -353,7 +353,7 @@ impl ControlHub {
 
     /// After a frame: sends changed values to the OSC feedback target and to OSCQuery listeners,
     /// and refreshes the OSCQuery tree (every 6th frame: clients poll far slower than that).
-    pub fn after_frame(&mut self, instance: &SceneInstance) {
+    pub fn after_frame(&mut self, instance: SceneView<'_>) {
         // The changes are found once, and only when someone receives them.
         let listening = self.oscquery.as_ref().is_some_and(OscQueryServer::listening);
         let changes = if self.feedback.is_some() || listening { self.changes.collect(instance) } else { Vec::new() };

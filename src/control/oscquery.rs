@@ -14,7 +14,7 @@ use super::discovery::Advertisement;
 use super::http::{HttpServer, Routes};
 use super::listen::Listeners;
 use crate::params::{ParamDecl, ParamType, ParamValue};
-use crate::scene::SceneInstance;
+use crate::scene::SceneView;
 
 /// The OSC type tag string of a parameter type.
 fn type_tag(ty: ParamType) -> &'static str {
@@ -50,9 +50,9 @@ fn range_json(decl: &ParamDecl) -> Option<Value> {
 }
 
 /// The whole address tree of `instance` with current values.
-pub fn tree(instance: &SceneInstance) -> Value {
+pub fn tree(instance: SceneView<'_>) -> Value {
     let mut nodes = Map::new();
-    for (n, node) in instance.scene().nodes.iter().enumerate() {
+    for (n, node) in instance.scene.nodes.iter().enumerate() {
         let params = instance.params(n);
         let mut contents = Map::new();
         for (p, decl) in params.decls().iter().enumerate() {
@@ -75,7 +75,7 @@ pub fn tree(instance: &SceneInstance) -> Value {
     }
     json!({
         "FULL_PATH": "/",
-        "CONTENTS": { "indra": { "FULL_PATH": "/indra", "CONTENTS": nodes, "DESCRIPTION": instance.scene().name } }
+        "CONTENTS": { "indra": { "FULL_PATH": "/indra", "CONTENTS": nodes, "DESCRIPTION": instance.scene.name } }
     })
 }
 
@@ -157,7 +157,7 @@ impl OscQueryServer {
     }
 
     /// Publishes the current tree.
-    pub fn publish(&self, instance: &SceneInstance) {
+    pub fn publish(&self, instance: SceneView<'_>) {
         let t = tree(instance);
         if let Ok(mut s) = self.snapshot.write() {
             *s = Some(t);
@@ -173,7 +173,7 @@ impl OscQueryServer {
     /// then announced to listening controllers) and queues `changes` (the frame's, see
     /// [`super::feedback::ParamChanges`]) for the controllers listening to them. Returns how many
     /// messages were queued.
-    pub fn after_frame(&mut self, instance: &SceneInstance, publish: bool, changes: &[OscMessage]) -> usize {
+    pub fn after_frame(&mut self, instance: SceneView<'_>, publish: bool, changes: &[OscMessage]) -> usize {
         if publish || self.path_changed {
             self.publish(instance);
         }

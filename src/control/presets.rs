@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 
 use crate::params::{NodeValues, ParamType, RawValue, raw_from_value, value_from_raw};
-use crate::scene::{Scene, SceneInstance};
+use crate::scene::{Scene, SceneView};
 
 /// A preset file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -33,10 +33,10 @@ pub struct PresetStore {
 
 impl PresetStore {
     /// Saves every parameter's current target as `<name>.ron`; returns the path.
-    pub fn save(&self, name: &str, instance: &SceneInstance) -> Result<PathBuf, String> {
+    pub fn save(&self, name: &str, instance: SceneView<'_>) -> Result<PathBuf, String> {
         check_name(name)?;
         let mut values = BTreeMap::new();
-        for (n, node) in instance.scene().nodes.iter().enumerate() {
+        for (n, node) in instance.scene.nodes.iter().enumerate() {
             let params = instance.params(n);
             let entries = params
                 .decls()
@@ -47,7 +47,7 @@ impl PresetStore {
                 .collect();
             values.insert(node.id.clone(), entries);
         }
-        let file = PresetFile { scene: instance.scene().name.clone(), values };
+        let file = PresetFile { scene: instance.scene.name.clone(), values };
         let text = ron::ser::to_string_pretty(&file, Default::default()).map_err(|e| e.to_string())?;
         std::fs::create_dir_all(&self.dir).map_err(|e| format!("cannot create {}: {e}", self.dir.display()))?;
         let path = self.dir.join(format!("{name}.ron"));

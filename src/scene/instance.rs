@@ -19,6 +19,25 @@ use crate::params::{
 use crate::techniques::{NodeSetup, Technique};
 use crate::time::FrameTime;
 
+/// What the control layer reads of a running show: the scene, every node's parameters and the
+/// tempo clock — not its GPU nodes, so protocol code (and its tests) needs no device.
+#[derive(Clone, Copy)]
+pub struct SceneView<'a> {
+    /// The validated scene.
+    pub scene: &'a Scene,
+    /// Each node's parameters, in node order.
+    pub params: &'a [ParamSet],
+    /// The show's tempo and beat position.
+    pub tempo: TempoClock,
+}
+
+impl<'a> SceneView<'a> {
+    /// The parameters of node `node`.
+    pub fn params(&self, node: usize) -> &'a ParamSet {
+        &self.params[node]
+    }
+}
+
 /// The running form of a [`Scene`].
 pub struct SceneInstance {
     scene: Scene,
@@ -54,6 +73,11 @@ impl SceneInstance {
             refused: BTreeSet::new(),
             messages: Vec::new(),
         })
+    }
+
+    /// What the control layer reads (see [`SceneView`]).
+    pub fn view(&self) -> SceneView<'_> {
+        SceneView { scene: &self.scene, params: &self.params, tempo: self.tempo }
     }
 
     /// The validated scene.

@@ -8,7 +8,7 @@ mod player;
 mod schema;
 
 pub use error::{SceneError, SceneErrors};
-pub use instance::SceneInstance;
+pub use instance::{SceneInstance, SceneView};
 pub use load::{
     AudioMapping, BoundTrack, MAX_NAME_CHARS, Scene, SceneNode, SceneOutput, check_audio, load_scene, parse_scene,
     parse_value_override, resolve_target,

@@ -134,7 +134,7 @@ fn audio_learn_maps_a_source_and_persists() {
     let mut h = hub(&dir, &s);
     let scale = s.nodes[0].params.index("scale").unwrap();
     assert_eq!(h.audio_mapped(0, scale), (false, false));
-    h.learn_audio(Target { node: 0, param: scale, component: None }, indra::scene::AudioSource::Beat, &inst);
+    h.learn_audio(Target { node: 0, param: scale, component: None }, indra::scene::AudioSource::Beat, inst.view());
     assert_eq!(h.audio_mapped(0, scale), (true, true));
     let saved = std::fs::read_to_string(dir.join("audio-learn.ron")).unwrap();
     assert!(saved.contains("Beat") && saved.contains("\"k.scale\""), "{saved}");
@@ -170,7 +170,7 @@ fn presets_save_recall_and_morph() {
         write(scale, ParamValue::Float(4.0), Source::Ui),
         write(inversion, ParamValue::Bool(true), Source::Ui),
     ]);
-    h.save_preset("bright", &inst);
+    h.save_preset("bright", inst.view());
     inst.apply(&[
         write(scale, ParamValue::Float(1.0), Source::Ui),
         write(inversion, ParamValue::Bool(false), Source::Ui),
@@ -254,7 +254,7 @@ fn script(s: &Scene, dir: &std::path::Path) -> Vec<(u64, Vec<ControlEvent>)> {
     let mut h = hub(dir, s);
     let gpu = common::gpu();
     let inst = instance(&gpu, s);
-    h.save_preset("zoomed", &inst);
+    h.save_preset("zoomed", inst.view());
     let scale = s.nodes[0].params.index("scale").unwrap();
     vec![
         (2, vec![write(scale, ParamValue::Float(3.3), Source::Osc)]),

@@ -11,7 +11,7 @@ use indra::control::feedback::{OscFeedback, ParamChanges};
 use indra::control::osc::{OscReceiver, OscRouter, Routed, decode};
 use indra::control::oscquery::OscQueryServer;
 use indra::params::ParamValue;
-use indra::scene::{ControlEvent, Scene, SceneInstance, load_scene};
+use indra::scene::{ControlEvent, Scene, SceneInstance, SceneView, load_scene};
 use rosc::{OscBundle, OscMessage, OscPacket, OscTime, OscType};
 
 fn scene(name: &str) -> Scene {
@@ -307,8 +307,8 @@ fn feedback_sends_changed_values_to_the_controller() {
     listener.set_read_timeout(Some(Duration::from_secs(2))).unwrap();
     let feedback = OscFeedback::connect(&listener.local_addr().unwrap().to_string()).unwrap();
     let mut changes = ParamChanges::default();
-    assert_eq!(feedback.send(&changes.collect(&instance)), 10, "everything once at first");
-    assert_eq!(feedback.send(&changes.collect(&instance)), 0, "nothing changed");
+    assert_eq!(feedback.send(&changes.collect(instance.view())), 10, "everything once at first");
+    assert_eq!(feedback.send(&changes.collect(instance.view())), 0, "nothing changed");
     let mut buf = [0u8; 1024];
     for _ in 0..10 {
         listener.recv(&mut buf).unwrap();
@@ -322,7 +322,7 @@ fn feedback_sends_changed_values_to_the_controller() {
         source: indra::params::Source::Midi,
     };
     instance.apply(&[ControlEvent::Write(write)]);
-    assert_eq!(feedback.send(&changes.collect(&instance)), 1);
+    assert_eq!(feedback.send(&changes.collect(instance.view())), 1);
     let n = listener.recv(&mut buf).unwrap();
     let (_, packet) = rosc::decoder::decode_udp(&buf[..n]).unwrap();
     assert_eq!(
@@ -344,17 +344,19 @@ fn http_get(addr: std::net::SocketAddr, path: &str) -> (u16, serde_json::Value) 
 
 #[test]
 fn oscquery_serves_every_parameter_with_type_range_and_value() {
-    let gpu = common::gpu();
-    let instance = SceneInstance::new(&gpu, &common::assets(), scene("star_glow"), (32, 32)).unwrap();
+    // The protocol needs the scene and its values, not a device: no GPU is opened here.
+    let star_glow = scene("star_glow");
+    let values: Vec<indra::params::ParamSet> = star_glow.nodes.iter().map(|n| n.params.clone()).collect();
+    let view = SceneView { scene: &star_glow, params: &values, tempo: indra::params::TempoClock::new(120.0) };
     let server = OscQueryServer::start("127.0.0.1:0", 9000).unwrap();
     // Before the show publishes its scene, the tree is not shown as an empty one.
     assert_eq!(http_raw(server.local_addr(), b"GET / HTTP/1.1\r\n\r\n"), 503);
     assert_eq!(http_get(server.local_addr(), "/?HOST_INFO").0, 200);
-    server.publish(&instance);
+    server.publish(view);
     let (status, tree) = http_get(server.local_addr(), "/");
     assert_eq!(status, 200);
-    for (n, node) in instance.scene().nodes.iter().enumerate() {
-        let params = instance.params(n);
+    for (n, node) in view.scene.nodes.iter().enumerate() {
+        let params = view.params(n);
         for (p, decl) in params.decls().iter().enumerate() {
             let leaf = &tree["CONTENTS"]["indra"]["CONTENTS"][&node.id]["CONTENTS"][&decl.name];
             assert_eq!(leaf["FULL_PATH"], format!("/indra/{}/{}", node.id, decl.name));
@@ -568,7 +570,7 @@ fn oscquery_listen_sends_changes_of_listened_values_over_a_websocket() {
     let heard = loop {
         assert!(started.elapsed() < Duration::from_secs(5), "no change arrived");
         set(&mut instance, "scale", ParamValue::Float(2.0 + started.elapsed().as_secs_f32()));
-        server.after_frame(&instance, false, &changes.collect(&instance));
+        server.after_frame(instance.view(), false, &changes.collect(instance.view()));
         if let Some(Message::Binary(bytes)) = next_message(&mut socket, Duration::from_millis(50)) {
             break rosc::decoder::decode_udp(&bytes).unwrap().1;
         }
@@ -580,7 +582,7 @@ fn oscquery_listen_sends_changes_of_listened_values_over_a_websocket() {
     while next_message(&mut socket, Duration::from_millis(100)).is_some() {}
     set(&mut instance, "iterations", ParamValue::Int(7));
     assert_eq!(
-        server.after_frame(&instance, false, &changes.collect(&instance)),
+        server.after_frame(instance.view(), false, &changes.collect(instance.view())),
         0,
         "iterations changed, but nobody listens to it"
     );
@@ -588,11 +590,11 @@ fn oscquery_listen_sends_changes_of_listened_values_over_a_websocket() {
     socket.send(Message::text(r#"{"COMMAND":"IGNORE","DATA":"/indra/limit_set/scale"}"#)).unwrap();
     std::thread::sleep(Duration::from_millis(300));
     set(&mut instance, "scale", ParamValue::Float(1.5));
-    assert_eq!(server.after_frame(&instance, false, &changes.collect(&instance)), 0, "ignored");
+    assert_eq!(server.after_frame(instance.view(), false, &changes.collect(instance.view())), 0, "ignored");
     assert!(next_message(&mut socket, Duration::from_millis(200)).is_none());
     // A new scene is announced once its tree is published.
     server.scene_changed();
-    server.after_frame(&instance, false, &changes.collect(&instance));
+    server.after_frame(instance.view(), false, &changes.collect(instance.view()));
     let Some(Message::Text(text)) = next_message(&mut socket, Duration::from_secs(2)) else {
         panic!("no PATH_CHANGED")
     };
