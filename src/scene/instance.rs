@@ -58,8 +58,8 @@ pub struct SceneInstance {
 impl SceneInstance {
     /// Creates every node's technique (pipelines, persistent resources) for `output_size`.
     pub fn new(gpu: &Gpu, assets: &Assets, scene: Scene, output_size: (u32, u32)) -> Result<Self, ShaderError> {
-        let nodes = create_nodes(&scene, gpu, assets, output_size)?;
-        let params = scene.nodes.iter().map(|n| n.params.clone()).collect();
+        let params: Vec<ParamSet> = scene.nodes.iter().map(|n| n.params.clone()).collect();
+        let nodes = create_nodes(&scene, &params, gpu, assets, output_size)?;
         let tempo = TempoClock::new(scene.bpm);
         Ok(Self {
             tempo,
@@ -247,7 +247,8 @@ impl SceneInstance {
             .iter()
             .map(|&i| {
                 let n = &self.scene.nodes[i];
-                (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa: self.scene.msaa })
+                let (msaa, seed, params) = (self.scene.msaa, self.scene.seed, &self.params[i]);
+                (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa, params, seed })
             })
             .collect::<Result<Vec<_>, _>>()?;
         for (i, node) in using.iter().zip(rebuilt) {
@@ -261,7 +262,7 @@ impl SceneInstance {
     /// initial state, since their state lived on the old device. Either every node builds or
     /// nothing changes and the error is returned.
     pub fn rebuild_all(&mut self, gpu: &Gpu, assets: &Assets, output_size: (u32, u32)) -> Result<(), ShaderError> {
-        self.nodes = create_nodes(&self.scene, gpu, assets, output_size)?;
+        self.nodes = create_nodes(&self.scene, &self.params, gpu, assets, output_size)?;
         Ok(())
     }
 
@@ -287,7 +288,8 @@ impl SceneInstance {
             fresh.push(match kept(n) {
                 Some(_) => None,
                 None => {
-                    Some((n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa: scene.msaa })?)
+                    let (msaa, seed, params) = (scene.msaa, scene.seed, &n.params);
+                    Some((n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa, params, seed })?)
                 }
             });
         }
@@ -469,10 +471,16 @@ impl SceneInstance {
 /// Every node's technique instance for `scene`, in node order.
 fn create_nodes(
     scene: &Scene,
+    params: &[ParamSet],
     gpu: &Gpu,
     assets: &Assets,
     output_size: (u32, u32),
 ) -> Result<Vec<Box<dyn Technique>>, ShaderError> {
-    let msaa = scene.msaa;
-    scene.nodes.iter().map(|n| (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa })).collect()
+    let (msaa, seed) = (scene.msaa, scene.seed);
+    scene
+        .nodes
+        .iter()
+        .zip(params)
+        .map(|(n, params)| (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa, params, seed }))
+        .collect()
 }

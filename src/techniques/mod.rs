@@ -83,6 +83,11 @@ pub struct NodeSetup<'a> {
     pub output_size: (u32, u32),
     /// Samples per pixel the scene asks rasterising nodes for (see [`NodeSetup::samples_for`]).
     pub msaa: u32,
+    /// The node's parameters now: a node builds its state from them, so that state exists from
+    /// the start (later changes reach it in `step`).
+    pub params: &'a ParamSet,
+    /// The scene seed (what [`FrameTime::seed`] will be).
+    pub seed: u64,
 }
 
 impl NodeSetup<'_> {

@@ -32,7 +32,9 @@ impl<T: Technique> NodeRunner<T> {
         dt: f32,
         create: impl FnOnce(&NodeSetup<'_>) -> Result<T, ShaderError>,
     ) -> Result<Self, ShaderError> {
-        let node = create(&NodeSetup { gpu: &gpu, assets, id: "node", output_size: RUNNER_SIZE, msaa: 1 })?;
+        let setup =
+            NodeSetup { gpu: &gpu, assets, id: "node", output_size: RUNNER_SIZE, msaa: 1, params: &params, seed: 1 };
+        let node = create(&setup)?;
         let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
         Ok(Self { gpu, node, params, runtime, clock: FixedClock::new(dt, 1) })
     }

@@ -16,8 +16,16 @@ const SIZE: (u32, u32) = (64, 64);
 /// Runs one StarGlow node over `source` (RGBA f32 per texel) and returns its RGBA output.
 fn glow(gpu: &Gpu, source: &[[f32; 4]], settings: &[(&str, &str)]) -> Vec<[f32; 4]> {
     let assets = assets();
-    let mut node =
-        (star_glow::INFO.create)(&NodeSetup { gpu, assets: &assets, id: "glow", output_size: SIZE, msaa: 1 }).unwrap();
+    let mut node = (star_glow::INFO.create)(&NodeSetup {
+        gpu,
+        assets: &assets,
+        id: "glow",
+        output_size: SIZE,
+        msaa: 1,
+        params: &ParamSet::new(star_glow::params()),
+        seed: 1,
+    })
+    .unwrap();
     let mut params = ParamSet::new(star_glow::params());
     for (name, value) in settings {
         let i = params.index(name).unwrap();

@@ -66,7 +66,16 @@ fn random_params(rng: &mut SplitMix64, grid: i32) -> ParamSet {
 
 fn node(gpu: &indra::gpu::Gpu) -> Tessellation {
     let assets = common::assets();
-    Tessellation::new(&NodeSetup { gpu, assets: &assets, id: "surface", output_size: (320, 200), msaa: 4 }).unwrap()
+    Tessellation::new(&NodeSetup {
+        gpu,
+        assets: &assets,
+        id: "surface",
+        output_size: (320, 200),
+        msaa: 4,
+        params: &ParamSet::new(tessellation::params()),
+        seed: 1,
+    })
+    .unwrap()
 }
 
 #[test]

@@ -28,7 +28,8 @@ impl Node {
     }
 
     fn with_assets(gpu: &Gpu, assets: &Assets) -> Self {
-        let setup = NodeSetup { gpu, assets, id: "wall", output_size: SIZE, msaa: 1 };
+        let params = ParamSet::new(warp::params());
+        let setup = NodeSetup { gpu, assets, id: "wall", output_size: SIZE, msaa: 1, params: &params, seed: 1 };
         Self { node: (warp::INFO.create)(&setup).unwrap(), params: ParamSet::new(warp::params()) }
     }
 

@@ -118,6 +118,14 @@ impl Drop for Show {
     }
 }
 
+/// An empty folder of this test process under the temporary folder.
+fn scratch_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("indra-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 fn send(socket: &UdpSocket, port: u16, addr: &str, args: Vec<rosc::OscType>) {
     let packet = rosc::OscPacket::Message(rosc::OscMessage { addr: addr.into(), args });
     socket.send_to(&rosc::encoder::encode(&packet).unwrap(), ("127.0.0.1", port)).unwrap();
@@ -135,9 +143,7 @@ fn frames(path: &Path) -> u64 {
 #[test]
 fn the_show_records_takes_started_and_stopped_over_osc_and_finishes_on_sigterm() {
     let display = VirtualDisplay::start();
-    let dir = std::env::temp_dir().join(format!("indra-window-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch_dir("window");
     let video = dir.join("show.mp4");
     let (mut show, port) = Show::start(&display, &dir, "star_glow", &["--record-video".as_ref(), video.as_os_str()]);
     let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
@@ -191,9 +197,7 @@ fn grab(display: &str, size: (u32, u32)) -> Vec<u8> {
 #[test]
 fn projector_outputs_open_their_windows_and_follow_corner_addresses() {
     let display = VirtualDisplay::start();
-    let dir = std::env::temp_dir().join(format!("indra-outputs-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch_dir("outputs");
     let (mut show, port) = Show::start(&display, &dir, "two_projectors", &[]);
     show.wait_for("output 1: window");
     show.wait_for("output 2: window");
@@ -221,9 +225,7 @@ fn projector_outputs_open_their_windows_and_follow_corner_addresses() {
 #[test]
 fn the_network_can_neither_name_files_outside_nor_freeze_the_show_with_them() {
     let display = VirtualDisplay::start();
-    let dir = std::env::temp_dir().join(format!("indra-hostile-files-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch_dir("hostile-files");
     let victim = dir.join("victim.conf");
     std::fs::write(&victim, "keep me").unwrap();
     // The pipe lies in a folder the performer opened: it is refused as no regular file.

@@ -55,7 +55,7 @@ pub struct Cloth {
     renderer: Renderer,
     /// One uniform buffer per clock step a frame may run.
     uniforms: Vec<wgpu::Buffer>,
-    state: Option<State>,
+    state: State,
     /// Steps queued by `step`, recorded by the next `add_passes`.
     pending: Vec<ClothUniforms>,
     messages: Vec<String>,
@@ -66,7 +66,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
 }
 
 impl Cloth {
-    /// Builds the pipelines; buffers are made on the first step, at the resolution asked for.
+    /// Builds the pipelines and the cloth at rest, at the resolution and pinning asked for.
     pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
         let device = &setup.gpu.device;
         let storage = |binding, read_only| crate::gpu::storage_entry(binding, wgpu::ShaderStages::COMPUTE, read_only);
@@ -91,13 +91,15 @@ impl Cloth {
         let uniforms = (0..MAX_CATCH_UP_STEPS.max(1))
             .map(|_| crate::gpu::uniform_buffer::<ClothUniforms>(device, "cloth_uniforms"))
             .collect();
+        let settings = Settings::read(setup.params);
+        let state = at_rest(device, &setup.gpu.queue, &renderer, &settings);
         Ok(Self {
             device: device.clone(),
             queue: setup.gpu.queue.clone(),
             kernels,
             renderer,
             uniforms,
-            state: None,
+            state,
             pending: Vec::new(),
             messages: Vec::new(),
         })
@@ -105,39 +107,45 @@ impl Cloth {
 
     /// Reads the current particle positions back (blocking; for tests and tools).
     pub fn positions(&self) -> Vec<[f32; 4]> {
-        self.state.as_ref().map(|s| s.read_positions(&self.device, &self.queue)).unwrap_or_default()
+        self.state.read_positions(&self.device, &self.queue)
     }
 
     /// Reads the previous positions back (blocking; for tests and tools).
     pub fn previous_positions(&self) -> Vec<[f32; 4]> {
-        self.state.as_ref().map(|s| s.read_previous(&self.device, &self.queue)).unwrap_or_default()
+        self.state.read_previous(&self.device, &self.queue)
     }
 
     /// Reads the normals back (blocking; for tests and tools).
     pub fn normals(&self) -> Vec<[f32; 4]> {
-        self.state.as_ref().map(|s| s.read_normals(&self.device, &self.queue)).unwrap_or_default()
+        self.state.read_normals(&self.device, &self.queue)
     }
 
-    /// (Re)creates the buffers if the resolution or pinning changed, or a reset was asked for.
+    /// Recreates the cloth at rest if the resolution or pinning changed, and puts it back to
+    /// rest if a reset was asked for.
     fn ensure_state(&mut self, p: &Settings) {
         let res = p.resolution.clamp(4, 1024) as u32;
-        let pin = p.pin.index();
-        let fresh = self.state.as_ref().is_none_or(|s| s.res != res || s.pin != pin);
-        if fresh {
-            self.state = Some(State::new(&self.device, &self.renderer, res, pin));
-        }
-        if fresh || p.reset {
-            let pose = rest_pose(res, p.rest_length, p.mass, pin);
-            self.state.as_mut().expect("just made").reset(&self.queue, &pose);
+        if self.state.res != res || self.state.pin != p.pin.index() {
+            self.state = at_rest(&self.device, &self.queue, &self.renderer, p);
+        } else if p.reset {
+            let pose = rest_pose(res, p.rest_length, p.mass, self.state.pin);
+            self.state.reset(&self.queue, &pose);
         }
     }
+}
+
+/// A cloth of `p`'s resolution and pinning, at rest.
+fn at_rest(device: &wgpu::Device, queue: &wgpu::Queue, renderer: &Renderer, p: &Settings) -> State {
+    let (res, pin) = (p.resolution.clamp(4, 1024) as u32, p.pin.index());
+    let mut state = State::new(device, renderer, res, pin);
+    state.reset(queue, &rest_pose(res, p.rest_length, p.mass, pin));
+    state
 }
 
 impl Technique for Cloth {
     fn step(&mut self, params: &ParamSet, time: &FrameTime) {
         let settings = Settings::read(params);
         self.ensure_state(&settings);
-        let state = self.state.as_mut().expect("ensured");
+        let state = &mut self.state;
         if state.nan.poll(&state.status_readback) {
             self.messages.push("cloth: the simulation blew up (a position became NaN or infinite); reset to the rest pose — lower the time step or stiffness, or add substeps".into());
             let pose = rest_pose(state.res, settings.rest_length, settings.mass, state.pin);
@@ -173,14 +181,14 @@ impl Technique for Cloth {
         for (slot, u) in steps.iter().enumerate() {
             self.queue.write_buffer(&self.uniforms[slot], 0, bytemuck::bytes_of(u));
         }
-        let state = self.state.as_mut().expect("ensured");
+        let state = &mut self.state;
         let dispatches = state.plan(&self.device, &self.kernels.layout, &self.uniforms, &steps, substeps);
         let (w, h) = graph.output_size();
         let view = ClothView::from_params(&settings, time, w as f32 / h as f32);
         let debug = settings.view == View::Debug;
         self.renderer.prepare(&self.device, &self.queue, state, &view, debug);
         let this: &'r Cloth = self;
-        let state = this.state.as_ref().expect("ensured");
+        let state = &this.state;
 
         let particles = state.import(graph);
         let count = state.res * state.res;

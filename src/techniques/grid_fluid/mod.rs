@@ -95,7 +95,7 @@ pub struct GridFluid {
     queue: wgpu::Queue,
     kernels: Kernels,
     /// All fields, N² floats each (see [`Field`]); imported into the graph each frame.
-    fields: Option<(wgpu::Buffer, u64, u32)>,
+    fields: (wgpu::Buffer, u64, u32),
     /// One 256-byte uniform block per dispatch of the frame, bound at a dynamic offset.
     uniforms: wgpu::Buffer,
     /// Bind groups by (fields id, output texture id or 0, uniform buffer size).
@@ -114,7 +114,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
 }
 
 impl GridFluid {
-    /// Builds the pipelines; the fields are made on the first step, at the resolution asked for.
+    /// Builds the pipelines and zeroed fields at the resolution asked for.
     pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
         let device = &setup.gpu.device;
         let uniform = wgpu::BindGroupLayoutEntry {
@@ -156,11 +156,12 @@ impl GridFluid {
                 ComputeKernel::new(device, &origin, &source, k.entry(), &[layout])
             })
             .collect::<Result<_, _>>()?;
+        let n = Settings::read(setup.params).resolution.clamp(16, 1024) as u32;
         Ok(Self {
             device: device.clone(),
             queue: setup.gpu.queue.clone(),
             kernels: Kernels { by_kind, simulate, image },
-            fields: None,
+            fields: zeroed_fields(device, n),
             uniforms: uniform_blocks(device, 512),
             bind_groups: RefCell::default(),
             pending: Vec::new(),
@@ -168,14 +169,14 @@ impl GridFluid {
         })
     }
 
-    /// The grid side the fields were made for (0 before the first step).
+    /// The grid side the fields were made for.
     pub fn resolution(&self) -> u32 {
-        self.fields.as_ref().map_or(0, |f| f.2)
+        self.fields.2
     }
 
     /// Reads one field back (N² floats, row 0 at the bottom; blocking, for tests and tools).
     pub fn read_field(&self, field: Field) -> Vec<f32> {
-        let Some((buffer, _, n)) = &self.fields else { return Vec::new() };
+        let (buffer, _, n) = &self.fields;
         let bytes = u64::from(*n) * u64::from(*n) * 4;
         crate::gpu::read_buffer(&self.device, &self.queue, buffer, field as u64 * bytes, bytes)
             .map(|b| bytemuck::cast_slice(&b).to_vec())
@@ -184,10 +185,9 @@ impl GridFluid {
 
     /// Writes one field (N² floats; for tests that start from a known state).
     pub fn write_field(&self, field: Field, values: &[f32]) {
-        if let Some((buffer, _, n)) = &self.fields {
-            let bytes = u64::from(*n) * u64::from(*n) * 4;
-            self.queue.write_buffer(buffer, field as u64 * bytes, bytemuck::cast_slice(values));
-        }
+        let (buffer, _, n) = &self.fields;
+        let bytes = u64::from(*n) * u64::from(*n) * 4;
+        self.queue.write_buffer(buffer, field as u64 * bytes, bytemuck::cast_slice(values));
     }
 
     /// (Re)creates zeroed fields if the resolution changed or a reset was asked for.
@@ -196,16 +196,21 @@ impl GridFluid {
         if self.resolution() == n && !settings.reset {
             return;
         }
-        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("grid_fluid_fields"),
-            size: u64::from(n) * u64::from(n) * 4 * Field::COUNT as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        self.fields = Some((buffer, crate::graph::next_resource_id(), n));
+        self.fields = zeroed_fields(&self.device, n);
         self.pending.clear();
         self.last_cursor = None;
     }
+}
+
+/// Zeroed fields for an `n`² grid, with their graph resource id.
+fn zeroed_fields(device: &wgpu::Device, n: u32) -> (wgpu::Buffer, u64, u32) {
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("grid_fluid_fields"),
+        size: u64::from(n) * u64::from(n) * 4 * Field::COUNT as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    (buffer, crate::graph::next_resource_id(), n)
 }
 
 /// A uniform buffer of `blocks` dispatch blocks.
@@ -262,7 +267,7 @@ impl Technique for GridFluid {
         self.bind_groups.get_mut().begin_frame();
 
         let this: &'r GridFluid = self;
-        let (buffer, buffer_id, _) = this.fields.as_ref().expect("ensured");
+        let (buffer, buffer_id, _) = &this.fields;
         let fields = graph.import_buffer("grid_fluid/fields", buffer, *buffer_id);
         let output = graph.create_texture(
             "grid_fluid/density",

@@ -238,10 +238,11 @@ pub struct Poisson {
     instances: crate::gpu::GrowableBuffer,
     /// Samples already in `instances`.
     uploaded: usize,
-    key: Option<RunKey>,
+    /// The settings of the run.
+    key: RunKey,
     /// The settings the sampler runs with: `key`, its radius raised to fit the budget.
-    fitted: Option<RunKey>,
-    sampler: Option<Sampler>,
+    fitted: RunKey,
+    sampler: Sampler,
     messages: Vec<String>,
     /// The first frame whose sampler steps have not run yet: frames skipped by a seek are caught
     /// up, so frame N renders the same whether reached by playing or by seeking.
@@ -283,16 +284,19 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     })?;
     let instances =
         crate::gpu::GrowableBuffer::new(device, "poisson_instances", wgpu::BufferUsages::VERTEX, 4096 * INSTANCE);
+    // The scene's run starts at frame 0; later runs start in the frame that asks for them.
+    let key = RunKey::of(&Settings::read(setup.params));
+    let (fitted, message) = key.clone().within_budget();
     Ok(Box::new(Poisson {
         pipeline,
         samples,
         block,
         instances,
         uploaded: 0,
-        key: None,
-        fitted: None,
-        sampler: None,
-        messages: Vec::new(),
+        sampler: Sampler::new(&fitted),
+        key,
+        fitted,
+        messages: message.into_iter().collect(),
         next_frame: 0,
         pending: Vec::new(),
         device: device.clone(),
@@ -300,19 +304,17 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
 }
 
 impl Poisson {
-    /// Restarts the run if its settings changed or `restart` fired (a scene's first run counts
-    /// from frame 0, later ones from the frame they start in).
+    /// Restarts the run if its settings changed or `restart` fired; it counts from this frame.
     fn sync(&mut self, settings: &Settings, time: &FrameTime) {
         let key = RunKey::of(settings);
-        let first = self.key.is_none();
-        if first || self.key.as_ref() != Some(&key) || settings.restart {
+        if self.key != key || settings.restart {
             let (fitted, message) = key.clone().within_budget();
             self.messages.extend(message);
-            self.sampler = Some(Sampler::new(&fitted));
-            self.fitted = Some(fitted);
-            self.key = Some(key);
+            self.sampler = Sampler::new(&fitted);
+            self.fitted = fitted;
+            self.key = key;
             self.uploaded = 0;
-            self.next_frame = if first { 0 } else { time.frame };
+            self.next_frame = time.frame;
         }
     }
 }
@@ -323,9 +325,8 @@ impl Technique for Poisson {
         self.sync(&settings, time);
         let frames = (time.frame + 1).saturating_sub(self.next_frame);
         self.next_frame = time.frame + 1;
-        let sampler = self.sampler.as_mut().expect("synced");
         for _ in 0..frames * settings.steps_per_step.max(0) as u64 {
-            if !sampler.step() {
+            if !self.sampler.step() {
                 break;
             }
         }
@@ -342,13 +343,10 @@ impl Technique for Poisson {
         time: &FrameTime,
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
+        // Runs (and restarts) are decided in `step`.
         let settings = Settings::read(params);
-        // Runs (and restarts) are decided in `step`; here only a frame drawn before any step.
-        if self.sampler.is_none() {
-            self.sync(&settings, time);
-        }
-        let key = self.fitted.clone().expect("synced");
-        let sampler = self.sampler.as_ref().expect("synced");
+        let key = self.fitted.clone();
+        let sampler = &self.sampler;
         let count = sampler.len();
         if self.instances.reserve(&self.device, count as u64 * INSTANCE) {
             // A new buffer: everything is uploaded again.

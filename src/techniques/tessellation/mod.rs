@@ -83,7 +83,7 @@ pub struct Tessellation {
     /// anything downstream sees the image).
     samples: u32,
     sampler: wgpu::Sampler,
-    buffers: Option<Buffers>,
+    buffers: Buffers,
     /// The output size of the last frame added (for the bench report).
     output_size: (u32, u32),
     /// Draw bind groups by height texture id.
@@ -192,6 +192,8 @@ impl Tessellation {
             ..Default::default()
         });
         let uniforms = crate::gpu::uniform_buffer::<TessUniforms>(device, "tessellation_uniforms");
+        let grid = Settings::read(setup.params).grid.clamp(1, 64) as u32;
+        let buffers = make_buffers(device, &compute_layout, &uniforms, grid);
         let uniform_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("tessellation_uniform_group"),
             layout: &uniform_layout,
@@ -212,7 +214,7 @@ impl Tessellation {
             draw,
             samples,
             sampler,
-            buffers: None,
+            buffers,
             output_size: (0, 0),
             draw_groups: RefCell::default(),
             compute_raster,
@@ -242,7 +244,7 @@ impl Tessellation {
     }
 
     fn read(&self, which: impl Fn(&Buffers) -> &wgpu::Buffer) -> Option<Vec<u8>> {
-        let buffer = which(self.buffers.as_ref()?);
+        let buffer = which(&self.buffers);
         crate::gpu::read_buffer(&self.device, &self.queue, buffer, 0, buffer.size()).ok()
     }
 
@@ -250,7 +252,7 @@ impl Tessellation {
     /// shader places it, for the last submitted frame and `height`: (patch · 3 + edge) · 65 +
     /// index, w = 1 where a point exists (blocking; the crack test).
     pub fn boundary_points(&self, height: &wgpu::TextureView) -> Vec<[f32; 4]> {
-        let Some(b) = &self.buffers else { return Vec::new() };
+        let b = &self.buffers;
         let patches = 2 * b.grid * b.grid;
         let out = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("tessellation_boundaries"),
@@ -279,39 +281,12 @@ impl Tessellation {
             .unwrap_or_default()
     }
 
-    /// (Re)creates the per-frame buffers for `grid`.
+    /// Recreates the per-frame buffers if `grid` changed.
     fn ensure_buffers(&mut self, grid: u32) {
-        if self.buffers.as_ref().is_some_and(|b| b.grid == grid) {
+        if self.buffers.grid == grid {
             return;
         }
-        let patches = u64::from(2 * grid * grid);
-        let make = |label, bytes: u64, usage| {
-            let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: bytes.max(16),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | usage,
-                mapped_at_creation: false,
-            });
-            (buffer, crate::graph::next_resource_id())
-        };
-        let none = wgpu::BufferUsages::empty();
-        let factors = make("tessellation_edge_factors", u64::from(edge_count(grid)) * 4, none);
-        let levels = make("tessellation_patch_levels", patches * 4, none);
-        let offsets = make("tessellation_offsets", (patches + 1) * 4, none);
-        // The draw, the triangle total and the compute rasterizer's dispatch.
-        let args = make("tessellation_draw_args", 8 * 4, wgpu::BufferUsages::INDIRECT);
-        let compute_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("tessellation_compute_group"),
-            layout: &self.compute_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: self.uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: factors.0.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: levels.0.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: offsets.0.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: args.0.as_entire_binding() },
-            ],
-        });
-        self.buffers = Some(Buffers { grid, factors, levels, offsets, args, compute_group });
+        self.buffers = make_buffers(&self.device, &self.compute_layout, &self.uniforms, grid);
         // Old draw groups bind the old buffers.
         *self.draw_groups.get_mut() = BindGroupCache::default();
     }
@@ -340,7 +315,7 @@ impl Tessellation {
 
     /// Records the draw into `targets`: multisampled and resolved, or directly.
     fn record_draw(&self, ctx: &mut PassContext<'_>, height: TextureHandle, targets: &RasterTargets, clear: [f32; 4]) {
-        let Some(b) = &self.buffers else { return };
+        let b = &self.buffers;
         let group = self.draw_group(ctx, height, b);
         let clear = wgpu::Color { r: f64::from(clear[0]), g: f64::from(clear[1]), b: f64::from(clear[2]), a: 1.0 };
         let mut pass = ctx.begin_draw(targets, clear);
@@ -352,7 +327,7 @@ impl Tessellation {
 
     /// Records the compute draw's coverage (`image` None) or its shading into `image`.
     fn record_compute_draw(&self, ctx: &mut PassContext<'_>, height: TextureHandle, image: Option<TextureHandle>) {
-        let (Some(b), Some(raster)) = (&self.buffers, &self.compute_raster) else { return };
+        let (b, Some(raster)) = (&self.buffers, &self.compute_raster) else { return };
         let mesh = self.draw_group(ctx, height, b);
         let bindings = DrawBindings { uniforms: &self.uniform_group, mesh: &mesh, args: &b.args.0 };
         match image {
@@ -364,6 +339,39 @@ impl Tessellation {
             }
         }
     }
+}
+
+/// The per-frame buffers of a `grid`² plane: edge factors, patch levels, their prefix sums and
+/// the indirect arguments, bound for the compute pass.
+fn make_buffers(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, uniforms: &wgpu::Buffer, grid: u32) -> Buffers {
+    let patches = u64::from(2 * grid * grid);
+    let make = |label, bytes: u64, usage| {
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: bytes.max(16),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | usage,
+            mapped_at_creation: false,
+        });
+        (buffer, crate::graph::next_resource_id())
+    };
+    let none = wgpu::BufferUsages::empty();
+    let factors = make("tessellation_edge_factors", u64::from(edge_count(grid)) * 4, none);
+    let levels = make("tessellation_patch_levels", patches * 4, none);
+    let offsets = make("tessellation_offsets", (patches + 1) * 4, none);
+    // The draw, the triangle total and the compute rasterizer's dispatch.
+    let args = make("tessellation_draw_args", 8 * 4, wgpu::BufferUsages::INDIRECT);
+    let compute_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("tessellation_compute_group"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: factors.0.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 2, resource: levels.0.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 3, resource: offsets.0.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 4, resource: args.0.as_entire_binding() },
+        ],
+    });
+    Buffers { grid, factors, levels, offsets, args, compute_group }
 }
 
 impl Technique for Tessellation {
@@ -392,7 +400,7 @@ impl Technique for Tessellation {
             && self.compute_raster.as_mut().is_some_and(|r| r.get_mut().prepare(&self.queue, size, samples, u.grid));
 
         let this: &'r Tessellation = self;
-        let b = this.buffers.as_ref().expect("ensured");
+        let b = &this.buffers;
         let import = |graph: &mut FrameGraph<'r>, name: &str, (buffer, id): &(wgpu::Buffer, u64)| -> BufferHandle {
             graph.import_buffer(name, buffer, *id)
         };
