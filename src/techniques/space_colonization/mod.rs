@@ -115,22 +115,30 @@ pub struct SpaceColonization {
     renderer: Renderer,
     /// One 256-byte growth uniform block per queued frame, bound at a dynamic offset.
     uniforms: wgpu::Buffer,
-    state: Option<GrowthState>,
-    key: Option<CloudKey>,
+    state: GrowthState,
+    /// What `state` was built from (a newer key waits while its model is read).
+    key: CloudKey,
     /// Frames queued by `step` (uniforms, grid, growth steps), recorded by `add_passes`.
     pending: Vec<(GrowthUniforms, GridLayout, u32)>,
     frames_since_reset: u64,
     last: Option<GrowthUniforms>,
     messages: Vec<String>,
+    /// Models read for the Model source.
+    models: Models,
+    /// The model the cloud was sampled from (it poses the nodes), if any.
+    mesh: Option<Arc<SkinnedMesh>>,
+}
+
+/// The models a node reads: loaded off the render thread, the last one kept by path (a restart
+/// does not read the file again).
+struct Models {
     /// Where model paths are looked up, under the file rules.
     assets: crate::assets::Assets,
     /// Models being read and parsed off the render thread.
     loader: crate::files::Loader<SkinnedMesh>,
     /// The model path being loaded, if any.
     loading: Option<String>,
-    /// The model the cloud was sampled from (it poses the nodes), if any.
-    mesh: Option<Arc<SkinnedMesh>>,
-    /// The last model loaded, by path (a restart does not read the file again).
+    /// The last model loaded, by path.
     loaded: Option<(String, Arc<SkinnedMesh>)>,
 }
 
@@ -148,38 +156,48 @@ fn uniform_blocks(device: &wgpu::Device, blocks: u64) -> wgpu::Buffer {
 }
 
 impl SpaceColonization {
-    /// Builds the pipelines; the cloud is made on the first step.
+    /// Builds the pipelines and the cloud the parameters ask for.
     pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
         let device = &setup.gpu.device;
-        Ok(Self {
-            device: device.clone(),
-            queue: setup.gpu.queue.clone(),
-            kernels: Kernels::new(setup)?,
-            renderer: Renderer::new(setup, FORMAT)?,
-            uniforms: uniform_blocks(device, 8),
-            state: None,
-            key: None,
-            pending: Vec::new(),
-            frames_since_reset: 0,
-            last: None,
-            messages: Vec::new(),
+        let (kernels, renderer) = (Kernels::new(setup)?, Renderer::new(setup, FORMAT)?);
+        let mut models = Models {
             assets: setup.assets.clone(),
             loader: crate::files::Loader::new(setup.assets.load_wait()),
             loading: None,
-            mesh: None,
             loaded: None,
+        };
+        let key = CloudKey::of(&Settings::read(setup.params), setup.seed);
+        let mut messages = Vec::new();
+        // A node's first load is waited for, so the scene's model is there from the start.
+        let (cloud, skin, mesh) = models.cloud(&key, &mut messages).unwrap_or_else(|| sphere(&key));
+        let growth = Growth { device, queue: &setup.gpu.queue, kernels: &kernels, index_count: renderer.index_count };
+        let state = growth.state(&key, &cloud, &skin, mesh.is_some());
+        Ok(Self {
+            device: device.clone(),
+            queue: setup.gpu.queue.clone(),
+            kernels,
+            renderer,
+            uniforms: uniform_blocks(device, 8),
+            state,
+            key,
+            pending: Vec::new(),
+            frames_since_reset: 0,
+            last: None,
+            messages,
+            models,
+            mesh,
         })
     }
 
     /// The attractions and the nodes in use, as the GPU holds them after the last submitted
     /// frame (blocking; for tests and tools).
     pub fn read(&self) -> (Vec<Attraction>, Vec<Node>) {
-        self.state.as_ref().map(|s| s.read(&self.device, &self.queue)).unwrap_or_default()
+        self.state.read(&self.device, &self.queue)
     }
 
     /// Every node's drawn position (world, w = t) from the last drawn frame (blocking; tests).
     pub fn read_posed(&self) -> Vec<[f32; 4]> {
-        let Some(state) = &self.state else { return Vec::new() };
+        let state = &self.state;
         let count = u64::from(state.node_count(&self.device, &self.queue));
         crate::gpu::read_buffer(&self.device, &self.queue, &state.posed.buffer, 0, count.max(1) * 16)
             .map(|b| bytemuck::pod_collect_to_vec(&b))
@@ -194,7 +212,7 @@ impl SpaceColonization {
 
     /// Node slots (the attraction count, as in the book).
     pub fn capacity(&self) -> u32 {
-        self.state.as_ref().map_or(0, |s| s.capacity)
+        self.state.capacity
     }
 
     /// The uniforms of the last queued frame (its growth settings in local units).
@@ -202,47 +220,49 @@ impl SpaceColonization {
         self.last
     }
 
-    /// Builds the cloud and seeds if the source changed or a reset was asked for.
+    /// Builds the cloud and seeds again if the source changed or a reset was asked for. While a
+    /// new model is being read the last cloud keeps growing.
     fn ensure_state(&mut self, p: &Settings, seed: u64) {
         let key = CloudKey::of(p, seed);
-        if self.state.is_some() && self.key.as_ref() == Some(&key) && !p.reset {
+        if self.key == key && !p.reset {
             return;
         }
-        let (cloud, skin, mesh) = match self.model_cloud(&key) {
-            ModelCloudLoad::Ready((cloud, skin, mesh)) => (cloud, skin, Some(mesh)),
-            ModelCloudLoad::Failed(e) => {
-                self.messages.push(format!("space_colonization: {e}; growing in the sphere instead"));
-                (Cloud::lattice_sphere(key.side.clamp(2, 128) as u32, key.rng_seed()), SkinData::default(), None)
-            }
-            ModelCloudLoad::Sphere => {
-                (Cloud::lattice_sphere(key.side.clamp(2, 128) as u32, key.rng_seed()), SkinData::default(), None)
-            }
-            // The last cloud keeps growing until the model is read; the very first frames grow in
-            // the sphere, under no key, so the model is taken up as soon as it is there.
-            ModelCloudLoad::Pending if self.state.is_some() => return,
-            ModelCloudLoad::Pending => {
-                let sphere = Cloud::lattice_sphere(key.side.clamp(2, 128) as u32, key.rng_seed());
-                self.build_state(&key, &sphere, &SkinData::default(), None);
-                self.key = None;
-                return;
-            }
+        let Some((cloud, skin, mesh)) = self.models.cloud(&key, &mut self.messages) else { return };
+        let growth = Growth {
+            device: &self.device,
+            queue: &self.queue,
+            kernels: &self.kernels,
+            index_count: self.renderer.index_count,
         };
-        self.build_state(&key, &cloud, &skin, mesh);
-    }
-
-    /// Seeds `cloud` and makes the GPU state growing in it, for `key`.
-    fn build_state(&mut self, key: &CloudKey, cloud: &Cloud, skin: &SkinData, mesh: Option<Arc<SkinnedMesh>>) {
-        let count = key.seed_count.clamp(1, 64) as usize;
-        // The sphere keeps the book's random seeds; a model's limbs each need one.
-        let seeds =
-            if mesh.is_some() { cloud.spread_seeds(count, key.rng_seed()) } else { cloud.seeds(count, key.rng_seed()) };
-        let index_count = self.renderer.index_count;
-        self.state = Some(GrowthState::new(&self.device, &self.queue, &self.kernels, cloud, &seeds, skin, index_count));
+        self.state = growth.state(&key, &cloud, &skin, mesh.is_some());
         self.mesh = mesh;
-        self.key = Some(key.clone());
+        self.key = key;
         self.pending.clear();
         self.frames_since_reset = 0;
     }
+}
+
+/// What a growth state is made with.
+struct Growth<'a> {
+    device: &'a wgpu::Device,
+    queue: &'a wgpu::Queue,
+    kernels: &'a Kernels,
+    index_count: u32,
+}
+
+impl Growth<'_> {
+    /// Seeds `cloud` and makes the GPU state growing in it, for `key`.
+    fn state(&self, key: &CloudKey, cloud: &Cloud, skin: &SkinData, model: bool) -> GrowthState {
+        let count = key.seed_count.clamp(1, 64) as usize;
+        // The sphere keeps the book's random seeds; a model's limbs each need one.
+        let seeds = if model { cloud.spread_seeds(count, key.rng_seed()) } else { cloud.seeds(count, key.rng_seed()) };
+        GrowthState::new(self.device, self.queue, self.kernels, cloud, &seeds, skin, self.index_count)
+    }
+}
+
+/// The key's lattice sphere.
+fn sphere(key: &CloudKey) -> (Cloud, SkinData, Option<Arc<SkinnedMesh>>) {
+    (Cloud::lattice_sphere(key.side.clamp(2, 128) as u32, key.rng_seed()), SkinData::default(), None)
 }
 
 /// Where the cloud of a step comes from.
@@ -260,7 +280,25 @@ enum ModelCloudLoad {
 /// A cloud sampled inside a model, its skins and the model.
 type ModelCloud = (Cloud, SkinData, Arc<SkinnedMesh>);
 
-impl SpaceColonization {
+impl Models {
+    /// The cloud the key asks for: the sphere, or inside its model (a model that fails is one
+    /// message and the sphere); `None` while the model is still being read.
+    fn cloud(
+        &mut self,
+        key: &CloudKey,
+        messages: &mut Vec<String>,
+    ) -> Option<(Cloud, SkinData, Option<Arc<SkinnedMesh>>)> {
+        match self.model_cloud(key) {
+            ModelCloudLoad::Ready((cloud, skin, mesh)) => Some((cloud, skin, Some(mesh))),
+            ModelCloudLoad::Failed(e) => {
+                messages.push(format!("space_colonization: {e}; growing in the sphere instead"));
+                Some(sphere(key))
+            }
+            ModelCloudLoad::Sphere => Some(sphere(key)),
+            ModelCloudLoad::Pending => None,
+        }
+    }
+
     /// The cloud inside the key's model, if the source is a model: loaded (or reused) and sampled.
     /// The file is read and parsed off the render thread; sampling is bounded by the clamped
     /// voxel count.
@@ -304,11 +342,13 @@ impl SpaceColonization {
         let skin = SkinData { skins, positions: mesh.positions.clone(), triangles: mesh.triangles.clone() };
         ModelCloudLoad::Ready((cloud, skin, mesh))
     }
+}
 
+impl SpaceColonization {
     /// The distance unit of the growth parameters: the sphere's 2 / side, or the model's voxel
     /// times `unit_scale`.
     fn unit(&self, params: &Settings) -> f32 {
-        let base = self.state.as_ref().map_or(1.0, |s| s.unit);
+        let base = self.state.unit;
         if self.mesh.is_some() { base * params.unit_scale } else { base }
     }
 
@@ -335,10 +375,10 @@ impl Technique for SpaceColonization {
     fn step(&mut self, params: &ParamSet, time: &FrameTime) {
         let params = &Settings::read(params);
         self.ensure_state(params, time.seed);
-        let state = self.state.as_ref().expect("ensured");
+        let state = &self.state;
         let every = params.update_every.clamp(1, 5) as u64;
         let steps = if self.frames_since_reset.is_multiple_of(every) { params.steps.clamp(1, 16) as u32 } else { 0 };
-        let key = self.key.as_ref().expect("ensured");
+        let key = &self.key;
         let hash_seed = (key.rng_seed() ^ (key.rng_seed() >> 32)) as u32;
         let u = params::growth_uniforms(params, self.unit(params), time.dt);
         let (u, layout) = state.complete(u, hash_seed, self.renderer.index_count);
@@ -384,13 +424,13 @@ impl Technique for SpaceColonization {
         }
         self.queue.write_buffer(&self.uniforms, 0, &bytes);
         let cells = frames.iter().map(|f| f.1.cells()).max().unwrap_or(1);
-        let state = self.state.as_mut().expect("ensured");
+        let state = &mut self.state;
         state.prepare(&self.device, &self.kernels, &self.uniforms, cells);
         let ops = state.plan(&frames);
 
         let (w, h) = graph.output_size();
         let (pose, joints) = self.pose(params, time.seconds);
-        let state = self.state.as_ref().expect("ensured");
+        let state = &self.state;
         state.set_pose(&self.queue, &pose, &joints);
         let (eye, view_proj) = params::view_proj(params, w as f32 / h.max(1) as f32);
         let light = glam::Vec3::from(params.light_dir).normalize_or(glam::Vec3::Y);
@@ -411,13 +451,13 @@ impl Technique for SpaceColonization {
         };
         let extras = Extras { floor: view.floor[3] > 0.0, mesh: view.ghost > 0.0 };
         let samples = if params.msaa == Msaa::On { self.renderer.samples } else { 1 };
-        self.renderer.prepare(&self.device, &self.queue, self.state.as_ref().expect("ensured"), &view);
+        self.renderer.prepare(&self.device, &self.queue, &self.state, &view);
         let b = linear_rgba(params.background);
         let clear = wgpu::Color { r: f64::from(b[0]), g: f64::from(b[1]), b: f64::from(b[2]), a: 1.0 };
         let style = if params.view == View::Lines { Style::Lines } else { Style::Tubes };
 
         let this: &'r SpaceColonization = self;
-        let state = this.state.as_ref().expect("ensured");
+        let state = &this.state;
         let nodes = graph.import_buffer("space_colonization/nodes", &state.nodes.buffer, state.nodes.id);
         let attractions =
             graph.import_buffer("space_colonization/attractions", &state.attractions.buffer, state.attractions.id);
