@@ -338,7 +338,16 @@ fn in_range_values_too_large_together_and_hostile_files_get_one_sentence() {
     std::fs::write(&huge, edited).unwrap();
     let long_name = dir.join("long_name.ron");
     std::fs::write(&long_name, scene.replace("\"Poisson disk 3-D\"", &format!("\"{}\"", "n".repeat(300)))).unwrap();
-    for (file, says) in [(&huge, "raise the radius"), (&long_name, "at most 200")] {
+    let long_id = dir.join("long_id.ron");
+    let id = "p".repeat(100);
+    std::fs::write(
+        &long_id,
+        scene
+            .replace("id: \"poisson\"", &format!("id: \"{id}\""))
+            .replace("output: \"poisson\"", &format!("output: \"{id}\"")),
+    )
+    .unwrap();
+    for (file, says) in [(&huge, "raise the radius"), (&long_name, "at most 200"), (&long_id, "at most 64")] {
         let o = indra(&["check", file.to_str().unwrap()]);
         let t = text(&o);
         assert_eq!(o.status.code(), Some(1), "{t}");

@@ -363,6 +363,9 @@ fn corner_aliases(outputs: &[SceneOutput], nodes: &[SceneNode]) -> Vec<(String, 
 /// The longest scene name (it becomes the window title).
 pub const MAX_NAME_CHARS: usize = 200;
 
+/// The longest node id (ids become OSC addresses and labels).
+pub const MAX_ID_CHARS: usize = 64;
+
 /// Errors located and reported per file; the rest are counted. Locating scans the source, so a
 /// file with tens of thousands of mistakes would otherwise take quadratic time to check.
 const MAX_REPORTED_ERRORS: usize = 50;
@@ -433,6 +436,11 @@ impl Validator<'_> {
             let anchor = format!("\"{}\"", node.id);
             if !seen.insert(node.id.clone()) {
                 self.error(&[&anchor, &anchor], format!("node id '{}' is used twice", node.id));
+            }
+            if node.id.chars().count() > MAX_ID_CHARS {
+                // Ids become OSC addresses, panel labels and GPU labels.
+                let length = node.id.chars().count();
+                self.error(&[&anchor], format!("a node id of {length} characters; at most {MAX_ID_CHARS}"));
             }
             if let Some(built) = self.node(node, &anchor) {
                 if let Some(Err(e)) = built.technique.check.map(|check| check(&built.params)) {

@@ -387,6 +387,17 @@ fn a_warp_file_outside_the_allowed_folders_is_neither_read_nor_written() {
     assert!(messages.len() == 1 && messages[0].starts_with("warp not saved"), "{messages:?}");
     assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep me", "the file outside is untouched");
 
+    // Inside the allowed folders a save replaces only a warp file: not a scene, not a preset.
+    let scene = dir.join("scenes/show.ron");
+    std::fs::write(&scene, "(name: \"show\", nodes: [], output: \"x\")").unwrap();
+    let mut node = Node::with_assets(&gpu, &assets().allowing(&dir));
+    node.set("file", ParamValue::Text(Text::new(scene.to_str().unwrap())));
+    node.step();
+    node.set("save", ParamValue::Trigger(true));
+    let messages = node.step();
+    assert!(messages.iter().any(|m| m.contains("is not a warp file")), "{messages:?}");
+    assert!(std::fs::read_to_string(&scene).unwrap().starts_with("(name:"), "the scene is untouched");
+
     // Allowed folders still refuse pipes and devices, at once: the step does not wait on them.
     let fifo = dir.join("pipe.ron");
     assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());

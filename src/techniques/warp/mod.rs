@@ -155,6 +155,8 @@ pub struct Warp {
     assets: Assets,
     /// Warp files being read and parsed off the render thread.
     loader: Loader<WarpFile>,
+    /// Files this node read or wrote as warp files: a save may replace them.
+    warp_files: std::collections::BTreeSet<std::path::PathBuf>,
     /// The mesh in use (a regular 2×2 grid without one).
     mesh: MeshWarp,
     /// The part of the source shown at the last step, for the pointer.
@@ -245,6 +247,7 @@ impl Warp {
             queue: setup.gpu.queue.clone(),
             assets: setup.assets.clone(),
             loader: Loader::new(setup.assets.load_wait()),
+            warp_files: Default::default(),
             mesh: MeshWarp::regular(2, 2),
             applied_size: [2, 2],
             applied_point: [-1.0, 0.0, 0.0],
@@ -272,9 +275,10 @@ impl Warp {
     /// Applies a finished load: its values go to the parameters and its mesh is used; a file
     /// that failed leaves the last good warp.
     fn take_loaded(&mut self) {
-        let Some((_, read)) = self.loader.poll() else { return };
+        let Some((name, read)) = self.loader.poll() else { return };
         match read {
             Ok(warp) => {
+                self.warp_files.extend(self.assets.locate_file(&name).ok());
                 self.mesh = warp.mesh.clone().unwrap_or_else(|| MeshWarp::regular(2, 2));
                 self.applied_size = [self.mesh.columns, self.mesh.rows];
                 self.upload_mesh();
@@ -298,8 +302,19 @@ impl Warp {
             Ok(file) => file,
             Err(e) => return self.messages.push(format!("warp not saved: {e}")),
         };
+        // A scene or preset is a .ron inside the allowed folders too: a save replaces only a
+        // warp file — one that reads as a warp, or that this node read as one before (it may be
+        // broken mid-edit) — or makes a new one, never another kind of file.
+        let known = self.warp_files.contains(&file);
+        if file.exists() && !known && read_warp(&self.assets, &file.display().to_string()).is_err() {
+            let message = format!("warp not saved: {} exists and is not a warp file", file.display());
+            return self.messages.push(message);
+        }
         match crate::atomic_file::write(&file, warp.to_ron().as_bytes()) {
-            Ok(()) => self.messages.push(format!("warp saved to {}", file.display())),
+            Ok(()) => {
+                self.messages.push(format!("warp saved to {}", file.display()));
+                self.warp_files.insert(file);
+            }
             Err(e) => self.messages.push(format!("cannot save the warp to {}: {e}", file.display())),
         }
     }
