@@ -8,7 +8,7 @@ const SIZE: (u32, u32) = (256, 256);
 
 fn check_golden(scene: &str, frame: u64) {
     let rendered = render_named(scene, SIZE, frame);
-    golden().check(&format!("{scene}_f{frame:04}"), SIZE, &rendered.rgba).unwrap_or_else(|e| panic!("{e}"));
+    golden(0.01, 0.3).check(&format!("{scene}_f{frame:04}"), SIZE, &rendered.rgba).unwrap_or_else(|e| panic!("{e}"));
 }
 
 #[test]

@@ -172,7 +172,9 @@ fn check_golden(scene: &str, frames: &[u64]) {
     for &f in frames {
         r.seek(f).unwrap();
         let rendered = r.render_next().unwrap();
-        common::golden().check(&format!("{scene}_f{f:04}"), SIZE, &rendered.rgba).unwrap_or_else(|e| panic!("{e}"));
+        common::golden(0.01, 0.3)
+            .check(&format!("{scene}_f{f:04}"), SIZE, &rendered.rgba)
+            .unwrap_or_else(|e| panic!("{e}"));
     }
 }
 
