@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use crate::files::{FileError, FileRules, LoadWait};
+use crate::files::{FileError, FileRules, LoadWait, NamedBytes};
 
 mod embedded {
     include!(concat!(env!("OUT_DIR"), "/embedded.rs"));
@@ -106,6 +106,12 @@ impl Assets {
     /// The file a parameter's `name` means, beside the root or as given, if the rules allow it.
     pub fn locate_file(&self, name: &str) -> Result<PathBuf, FileError> {
         self.files.locate(self.root.as_deref(), name)
+    }
+
+    /// The bytes of the file a parameter's `name` means, at most `limit` of them, or `bundled`'s
+    /// where no such file exists (see [`FileRules::read`]).
+    pub fn read_file(&self, name: &str, limit: u64, bundled: Option<&'static [u8]>) -> Result<NamedBytes, FileError> {
+        self.files.read(self.root.as_deref(), name, limit, bundled)
     }
 
     /// Where a parameter's `name` may be saved as a `.ext` file, if the rules allow it.

@@ -49,7 +49,8 @@ impl<T: Send + 'static> Loader<T> {
     }
 
     /// Whether a load is under way or queued.
-    pub fn busy(&self) -> bool {
+    #[cfg(test)]
+    fn busy(&self) -> bool {
         self.running.is_some() || self.queued.is_some()
     }
 

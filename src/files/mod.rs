@@ -16,6 +16,7 @@ mod loader;
 
 pub use loader::{LoadWait, Loader};
 
+use std::borrow::Cow;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
@@ -54,11 +55,6 @@ impl FileRules {
         let mut folders = self.folders.clone();
         folders.push(folder.into());
         Self { folders }
-    }
-
-    /// The allowed folders, for messages.
-    pub fn folders(&self) -> &[PathBuf] {
-        &self.folders
     }
 
     /// The file `name` means: beside `root` first, then as given (relative to the current folder
@@ -111,6 +107,27 @@ impl FileRules {
         Ok(real)
     }
 
+    /// The bytes of the file `name` means (see [`FileRules::locate`]), at most `limit` of them;
+    /// where no such file exists, `bundled`'s (a copy built into the binary), if given.
+    pub fn read(
+        &self,
+        root: Option<&Path>,
+        name: &str,
+        limit: u64,
+        bundled: Option<&'static [u8]>,
+    ) -> Result<NamedBytes, FileError> {
+        match (self.locate(root, name), bundled) {
+            (Err(FileError::NotFound(_)), Some(bytes)) => {
+                Ok(NamedBytes { path: None, origin: format!("bundled {name}"), bytes: Cow::Borrowed(bytes) })
+            }
+            (Err(e), _) => Err(e),
+            (Ok(path), _) => {
+                let bytes = read_limited(&path, limit)?;
+                Ok(NamedBytes { origin: path.display().to_string(), path: Some(path), bytes: Cow::Owned(bytes) })
+            }
+        }
+    }
+
     fn check_inside(&self, real: &Path, name: &str) -> Result<(), FileError> {
         let inside = self.folders.iter().filter_map(|f| f.canonicalize().ok()).any(|f| real.starts_with(&f));
         if inside {
@@ -122,6 +139,17 @@ impl FileRules {
             if folders.is_empty() { "none".to_string() } else { folders.join(", ") }
         )))
     }
+}
+
+/// A file's bytes and where they came from.
+#[derive(Clone, Debug)]
+pub struct NamedBytes {
+    /// The file on disk, links followed (`None`: a copy built into the binary).
+    pub path: Option<PathBuf>,
+    /// Where the bytes came from, for messages: the path, or `bundled <name>`.
+    pub origin: String,
+    /// The bytes.
+    pub bytes: Cow<'static, [u8]>,
 }
 
 /// The bytes of `path`, if it is a regular file of at most `limit` bytes. Opened without blocking

@@ -97,10 +97,16 @@ impl SkinnedMesh {
     /// The file and every buffer are regular files of bounded size, and the data the accessors
     /// claim is checked against [`MODEL_DATA_LIMIT`] before anything is allocated for it.
     pub fn load_confined(path: &Path, rules: &FileRules) -> Result<Self, String> {
-        let named = |e: String| format!("{}: {e}", path.display());
         let bytes = files::read_limited(path, MODEL_DATA_LIMIT).map_err(|e| e.to_string())?;
-        precheck(&bytes).map_err(named)?;
-        let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| named(e.to_string()))?;
+        Self::from_file_bytes(path, &bytes, rules)
+    }
+
+    /// A `.gltf` or `.glb` already read from `path`, its external buffers read from beside it
+    /// inside `rules`' folders (see [`SkinnedMesh::load_confined`]).
+    pub fn from_file_bytes(path: &Path, bytes: &[u8], rules: &FileRules) -> Result<Self, String> {
+        let named = |e: String| format!("{}: {e}", path.display());
+        precheck(bytes).map_err(named)?;
+        let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| named(e.to_string()))?;
         let folder = path.parent().unwrap_or(Path::new("."));
         let buffers = read_buffers(&gltf, folder, rules).map_err(named)?;
         Self::from_document(&gltf.document, &buffers).map_err(named)
@@ -302,7 +308,7 @@ fn read_buffers(gltf: &gltf::Gltf, folder: &Path, rules: &FileRules) -> Result<V
                 if uri.contains(':') {
                     return Err(format!("buffer '{uri}': only files beside the model and data URIs are read"));
                 }
-                let name = folder.join(percent_decoded(uri));
+                let name = folder.join(&*urlencoding::decode(uri).map_err(|e| format!("buffer '{uri}': {e}"))?);
                 let file = rules.locate(None, &name.to_string_lossy()).map_err(|e| match e {
                     FileError::NotFound(_) => format!("buffer file {uri} not found beside it"),
                     FileError::Refused(why) => format!("buffer '{uri}': {why}"),
@@ -318,27 +324,6 @@ fn read_buffers(gltf: &gltf::Gltf, folder: &Path, rules: &FileRules) -> Result<V
         buffers.push(gltf::buffer::Data(data));
     }
     Ok(buffers)
-}
-
-/// A URI path with its `%XX` escapes decoded (glTF URIs are URI-encoded).
-fn percent_decoded(uri: &str) -> String {
-    let bytes = uri.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        let hex = bytes.get(i + 1..i + 3).and_then(|h| std::str::from_utf8(h).ok());
-        match (bytes[i], hex.and_then(|h| u8::from_str_radix(h, 16).ok())) {
-            (b'%', Some(byte)) => {
-                out.push(byte);
-                i += 3;
-            }
-            (byte, _) => {
-                out.push(byte);
-                i += 1;
-            }
-        }
-    }
-    String::from_utf8_lossy(&out).into_owned()
 }
 
 fn rest_nodes(document: &gltf::Document) -> Vec<RestNode> {

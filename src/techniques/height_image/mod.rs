@@ -11,7 +11,9 @@
 use std::io::Cursor;
 
 use crate::assets::Assets;
-use crate::files::{FileError, Loader};
+use image::ImageDecoder;
+
+use crate::files::Loader;
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, PersistentTexture, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, Text};
@@ -97,24 +99,23 @@ impl HeightImage {
 /// answer for their paths when no file is there.
 fn read_image(assets: &Assets, name: &str, max_side: u32) -> Result<image::RgbaImage, String> {
     let bundled = BUNDLED.iter().find(|(bundled, _)| *bundled == name).map(|(_, bytes)| *bytes);
-    match (assets.locate_file(name), bundled) {
-        (Err(FileError::NotFound(_)), Some(bytes)) => decode_bounded(bytes, &format!("bundled {name}"), max_side),
-        (Err(e), _) => Err(format!("no image: {e}")),
-        (Ok(file), _) => {
-            let bytes = crate::files::read_limited(&file, IMAGE_FILE_LIMIT).map_err(|e| format!("cannot read {e}"))?;
-            decode_bounded(&bytes, &file.display().to_string(), max_side)
-        }
-    }
+    let read = assets.read_file(name, IMAGE_FILE_LIMIT, bundled).map_err(|e| format!("cannot read image: {e}"))?;
+    decode_bounded(&read.bytes, &read.origin, max_side)
 }
 
 /// Decodes `bytes` if the image's header says it fits a texture of at most `max_side` a side and
 /// the memory budget: a tiny file claiming a huge image is refused before it is decoded.
 pub fn decode_bounded(bytes: &[u8], name: &str, max_side: u32) -> Result<image::RgbaImage, String> {
-    let reader = || image::ImageReader::new(Cursor::new(bytes)).with_guessed_format();
-    let (width, height) = reader()
-        .map_err(|e| format!("cannot read {name}: {e}"))?
-        .into_dimensions()
+    let failed = |e: image::ImageError| format!("cannot read {name}: {e}");
+    let mut reader = image::ImageReader::new(Cursor::new(bytes))
+        .with_guessed_format()
         .map_err(|e| format!("cannot read {name}: {e}"))?;
+    // A backstop: the checks below refuse first, with a sentence that says why.
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(2 * DECODED_LIMIT);
+    reader.limits(limits);
+    let decoder = reader.into_decoder().map_err(failed)?;
+    let (width, height) = decoder.dimensions();
     if width > max_side || height > max_side {
         return Err(format!("{name} is {width}×{height} pixels; this GPU takes at most {max_side} on a side"));
     }
@@ -126,13 +127,7 @@ pub fn decode_bounded(bytes: &[u8], name: &str, max_side: u32) -> Result<image::
             DECODED_LIMIT >> 20
         ));
     }
-    let mut limits = image::Limits::default();
-    limits.max_image_width = Some(max_side);
-    limits.max_image_height = Some(max_side);
-    limits.max_alloc = Some(2 * DECODED_LIMIT);
-    let mut decoder = reader().map_err(|e| format!("cannot read {name}: {e}"))?;
-    decoder.limits(limits);
-    Ok(decoder.decode().map_err(|e| format!("cannot read {name}: {e}"))?.to_rgba8())
+    Ok(image::DynamicImage::from_decoder(decoder).map_err(failed)?.to_rgba8())
 }
 
 fn upload(device: &wgpu::Device, queue: &wgpu::Queue, image: &image::RgbaImage) -> PersistentTexture {

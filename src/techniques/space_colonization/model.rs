@@ -5,8 +5,7 @@
 use super::cloud::{Attraction, Cloud};
 use super::growth::VertexSkin;
 use crate::assets::Assets;
-use crate::files::FileError;
-use crate::geometry::skinned::SkinnedMesh;
+use crate::geometry::skinned::{MODEL_DATA_LIMIT, SkinnedMesh};
 use crate::geometry::volume;
 
 /// The bundled models, by the path scenes use.
@@ -16,11 +15,11 @@ const BUNDLED: &[(&str, &[u8])] =
 /// Loads model `name` (beside the asset root, then as given, under the file rules; else the
 /// bundled copy).
 pub fn load(assets: &Assets, name: &str) -> Result<SkinnedMesh, String> {
-    let bundled = BUNDLED.iter().find(|(bundled, _)| *bundled == name);
-    match (assets.locate_file(name), bundled) {
-        (Ok(file), _) => SkinnedMesh::load_confined(&file, assets.file_rules()),
-        (Err(FileError::NotFound(_)), Some((name, bytes))) => SkinnedMesh::from_slice(name, bytes),
-        (Err(e), _) => Err(format!("no model: {e}")),
+    let bundled = BUNDLED.iter().find(|(bundled, _)| *bundled == name).map(|(_, bytes)| *bytes);
+    let read = assets.read_file(name, MODEL_DATA_LIMIT, bundled).map_err(|e| format!("cannot read model: {e}"))?;
+    match &read.path {
+        Some(file) => SkinnedMesh::from_file_bytes(file, &read.bytes, assets.file_rules()),
+        None => SkinnedMesh::from_slice(name, &read.bytes),
     }
 }
 

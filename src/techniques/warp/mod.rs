@@ -9,9 +9,10 @@
 //! good warp stays on the wall.
 
 use std::cell::RefCell;
+use std::path::PathBuf;
 
 use crate::assets::Assets;
-use crate::files::{FileError, Loader};
+use crate::files::Loader;
 use crate::geometry::warp::{Corners, EdgeBlend, Homography, MAX_MESH_SIDE, MeshWarp, Region, WarpFile};
 use crate::gpu::{BindGroupCache, GrowableBuffer, RasterDesc, ShaderError, uniform_buffer, uniform_entry};
 use crate::graph::{FrameGraph, PassContext, RasterTargets, TextureHandle};
@@ -154,9 +155,9 @@ pub struct Warp {
     /// Where warp files are looked up, and may be saved.
     assets: Assets,
     /// Warp files being read and parsed off the render thread.
-    loader: Loader<WarpFile>,
+    loader: Loader<(Option<PathBuf>, WarpFile)>,
     /// Files this node read or wrote as warp files: a save may replace them.
-    warp_files: std::collections::BTreeSet<std::path::PathBuf>,
+    warp_files: std::collections::BTreeSet<PathBuf>,
     /// The mesh in use (a regular 2×2 grid without one).
     mesh: MeshWarp,
     /// The part of the source shown at the last step, for the pointer.
@@ -275,10 +276,10 @@ impl Warp {
     /// Applies a finished load: its values go to the parameters and its mesh is used; a file
     /// that failed leaves the last good warp.
     fn take_loaded(&mut self) {
-        let Some((name, read)) = self.loader.poll() else { return };
+        let Some((_, read)) = self.loader.poll() else { return };
         match read {
-            Ok(warp) => {
-                self.warp_files.extend(self.assets.locate_file(&name).ok());
+            Ok((file, warp)) => {
+                self.warp_files.extend(file);
                 self.mesh = warp.mesh.clone().unwrap_or_else(|| MeshWarp::regular(2, 2));
                 self.applied_size = [self.mesh.columns, self.mesh.rows];
                 self.upload_mesh();
@@ -428,18 +429,14 @@ fn invert_mesh(mesh: &MeshWarp, target: [f32; 2]) -> Option<[f32; 2]> {
     ((p[0] - target[0]).abs() < 1e-4 && (p[1] - target[1]).abs() < 1e-4).then_some(uv)
 }
 
-/// Reads and parses warp file `name` under the file rules; the bundled examples are built in,
-/// so their scenes map the same from any folder.
-fn read_warp(assets: &Assets, name: &str) -> Result<WarpFile, String> {
-    let bundled = BUNDLED.iter().find(|(bundled, _)| *bundled == name).map(|(_, text)| *text);
-    let file = match (assets.locate_file(name), bundled) {
-        (Err(FileError::NotFound(_)), Some(text)) => return WarpFile::parse(name, text),
-        (Err(e), _) => return Err(format!("cannot read warp file: {e}")),
-        (Ok(file), _) => file,
-    };
-    let bytes = crate::files::read_limited(&file, WARP_FILE_LIMIT).map_err(|e| format!("cannot read warp file {e}"))?;
-    let text = String::from_utf8(bytes).map_err(|_| format!("cannot read warp file {}: not UTF-8", file.display()))?;
-    WarpFile::parse(&file.display().to_string(), &text)
+/// Reads and parses warp file `name` under the file rules, with the file it was read from; the
+/// bundled examples are built in, so their scenes map the same from any folder.
+fn read_warp(assets: &Assets, name: &str) -> Result<(Option<PathBuf>, WarpFile), String> {
+    let bundled = BUNDLED.iter().find(|(bundled, _)| *bundled == name).map(|(_, text)| text.as_bytes());
+    let read = assets.read_file(name, WARP_FILE_LIMIT, bundled).map_err(|e| format!("cannot read warp file: {e}"))?;
+    let text =
+        std::str::from_utf8(&read.bytes).map_err(|_| format!("cannot read warp file {}: not UTF-8", read.origin))?;
+    Ok((read.path, WarpFile::parse(&read.origin, text)?))
 }
 
 /// The parameter values a warp file sets.
