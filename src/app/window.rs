@@ -544,7 +544,7 @@ impl Running {
     /// whose files are complete.
     fn act_on_record_requests(&mut self) {
         let mut still = Vec::new();
-        for take in std::mem::take(&mut self.finishing) {
+        for mut take in std::mem::take(&mut self.finishing) {
             match take.poll() {
                 Some(report) => self.take_finished(report),
                 None => still.push(take),

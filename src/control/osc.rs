@@ -153,11 +153,12 @@ const RECEIVE_BUFFER_BYTES: usize = 4 << 20;
 /// The UDP receiver thread and the queue it fills.
 pub struct OscReceiver {
     local: SocketAddr,
-    queue: Receiver<Batch>,
+    queue: Receiver<(Batch, usize)>,
     /// Bytes of the batches in `queue` (the receiver thread adds, `drain` subtracts).
     queued_bytes: Arc<AtomicUsize>,
     counters: Arc<OscCounters>,
-    scheduled: Vec<Batch>,
+    /// Future batches with their bytes.
+    scheduled: Vec<(Batch, usize)>,
     /// Bytes of the batches in `scheduled`.
     scheduled_bytes: usize,
     stop: Arc<AtomicBool>,
@@ -215,8 +216,7 @@ impl OscReceiver {
     /// [`MAX_SCHEDULED`], none more than [`MAX_AHEAD`] ahead: the rest are dropped and counted).
     pub fn drain(&mut self, now: SystemTime) -> Vec<Batch> {
         let horizon = now + MAX_AHEAD;
-        for batch in self.queue.try_iter() {
-            let bytes = batch.bytes();
+        for (batch, bytes) in self.queue.try_iter() {
             self.queued_bytes.fetch_sub(bytes, Ordering::Relaxed);
             let too_late = batch.due.is_some_and(|t| t > horizon);
             let full = batch.due.is_some_and(|t| t > now)
@@ -228,13 +228,13 @@ impl OscReceiver {
                 continue;
             }
             self.scheduled_bytes += bytes;
-            self.scheduled.push(batch);
+            self.scheduled.push((batch, bytes));
         }
-        let (due, later): (Vec<Batch>, Vec<Batch>) =
-            self.scheduled.drain(..).partition(|b| b.due.is_none_or(|t| t <= now));
+        let (due, later): (Vec<_>, Vec<_>) =
+            self.scheduled.drain(..).partition(|(b, _)| b.due.is_none_or(|t| t <= now));
         self.scheduled = later;
-        self.scheduled_bytes -= due.iter().map(Batch::bytes).sum::<usize>();
-        due
+        self.scheduled_bytes -= due.iter().map(|(_, bytes)| bytes).sum::<usize>();
+        due.into_iter().map(|(batch, _)| batch).collect()
     }
 
     /// Bytes waiting: queued by the receiver thread and scheduled for later.
@@ -298,10 +298,29 @@ fn describe_args(args: &[OscType]) -> String {
     parts.join(", ")
 }
 
-/// The receiver thread's end of the queue, with the bytes it holds.
+/// The receiver thread's end of the queue: batches with their [`Batch::bytes`], counted once,
+/// and the bytes the queue holds.
 struct Queue {
-    tx: SyncSender<Batch>,
+    tx: SyncSender<(Batch, usize)>,
     bytes: Arc<AtomicUsize>,
+}
+
+impl Queue {
+    /// Queues `batch` if the queue has room for it by count and by bytes.
+    fn push(&self, batch: Batch) -> Result<(), TrySendError<()>> {
+        let bytes = batch.bytes();
+        if self.bytes.load(Ordering::Relaxed) + bytes > MAX_QUEUED_BYTES {
+            return Err(TrySendError::Full(()));
+        }
+        self.bytes.fetch_add(bytes, Ordering::Relaxed);
+        self.tx.try_send((batch, bytes)).map_err(|e| {
+            self.bytes.fetch_sub(bytes, Ordering::Relaxed);
+            match e {
+                TrySendError::Full(_) => TrySendError::Full(()),
+                TrySendError::Disconnected(_) => TrySendError::Disconnected(()),
+            }
+        })
+    }
 }
 
 fn receive_loop(
@@ -323,17 +342,9 @@ fn receive_loop(
                     if batch.messages.iter().any(|m| m.addr == "/indra/stats") {
                         reply_stats(socket, from, counters);
                     }
-                    let bytes = batch.bytes();
-                    let room = queue.bytes.load(Ordering::Relaxed) + bytes <= MAX_QUEUED_BYTES;
-                    if room {
-                        queue.bytes.fetch_add(bytes, Ordering::Relaxed);
-                    }
-                    match if room { queue.tx.try_send(batch) } else { Err(TrySendError::Full(batch)) } {
+                    match queue.push(batch) {
                         Ok(()) => {}
-                        Err(TrySendError::Full(_)) => {
-                            if room {
-                                queue.bytes.fetch_sub(bytes, Ordering::Relaxed);
-                            }
+                        Err(TrySendError::Full(())) => {
                             counters.dropped.fetch_add(1, Ordering::Relaxed);
                             log_once(
                                 logged,
@@ -341,7 +352,7 @@ fn receive_loop(
                                 "the render loop is behind; packets are dropped and counted",
                             );
                         }
-                        Err(TrySendError::Disconnected(_)) => return,
+                        Err(TrySendError::Disconnected(())) => return,
                     }
                 }
             }
@@ -498,7 +509,6 @@ fn route_command(command: Command, args: &[OscType]) -> Option<Routed> {
         Some(OscType::String(s)) => Some(s.clone()),
         _ => None,
     };
-    let seconds = numbers(&args[args.len().min(1)..]).and_then(|n| n.first().copied()).unwrap_or(0.0);
     // Infinity or NaN in a command would pin what it starts (a morph that never ends): refused
     // like a wrong argument, as parameter values are.
     let non_finite = |a: &OscType| match a {
@@ -509,6 +519,7 @@ fn route_command(command: Command, args: &[OscType]) -> Option<Routed> {
     if args.iter().any(non_finite) {
         return None;
     }
+    let seconds = numbers(&args[args.len().min(1)..]).and_then(|n| n.first().copied()).unwrap_or(0.0);
     match command {
         Command::Resume => Some(Routed::Event(ControlEvent::ResumeTracks)),
         Command::PresetSave => name.map(Routed::SavePreset),

@@ -253,7 +253,8 @@ impl LiveRecorder {
     }
 
     /// Reads back the frames still in flight (a few, already rendered), then leaves encoding
-    /// them and closing the file to a thread: the frame that stops a take never waits for ffmpeg.
+    /// them and closing the file to the encoder thread: the frame that stops a take never waits
+    /// for ffmpeg.
     pub fn finish_in_background(mut self, device: &wgpu::Device) -> FinishingTake {
         while !self.pending.is_empty() {
             self.after_submit();
@@ -269,51 +270,38 @@ impl LiveRecorder {
             self.counts.dropped_busy += u64::from(p.repeats);
         }
         drop(self.sender.take());
-        let (path, counts, encoder) = (self.path.clone(), self.counts, self.encoder.take());
-        let (sender, result) = std::sync::mpsc::channel();
-        let report_path = path.clone();
-        let closing = std::thread::Builder::new().name("indra-take-close".into()).spawn(move || {
-            let written = match encoder.map(JoinHandle::join) {
-                Some(Ok(result)) => result,
-                _ => Err(VideoError::Settings("the encoder thread stopped unexpectedly".into())),
-            };
-            let _ = sender.send(written.map(|written| CaptureReport { path: report_path, written, counts }));
-        });
-        if let Err(e) = closing {
-            log::warn!("no thread to close {} ({e}): it is left to ffmpeg", path.display());
-        }
-        FinishingTake { path, result }
+        FinishingTake { path: self.path.clone(), counts: self.counts, encoder: self.encoder.take() }
     }
 }
 
-/// A take being closed off the render thread: its last frames encoded, ffmpeg finishing the file.
+/// A take being closed off the render thread: the encoder thread writes its last frames and
+/// ffmpeg finishes the file; the render thread only asks whether that thread has ended.
 pub struct FinishingTake {
     path: std::path::PathBuf,
-    result: Receiver<Result<CaptureReport, VideoError>>,
+    counts: CaptureCounts,
+    encoder: Option<JoinHandle<Result<u64, VideoError>>>,
 }
 
 impl FinishingTake {
-    /// The video file.
-    pub fn path(&self) -> &std::path::Path {
-        &self.path
-    }
-
     /// How the take went, once the file is complete (`None` while ffmpeg is still writing).
-    pub fn poll(&self) -> Option<Result<CaptureReport, VideoError>> {
-        match self.result.try_recv() {
-            Ok(report) => Some(report),
-            Err(std::sync::mpsc::TryRecvError::Empty) => None,
-            Err(std::sync::mpsc::TryRecvError::Disconnected) => Some(Err(self.lost())),
+    pub fn poll(&mut self) -> Option<Result<CaptureReport, VideoError>> {
+        if self.encoder.as_ref().is_some_and(|e| !e.is_finished()) {
+            return None;
         }
+        Some(self.report())
     }
 
     /// Waits until the file is complete (the show is ending, or a take made off-screen).
-    pub fn wait(self) -> Result<CaptureReport, VideoError> {
-        self.result.recv().unwrap_or_else(|_| Err(self.lost()))
+    pub fn wait(mut self) -> Result<CaptureReport, VideoError> {
+        self.report()
     }
 
-    fn lost(&self) -> VideoError {
-        VideoError::Settings(format!("closing {} stopped unexpectedly", self.path.display()))
+    /// Joins the encoder thread (at once when it has ended) and says how the take went.
+    fn report(&mut self) -> Result<CaptureReport, VideoError> {
+        match self.encoder.take().map(JoinHandle::join) {
+            Some(Ok(written)) => Ok(CaptureReport { path: self.path.clone(), written: written?, counts: self.counts }),
+            _ => Err(VideoError::Settings("the encoder thread stopped unexpectedly".into())),
+        }
     }
 }
 
