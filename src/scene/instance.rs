@@ -245,11 +245,7 @@ impl SceneInstance {
             (0..self.nodes.len()).filter(|&i| self.scene.nodes[i].technique.shaders.contains(&name)).collect();
         let rebuilt = using
             .iter()
-            .map(|&i| {
-                let n = &self.scene.nodes[i];
-                let (msaa, seed, params) = (self.scene.msaa, self.scene.seed, &self.params[i]);
-                (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa, params, seed })
-            })
+            .map(|&i| create_node(&self.scene, i, &self.params[i], gpu, assets, output_size))
             .collect::<Result<Vec<_>, _>>()?;
         for (i, node) in using.iter().zip(rebuilt) {
             self.nodes[*i] = node;
@@ -284,13 +280,10 @@ impl SceneInstance {
             self.scene.nodes.iter().position(|o| same_msaa && o.id == n.id && o.technique.name == n.technique.name)
         };
         let mut fresh: Vec<Option<Box<dyn Technique>>> = Vec::with_capacity(scene.nodes.len());
-        for n in &scene.nodes {
+        for (i, n) in scene.nodes.iter().enumerate() {
             fresh.push(match kept(n) {
                 Some(_) => None,
-                None => {
-                    let (msaa, seed, params) = (scene.msaa, scene.seed, &n.params);
-                    Some((n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa, params, seed })?)
-                }
+                None => Some(create_node(&scene, i, &n.params, gpu, assets, output_size)?),
             });
         }
         let mut old_nodes: Vec<Option<Box<dyn Technique>>> = self.nodes.drain(..).map(Some).collect();
@@ -476,11 +469,19 @@ fn create_nodes(
     assets: &Assets,
     output_size: (u32, u32),
 ) -> Result<Vec<Box<dyn Technique>>, ShaderError> {
+    params.iter().enumerate().map(|(i, params)| create_node(scene, i, params, gpu, assets, output_size)).collect()
+}
+
+/// Creates node `i` of `scene` from `params` (its values now).
+fn create_node(
+    scene: &Scene,
+    i: usize,
+    params: &ParamSet,
+    gpu: &Gpu,
+    assets: &Assets,
+    output_size: (u32, u32),
+) -> Result<Box<dyn Technique>, ShaderError> {
+    let n = &scene.nodes[i];
     let (msaa, seed) = (scene.msaa, scene.seed);
-    scene
-        .nodes
-        .iter()
-        .zip(params)
-        .map(|(n, params)| (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa, params, seed }))
-        .collect()
+    (n.technique.create)(&NodeSetup { gpu, assets, id: &n.id, output_size, msaa, params, seed })
 }

@@ -202,6 +202,24 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }
 
+crate::param_enum! {
+    /// An `msaa` parameter: whether a node draws at the scene's sample count or at one sample
+    /// (faster where fill is slow).
+    pub enum Msaa {
+        /// One sample.
+        Off = "off",
+        /// The scene's samples.
+        On = "on",
+    }
+}
+
+impl Msaa {
+    /// The samples a draw uses: `scene_samples` when on, else 1.
+    pub fn samples(self, scene_samples: u32) -> u32 {
+        if self == Msaa::On { scene_samples } else { 1 }
+    }
+}
+
 /// An sRGB-encoded colour (as colour pickers and scene files give) in linear light; alpha as is.
 pub fn linear_rgba(c: [f32; 4]) -> [f32; 4] {
     [srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3]]

@@ -44,7 +44,7 @@ pub use cloud::{Attraction, Cloud, NONE, Node};
 pub use growth::{SkinData, VertexSkin};
 pub use model::{Sampling, load as load_model};
 pub use params::{
-    GridLayout, GrowthUniforms, MAX_CELLS, Msaa, PoseUniforms, Search, Settings, Source, View, ViewUniforms, params,
+    GridLayout, GrowthUniforms, MAX_CELLS, PoseUniforms, Search, Settings, Source, View, ViewUniforms, params,
 };
 pub use render::{TUBE_CAP_ROWS, TUBE_SIDES, tube_indices};
 
@@ -450,7 +450,7 @@ impl Technique for SpaceColonization {
             },
         };
         let extras = Extras { floor: view.floor[3] > 0.0, mesh: view.ghost > 0.0 };
-        let samples = if params.msaa == Msaa::On { self.renderer.samples } else { 1 };
+        let samples = params.msaa.samples(self.renderer.samples);
         self.renderer.prepare(&self.device, &self.queue, &self.state, &view);
         let b = linear_rgba(params.background);
         let clear = wgpu::Color { r: f64::from(b[0]), g: f64::from(b[1]), b: f64::from(b[2]), a: 1.0 };

@@ -2,6 +2,7 @@
 //! blocks built from them.
 
 use crate::params::{InputRole, ParamDecl, ParamValue, Text};
+use crate::techniques::Msaa;
 
 /// Most grid cells (the cell grows past the reach before the grid grows past this).
 pub const MAX_CELLS: u32 = 1 << 21;
@@ -35,16 +36,6 @@ crate::param_enum! {
         Tubes = "Tubes",
         /// Lit tubes with glowing tips.
         TubesLit = "TubesLit",
-    }
-}
-
-crate::param_enum! {
-    /// Multisampling of the draw.
-    pub enum Msaa {
-        /// One sample.
-        Off = "off",
-        /// The scene's samples.
-        On = "on",
     }
 }
 

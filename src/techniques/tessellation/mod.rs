@@ -22,8 +22,7 @@ mod params;
 pub mod reference;
 
 pub use params::{
-    Channel, Msaa, PLANE_SIZE, Rasterizer, Settings, TessUniforms, View, camera, edge_count, frustum_planes, model,
-    params,
+    Channel, PLANE_SIZE, Rasterizer, Settings, TessUniforms, View, camera, edge_count, frustum_planes, model, params,
 };
 
 use std::cell::RefCell;
@@ -395,7 +394,7 @@ impl Technique for Tessellation {
         self.last = Some(u);
         self.draw_groups.get_mut().begin_frame();
         let settings = Settings::read(params);
-        let samples = if settings.msaa == Msaa::On { self.samples } else { 1 };
+        let samples = settings.msaa.samples(self.samples);
         self.drew_in_compute = settings.rasterizer == Rasterizer::Compute
             && self.compute_raster.as_mut().is_some_and(|r| r.get_mut().prepare(&self.queue, size, samples, u.grid));
 

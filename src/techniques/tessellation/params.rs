@@ -4,7 +4,7 @@
 use glam::{Mat4, Vec3, Vec4};
 
 use crate::params::{ParamDecl, ParamSet, ParamValue};
-use crate::techniques::srgb_to_linear;
+use crate::techniques::{Msaa, srgb_to_linear};
 
 /// The base plane's side, world units (Unity's Plane).
 pub const PLANE_SIZE: f32 = 10.0;
@@ -18,16 +18,6 @@ crate::param_enum! {
         Wireframe = "wireframe",
         /// The tessellation level as colour.
         Level = "level",
-    }
-}
-
-crate::param_enum! {
-    /// Multisampling of the surface.
-    pub enum Msaa {
-        /// One sample.
-        Off = "off",
-        /// The scene's samples.
-        On = "on",
     }
 }
 
