@@ -99,6 +99,10 @@ struct RunKey {
     seed: i32,
 }
 
+/// The most memory one run may take: its grid, and every sample it can hold on the CPU and the
+/// GPU. Each setting's range alone allows 10⁴ × 10⁴ × 10⁴ at radius 0.5, 4·10¹³ grid cells.
+pub const RUN_BUDGET: u64 = 512 << 20;
+
 impl RunKey {
     fn of(p: &Settings) -> Self {
         Self {
@@ -109,13 +113,12 @@ impl RunKey {
             seed: p.seed,
         }
     }
-}
 
-/// The most memory one run may take: its grid, and every sample it can hold on the CPU and the
-/// GPU. Each setting's range alone allows 10⁴ × 10⁴ × 10⁴ at radius 0.5, 4·10¹³ grid cells.
-pub const RUN_BUDGET: u64 = 512 << 20;
+    /// Whether a run of these settings fits [`RUN_BUDGET`].
+    fn fits(&self) -> bool {
+        self.cost() <= RUN_BUDGET as f64
+    }
 
-impl RunKey {
     /// The bytes a run of these settings may take at most: 4 per grid cell, and per sample its
     /// point (8 per dimension), its instance (16) and active-list entry (8), for the most samples
     /// r apart the box can hold (discs of radius r/2 packed into the box grown by r).
@@ -136,7 +139,7 @@ impl RunKey {
 
     /// These settings, or with the least radius that fits [`RUN_BUDGET`] (a message says so).
     fn within_budget(mut self) -> (Self, Option<String>) {
-        if self.cost() <= RUN_BUDGET as f64 {
+        if self.fits() {
             return (self, None);
         }
         let asked = self.radius;
@@ -144,7 +147,7 @@ impl RunKey {
         for _ in 0..60 {
             let mid = (lo + hi) / 2.0;
             self.radius = mid as f32;
-            if self.cost() <= RUN_BUDGET as f64 { hi = mid } else { lo = mid }
+            if self.fits() { hi = mid } else { lo = mid }
         }
         self.radius = hi as f32;
         let message = format!(
@@ -161,10 +164,10 @@ impl RunKey {
 /// Refuses settings whose run would pass [`RUN_BUDGET`] (see [`TechniqueInfo::check`]).
 fn check_settings(params: &ParamSet) -> Result<(), String> {
     let key = RunKey::of(&Settings::read(params));
-    let cost = key.cost();
-    if cost <= RUN_BUDGET as f64 {
+    if key.fits() {
         return Ok(());
     }
+    let cost = key.cost();
     Err(format!(
         "radius {} in a box of {:?} ({}) needs about {:.0} MiB, more than the {} MiB a Poisson run may take: raise the radius or shrink the extent",
         key.radius,
