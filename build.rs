@@ -1,4 +1,4 @@
-//! Embeds every file of `shaders/` and `scenes/` into the binary as a fallback, so that adding a
+//! Embeds every file of `shaders/`, `scenes/` and `shows/` into the binary as a fallback, so that adding a
 //! technique means adding files, not editing a list of `include_str!`s.
 
 use std::{env, fs, path::Path};
@@ -7,7 +7,7 @@ fn main() {
     let manifest = env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR");
     let out = Path::new(&env::var("OUT_DIR").expect("cargo sets OUT_DIR")).join("embedded.rs");
     let mut code = String::new();
-    for (dir, ext, konst) in [("shaders", "wgsl", "SHADERS"), ("scenes", "ron", "SCENES")] {
+    for (dir, ext, konst) in [("shaders", "wgsl", "SHADERS"), ("scenes", "ron", "SCENES"), ("shows", "ron", "SHOWS")] {
         println!("cargo:rerun-if-changed={dir}");
         let mut names: Vec<String> = fs::read_dir(Path::new(&manifest).join(dir))
             .map(|entries| {

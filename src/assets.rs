@@ -18,6 +18,8 @@ pub enum AssetKind {
     Shader,
     /// RON scene files in `scenes/`.
     Scene,
+    /// RON show files in `shows/`: layers of clips, transitions and a cue list.
+    Show,
 }
 
 impl AssetKind {
@@ -26,6 +28,7 @@ impl AssetKind {
         match self {
             AssetKind::Shader => "shaders",
             AssetKind::Scene => "scenes",
+            AssetKind::Show => "shows",
         }
     }
 
@@ -33,7 +36,7 @@ impl AssetKind {
     pub fn ext(self) -> &'static str {
         match self {
             AssetKind::Shader => "wgsl",
-            AssetKind::Scene => "ron",
+            AssetKind::Scene | AssetKind::Show => "ron",
         }
     }
 
@@ -41,6 +44,7 @@ impl AssetKind {
         match self {
             AssetKind::Shader => embedded::SHADERS,
             AssetKind::Scene => embedded::SCENES,
+            AssetKind::Show => embedded::SHOWS,
         }
     }
 }

@@ -267,7 +267,11 @@ fn with_scene_folder(assets: &Assets, name: &str) -> Assets {
 
 /// Loads a scene and applies `--set` assignments.
 fn scene_with_sets(assets: &Assets, name: &str, sets: &[String], msaa: Option<u32>) -> Result<Scene, String> {
-    let mut scene = load_scene(assets, name).map_err(|e| e.to_string())?;
+    with_sets(load_scene(assets, name).map_err(|e| e.to_string())?, sets, msaa)
+}
+
+/// Applies `--set` assignments and `--msaa` to a loaded scene.
+fn with_sets(mut scene: Scene, sets: &[String], msaa: Option<u32>) -> Result<Scene, String> {
     for assignment in sets {
         scene.set_from_str(assignment)?;
     }
@@ -287,7 +291,15 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
     // A live show never waits for a file a parameter names: it loads in the background.
     let assets = &with_scene_folder(assets, &args.scene).with_load_wait(indra::files::LoadWait::Background);
     let mut notices = Vec::new();
-    let mut scene = match scene_with_sets(assets, &args.scene, &args.sets, args.msaa) {
+    // A show plays what it can: a clip whose scene is missing or broken is left out and told.
+    let loaded = if indra::scene::names_a_show(&args.scene) {
+        indra::scene::show::load_show(assets, &args.scene, true)
+            .map_err(|e| e.to_string())
+            .and_then(|scene| with_sets(scene, &args.sets, args.msaa))
+    } else {
+        scene_with_sets(assets, &args.scene, &args.sets, args.msaa)
+    };
+    let mut scene = match loaded {
         Ok(scene) => scene,
         Err(e) => match scene_with_sets(&assets.builtin_only(), &args.scene, &args.sets, args.msaa) {
             Ok(builtin) => {
@@ -449,16 +461,24 @@ pub fn check(assets: &Assets, files: &[PathBuf]) -> Result<(), String> {
     if files.is_empty() {
         targets.extend(assets.names(AssetKind::Shader).into_iter().map(|n| (AssetKind::Shader, n)));
         targets.extend(assets.names(AssetKind::Scene).into_iter().map(|n| (AssetKind::Scene, n)));
+        targets.extend(assets.names(AssetKind::Show).into_iter().map(|n| (AssetKind::Show, format!("shows/{n}"))));
     } else {
         for f in files {
-            let kind = if f.extension().is_some_and(|e| e == "wgsl") { AssetKind::Shader } else { AssetKind::Scene };
-            targets.push((kind, f.display().to_string()));
+            let name = f.display().to_string();
+            let kind = if f.extension().is_some_and(|e| e == "wgsl") {
+                AssetKind::Shader
+            } else if indra::scene::names_a_show(&name) {
+                AssetKind::Show
+            } else {
+                AssetKind::Scene
+            };
+            targets.push((kind, name));
         }
     }
     let mut failures = 0;
     for (kind, name) in &targets {
         let result = match kind {
-            AssetKind::Scene => load_scene(assets, name).map(|_| ()).map_err(|e| e.to_string()),
+            AssetKind::Scene | AssetKind::Show => load_scene(assets, name).map(|_| ()).map_err(|e| e.to_string()),
             AssetKind::Shader => read_shader(assets, name).and_then(|(origin, source)| {
                 // A base is looked for beside the file first, then among the project's shaders.
                 let beside = |base: &str| Path::new(name).with_file_name(base).display().to_string();
@@ -488,14 +508,19 @@ fn read_shader(assets: &Assets, name: &str) -> Result<(String, String), String> 
     assets.load(AssetKind::Shader, name).map(|a| (a.origin, a.source))
 }
 
-/// Lists scenes with their nodes and parameters.
+/// Lists scenes and shows with their nodes and parameters.
 pub fn list(assets: &Assets) -> Result<(), String> {
-    for name in assets.names(AssetKind::Scene) {
+    let scenes = assets.names(AssetKind::Scene).into_iter();
+    let shows = assets.names(AssetKind::Show).into_iter().map(|n| format!("shows/{n}"));
+    for name in scenes.chain(shows) {
         match load_scene(assets, &name) {
             Err(e) => say!("{name}: INVALID\n{e}\n"),
             Ok(scene) => {
                 let stem = name.trim_end_matches(".ron");
                 say!("{stem} — {} ({}x{}): {}", scene.name, scene.size.0, scene.size.1, scene.description);
+                if let Some(show) = &scene.show {
+                    list_show(show);
+                }
                 for (i, node) in scene.nodes.iter().enumerate() {
                     say!("  node {} ({})", node.id, node.technique.name);
                     for (p, decl) in node.params.decls().iter().enumerate() {
@@ -516,6 +541,20 @@ pub fn list(assets: &Assets) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// A show's layers, clips (with their trigger addresses) and cues.
+fn list_show(show: &indra::scene::show::Show) {
+    for (l, layer) in show.layers.iter().enumerate() {
+        say!("  layer {} '{}': /indra/layer/{}/opacity, /indra/layer/{}/blend", l + 1, layer.name, l + 1, l + 1);
+        for (c, &clip) in layer.clips.iter().enumerate() {
+            let clip = &show.clips[clip];
+            say!("    clip {} {} ({}): /indra/layer/{}/clip/{}/connect", c + 1, clip.id, clip.scene, l + 1, c + 1);
+        }
+    }
+    for (i, cue) in show.cues.iter().enumerate() {
+        say!("  cue {} {}", i + 1, cue.name);
+    }
 }
 
 /// Renders `frames` frames and prints per-pass GPU medians and frame time.

@@ -14,6 +14,15 @@ pub struct FrameTime {
     pub seed: u64,
 }
 
+impl FrameTime {
+    /// This time on a clock that started at frame `start` (a show's clip, restarted when
+    /// triggered): frame and seconds counted from there, the same step and seed.
+    pub fn since(&self, start: u64) -> FrameTime {
+        let frame = self.frame.saturating_sub(start);
+        FrameTime { frame, seconds: frame as f64 * f64::from(self.dt), ..*self }
+    }
+}
+
 /// A fixed-step clock.
 #[derive(Clone, Debug)]
 pub struct FixedClock {

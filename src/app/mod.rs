@@ -5,6 +5,7 @@
 
 mod outputs;
 mod panel;
+mod show_panel;
 mod surface;
 mod window;
 

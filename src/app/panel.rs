@@ -178,6 +178,7 @@ pub fn draw_ui(
                     events.extend(audio_panel(ui, &frame));
                 }
                 ui.small(hub.status());
+                events.extend(super::show_panel::show_panel(ui, instance));
                 events.extend(param_panel(ui, instance, hub).into_iter().map(ControlEvent::Write));
                 ui.separator();
                 events.extend(preset_panel(ui, instance, overlay, hub));
@@ -185,7 +186,7 @@ pub fn draw_ui(
                 record_panel(ui, overlay);
                 ui.separator();
                 timing_panel(ui, overlay);
-                ui.small("F1: hide panel · F2: resume tracks · 1–9: presets · F11: fullscreen · Esc: leave fullscreen");
+                ui.small("F1: hide panel · F2: resume tracks · 1–9: presets · space: GO (shows) · F11: fullscreen · Esc: leave fullscreen");
             });
         });
     }
@@ -243,6 +244,14 @@ fn preset_panel(
 fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub) -> Vec<ParamWrite> {
     let mut writes = Vec::new();
     for node in 0..instance.scene().nodes.len() {
+        // A show lists the nodes of the clips on screen; its faders are in the show panel.
+        if let Some((show, state)) = instance.show()
+            && (show.clip_of(node).is_some_and(|c| !state.visible(c))
+                || show.layer_of_node(node).is_some()
+                || node == show.master)
+        {
+            continue;
+        }
         let header = format!("{} ({})", instance.scene().nodes[node].id, instance.scene().nodes[node].technique.name);
         egui::CollapsingHeader::new(header).default_open(true).show(ui, |ui| {
             for (p, decl) in instance.params(node).decls().iter().enumerate() {
@@ -342,7 +351,8 @@ fn audio_learn_button(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut Con
 }
 
 /// One widget per parameter type; returns whether the value changed.
-fn param_widget(ui: &mut egui::Ui, decl: &ParamDecl, value: &mut ParamValue) -> bool {
+/// The widget of one parameter by its type; whether the performer changed it.
+pub(super) fn param_widget(ui: &mut egui::Ui, decl: &ParamDecl, value: &mut ParamValue) -> bool {
     let (lo, hi) = decl.range.unwrap_or((-1e6, 1e6));
     match value {
         // Wide positive ranges (zoom, radius) need a logarithmic slider to be playable.

@@ -300,6 +300,10 @@ impl ApplicationHandler for WindowApp {
                 }
                 NamedKey::F1 => r.overlay.panel_visible = !r.overlay.panel_visible,
                 NamedKey::F2 => r.ui_events.push(ControlEvent::ResumeTracks),
+                // Space is GO in a show with a cue list (not while typing in the panel).
+                NamedKey::Space if !consumed && r.player.instance().show().is_some_and(|(s, _)| !s.cues.is_empty()) => {
+                    r.ui_events.push(ControlEvent::Show(crate::params::ShowCommand::CueGo));
+                }
                 // Esc leaves fullscreen and nothing else: a stray key must not end a show.
                 NamedKey::Escape if !consumed => r.window.set_fullscreen(None),
                 _ => {}

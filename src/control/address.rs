@@ -8,7 +8,7 @@
 use std::collections::HashMap;
 
 use crate::params::ParamType;
-use crate::params::Target;
+use crate::params::{ShowCommand, Target};
 use crate::scene::Scene;
 
 /// Engine commands with fixed addresses.
@@ -28,6 +28,8 @@ pub enum Command {
     TempoBpm,
     /// `/indra/tempo/tap`: a tap of tap tempo.
     TempoTap,
+    /// `/indra/cue/goto i|s`: a show's cue by number (from 1) or name.
+    CueGoto,
 }
 
 /// What an address resolves to.
@@ -37,6 +39,8 @@ pub enum Route {
     Param(Target),
     /// An engine command.
     Command(Command),
+    /// A show's clip, column or cue command (the address holds its numbers).
+    Show(ShowCommand),
 }
 
 /// The address tree of one scene.
@@ -76,6 +80,24 @@ impl AddressMap {
         routes.insert("/indra/record/stop".into(), Route::Command(Command::RecordStop));
         routes.insert("/indra/tempo/bpm".into(), Route::Command(Command::TempoBpm));
         routes.insert("/indra/tempo/tap".into(), Route::Command(Command::TempoTap));
+        if let Some(show) = &scene.show {
+            for (l, layer) in show.layers.iter().enumerate() {
+                for c in 0..layer.clips.len() {
+                    let trigger = ShowCommand::Trigger { layer: l, clip: Some(c) };
+                    routes.insert(format!("/indra/layer/{}/clip/{}/connect", l + 1, c + 1), Route::Show(trigger));
+                }
+                let clear = ShowCommand::Trigger { layer: l, clip: None };
+                routes.insert(format!("/indra/layer/{}/clear", l + 1), Route::Show(clear));
+            }
+            for c in 0..show.columns.len() {
+                routes.insert(format!("/indra/column/{}/connect", c + 1), Route::Show(ShowCommand::Column(c)));
+            }
+            if !show.cues.is_empty() {
+                routes.insert("/indra/cue/go".into(), Route::Show(ShowCommand::CueGo));
+                routes.insert("/indra/cue/back".into(), Route::Show(ShowCommand::CueBack));
+                routes.insert("/indra/cue/goto".into(), Route::Command(Command::CueGoto));
+            }
+        }
         Self { routes }
     }
 
@@ -94,7 +116,7 @@ impl AddressMap {
             .iter()
             .filter_map(|(address, route)| match route {
                 Route::Param(t) => Some((address, *t)),
-                Route::Command(_) => None,
+                Route::Command(_) | Route::Show(_) => None,
             })
             .filter(|(address, _)| {
                 rosc::address::OscAddress::new((*address).clone()).is_ok_and(|a| matcher.match_address(&a))

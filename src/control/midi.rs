@@ -114,6 +114,20 @@ impl MidiParser {
     }
 }
 
+/// The clips a note-on triggers: each show clip whose `note` (and channel, if given) it is.
+pub fn clip_triggers(event: MidiEvent, scene: &Scene) -> Vec<crate::params::ShowCommand> {
+    let (MidiEvent::NoteOn { channel, note, .. }, Some(show)) = (event, &scene.show) else { return Vec::new() };
+    show.layers
+        .iter()
+        .enumerate()
+        .flat_map(|(l, layer)| layer.clips.iter().enumerate().map(move |(c, &clip)| (l, c, clip)))
+        .filter(|&(_, _, clip)| {
+            show.clips[clip].note.is_some_and(|(ch, n)| n == note && ch.is_none_or(|ch| ch == channel))
+        })
+        .map(|(layer, c, _)| crate::params::ShowCommand::Trigger { layer, clip: Some(c) })
+        .collect()
+}
+
 /// Tempo from MIDI clock (24 pulses per quarter note) and transport state.
 #[derive(Debug, Default)]
 pub struct MidiClock {

@@ -14,7 +14,7 @@ use std::time::{Duration, SystemTime};
 use rosc::{OscMessage, OscPacket, OscType};
 
 use super::address::{AddressMap, Command, Route, is_pattern};
-use crate::params::{ControlEvent, ParamDecl, ParamType, ParamValue, ParamWrite, Source, Target};
+use crate::params::{ControlEvent, ParamDecl, ParamType, ParamValue, ParamWrite, ShowCommand, Source, Target};
 use crate::scene::Scene;
 
 /// What went in and what was rejected, shared between the receiver thread and the render loop.
@@ -385,6 +385,8 @@ pub enum Routed {
     Record(RecordRequest),
     /// A tap of tap tempo (timed where it is received).
     TapTempo,
+    /// Accepted, nothing to do: a trigger button's release (`connect 0`).
+    Released,
 }
 
 /// Start or stop recording the show to a video file.
@@ -469,8 +471,10 @@ impl OscRouter {
             return None;
         };
         let routed = match route {
+            Route::Command(Command::CueGoto) => cue_goto(&msg.args, scene),
             Route::Command(command) => route_command(command, &msg.args),
             Route::Param(t) => write_for(t, &msg.args, scene),
+            Route::Show(command) => show_trigger(command, &msg.args),
         };
         count(routed.is_some(), msg, rx);
         routed
@@ -530,7 +534,34 @@ fn route_command(command: Command, args: &[OscType]) -> Option<Routed> {
             .filter(|n| n.len() == 1 && n[0].is_finite())
             .map(|n| Routed::Event(ControlEvent::Tempo { bpm: n[0], resync: false })),
         Command::TempoTap => Some(Routed::TapTempo),
+        // Needs the show to resolve a name: see `cue_goto`.
+        Command::CueGoto => None,
     }
+}
+
+/// A show trigger: with no argument, or a true / non-zero one (a button's press); a false or
+/// zero one is its release (Resolume's `connect 1` then `connect 0`).
+fn show_trigger(command: ShowCommand, args: &[OscType]) -> Option<Routed> {
+    let pressed = match args.first() {
+        None => true,
+        Some(OscType::Bool(b)) => *b,
+        Some(_) => numbers(&args[..1]).is_some_and(|n| n[0] != 0.0 && n[0].is_finite()),
+    };
+    Some(if pressed { Routed::Event(ControlEvent::Show(command)) } else { Routed::Released })
+}
+
+/// `/indra/cue/goto i|s`: the cue numbered from 1 or named.
+fn cue_goto(args: &[OscType], scene: &Scene) -> Option<Routed> {
+    let show = scene.show.as_ref()?;
+    let cue = match args {
+        [OscType::String(name)] => show.cue_named(name),
+        [other] => numbers(std::slice::from_ref(other))
+            .map(|n| n[0])
+            .filter(|n| n.fract() == 0.0 && *n >= 1.0 && *n <= show.cues.len() as f64)
+            .map(|n| n as usize - 1),
+        _ => None,
+    }?;
+    Some(Routed::Event(ControlEvent::Show(ShowCommand::CueGoto(cue))))
 }
 
 /// Numeric arguments as f64 (f, d, i, h, T/F); `None` if any is not numeric.

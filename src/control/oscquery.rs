@@ -49,10 +49,19 @@ fn range_json(decl: &ParamDecl) -> Option<Value> {
     Some(Value::Array(vec![json!({ "MIN": lo, "MAX": hi }); decl.ty().components()]))
 }
 
-/// The whole address tree of `instance` with current values.
+/// The whole address tree of `instance` with current values. Node ids with `/` (a show's
+/// `<clip>/<node>`, `layer/<n>`) nest as their addresses do. A show's tree holds its layers, the
+/// master, the trigger addresses of every clip, column and cue, and the parameters of the clips
+/// on screen — a clip change alters it (see [`shown_clips`]); a hidden clip's parameters still
+/// take writes at their addresses.
 pub fn tree(instance: SceneView<'_>) -> Value {
-    let mut nodes = Map::new();
+    let mut root = Map::new();
     for (n, node) in instance.scene.nodes.iter().enumerate() {
+        if let Some((show, state)) = instance.show
+            && show.clip_of(n).is_some_and(|c| !state.visible(c))
+        {
+            continue;
+        }
         let params = instance.params(n);
         let mut contents = Map::new();
         for (p, decl) in params.decls().iter().enumerate() {
@@ -67,16 +76,73 @@ pub fn tree(instance: SceneView<'_>) -> Value {
             leaf.insert("DESCRIPTION".into(), json!(decl.doc));
             contents.insert(decl.name.clone(), Value::Object(leaf));
         }
-        let path = format!("/indra/{}", node.id);
-        nodes.insert(
-            node.id.clone(),
-            json!({ "FULL_PATH": path, "CONTENTS": contents, "DESCRIPTION": node.technique.summary }),
-        );
+        let container = container_at(&mut root, &node.id, "/indra");
+        container.insert("DESCRIPTION".into(), json!(node.technique.summary));
+        contents_of(container).extend(contents);
+    }
+    if let Some((show, _)) = instance.show {
+        let trigger = |path: String, description: String| json!({ "FULL_PATH": format!("/indra/{path}"), "TYPE": "I", "ACCESS": 2, "DESCRIPTION": description });
+        let mut put = |path: String, leaf: Value| {
+            let (parent, name) = path.rsplit_once('/').unwrap_or(("", &path));
+            let name = name.to_string();
+            let container =
+                if parent.is_empty() { &mut root } else { contents_of(container_at(&mut root, parent, "/indra")) };
+            container.insert(name, leaf);
+        };
+        for (l, layer) in show.layers.iter().enumerate() {
+            for (c, &clip) in layer.clips.iter().enumerate() {
+                let path = format!("layer/{}/clip/{}/connect", l + 1, c + 1);
+                put(path.clone(), trigger(path, format!("play {} on {}", show.clips[clip].id, layer.name)));
+            }
+            let path = format!("layer/{}/clear", l + 1);
+            put(path.clone(), trigger(path, format!("empty {}", layer.name)));
+        }
+        for (c, name) in show.columns.iter().enumerate() {
+            let path = format!("column/{}/connect", c + 1);
+            put(path.clone(), trigger(path, format!("play column {name}")));
+        }
+        if !show.cues.is_empty() {
+            put("cue/go".into(), trigger("cue/go".into(), "the next cue".into()));
+            put("cue/back".into(), trigger("cue/back".into(), "the previous cue".into()));
+            let names: Vec<&str> = show.cues.iter().map(|c| c.name.as_str()).collect();
+            let goto = json!({ "FULL_PATH": "/indra/cue/goto", "TYPE": "s", "ACCESS": 2,
+                "RANGE": [{ "VALS": names }], "DESCRIPTION": "a cue by name (or its number, from 1)" });
+            put("cue/goto".into(), goto);
+        }
     }
     json!({
         "FULL_PATH": "/",
-        "CONTENTS": { "indra": { "FULL_PATH": "/indra", "CONTENTS": nodes, "DESCRIPTION": instance.scene.name } }
+        "CONTENTS": { "indra": { "FULL_PATH": "/indra", "CONTENTS": root, "DESCRIPTION": instance.scene.name } }
     })
+}
+
+/// The clips a show's tree holds now (those on screen); empty for a scene.
+pub fn shown_clips(instance: SceneView<'_>) -> Vec<usize> {
+    instance.show.map_or_else(Vec::new, |(show, state)| (0..show.clips.len()).filter(|&c| state.visible(c)).collect())
+}
+
+/// The container at `path` (segments under `parent`, a full path) in `map`, made as needed.
+fn container_at<'m>(map: &'m mut Map<String, Value>, path: &str, parent: &str) -> &'m mut Map<String, Value> {
+    let (head, rest) = path.split_once('/').map_or((path, None), |(h, r)| (h, Some(r)));
+    let full = format!("{parent}/{head}");
+    let entry = map.entry(head.to_string()).or_insert_with(|| json!({ "FULL_PATH": full.clone(), "CONTENTS": {} }));
+    if !entry.is_object() {
+        *entry = json!({ "FULL_PATH": full.clone(), "CONTENTS": {} });
+    }
+    let object = entry.as_object_mut().expect("made an object above");
+    match rest {
+        None => object,
+        Some(rest) => container_at(contents_of(object), rest, &full),
+    }
+}
+
+/// The CONTENTS map of a container (made if missing).
+fn contents_of(container: &mut Map<String, Value>) -> &mut Map<String, Value> {
+    let contents = container.entry("CONTENTS").or_insert_with(|| json!({}));
+    if !contents.is_object() {
+        *contents = json!({});
+    }
+    contents.as_object_mut().expect("made an object above")
 }
 
 /// The HOST_INFO reply.
@@ -105,6 +171,8 @@ pub struct OscQueryServer {
     listeners: Arc<Listeners>,
     /// The scene changed: publish and announce it after the next frame.
     path_changed: bool,
+    /// The show's clips the published tree holds.
+    shown: Vec<usize>,
     server: HttpServer,
     /// Kept for its lifetime: dropping it withdraws the advertisement.
     _advertisement: Option<Advertisement>,
@@ -148,7 +216,7 @@ impl OscQueryServer {
                 None
             }
         };
-        Ok(Self { snapshot, listeners, path_changed: false, server, _advertisement: advertisement })
+        Ok(Self { snapshot, listeners, path_changed: false, shown: Vec::new(), server, _advertisement: advertisement })
     }
 
     /// The bound address.
@@ -174,6 +242,12 @@ impl OscQueryServer {
     /// [`super::feedback::ParamChanges`]) for the controllers listening to them. Returns how many
     /// messages were queued.
     pub fn after_frame(&mut self, instance: SceneView<'_>, publish: bool, changes: &[OscMessage]) -> usize {
+        // A show's tree holds the clips on screen: a clip change is a namespace change.
+        let shown = shown_clips(instance);
+        if shown != self.shown {
+            self.shown = shown;
+            self.path_changed = true;
+        }
         if publish || self.path_changed {
             self.publish(instance);
         }

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::params::{ControlEvent, ParamWrite, RawValue, Source, raw_from_value, value_from_raw};
+use crate::params::{ControlEvent, ParamWrite, RawValue, ShowCommand, Source, raw_from_value, value_from_raw};
 use crate::scene::Scene;
 
 /// One line of a control-stream file.
@@ -61,6 +61,8 @@ pub enum RecordedEvent {
         /// Beats per bar.
         quantum: f64,
     },
+    /// A show command (clip, column or cue), numbered from 0.
+    Show(ShowCommand),
 }
 
 /// Writes events as they are applied — into a temporary file beside the target, renamed over it
@@ -150,6 +152,7 @@ fn to_recorded(event: &ControlEvent, scene: &Scene) -> Option<RecordedEvent> {
         ControlEvent::ResumeTracks => RecordedEvent::ResumeTracks,
         ControlEvent::Tempo { bpm, resync } => RecordedEvent::Tempo { bpm: *bpm, resync: *resync },
         ControlEvent::Phase { phase, quantum } => RecordedEvent::Phase { phase: *phase, quantum: *quantum },
+        ControlEvent::Show(command) => RecordedEvent::Show(*command),
     })
 }
 
@@ -226,5 +229,7 @@ fn from_recorded(event: &RecordedEvent, scene: &Scene) -> Result<ControlEvent, S
         RecordedEvent::Phase { phase, quantum } => {
             ControlEvent::Phase { phase: finite("phase", *phase)?, quantum: finite("quantum", *quantum)? }
         }
+        // Numbers past the show's layers, clips or cues are refused where the show applies them.
+        RecordedEvent::Show(command) => ControlEvent::Show(*command),
     })
 }

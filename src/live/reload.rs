@@ -8,6 +8,7 @@ use super::watcher::{Watcher, read_stable};
 use crate::assets::{Asset, AssetKind, Assets};
 use crate::gpu::{Gpu, JoinedSource};
 use crate::params::Remap;
+use crate::scene::show::parse_show;
 use crate::scene::{Player, SceneInstance, parse_scene};
 
 /// What one poll did.
@@ -49,9 +50,10 @@ struct AppliedShader {
 }
 
 impl LiveReload {
-    /// Watches `assets`' `shaders/` and `scenes/` folders (if it has a root on disk).
+    /// Watches `assets`' `shaders/`, `scenes/` and `shows/` folders (if it has a root on disk).
     pub fn new(assets: &Assets) -> Result<Self, String> {
-        let dirs: Vec<PathBuf> = [AssetKind::Shader, AssetKind::Scene].iter().filter_map(|k| assets.dir(*k)).collect();
+        let kinds = [AssetKind::Shader, AssetKind::Scene, AssetKind::Show];
+        let dirs: Vec<PathBuf> = kinds.iter().filter_map(|k| assets.dir(*k)).collect();
         let watcher = if dirs.iter().any(|d| d.is_dir()) { Some(Watcher::watch(&dirs)?) } else { None };
         let running = assets.with_shaders_pinned();
         Ok(Self { watcher, running, broken: BTreeMap::new(), newest: None, stalled: BTreeMap::new() })
@@ -178,13 +180,29 @@ impl LiveReload {
         size: (u32, u32),
         report: &mut ReloadReport,
     ) -> Result<bool, String> {
-        let running = Path::new(&instance.scene().origin);
-        let same = running.canonicalize().ok().zip(path.canonicalize().ok()).is_some_and(|(a, b)| a == b);
-        if !same {
-            return Ok(false);
-        }
-        let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let scene = parse_scene(&path.display().to_string(), &source).map_err(|e| e.to_string())?;
+        let same_file = |origin: &str| {
+            let running = Path::new(origin);
+            running.canonicalize().ok().zip(path.canonicalize().ok()).is_some_and(|(a, b)| a == b)
+        };
+        let scene = match &instance.scene().show {
+            // A show reloads when its file or one of its clips' scenes changes; a clip that
+            // breaks keeps the whole show as it was (its last good version plays on).
+            Some(show) => {
+                if !show.sources.iter().any(|s| same_file(s)) {
+                    return Ok(false);
+                }
+                let origin = instance.scene().origin.clone();
+                let source = read_stable(Path::new(&origin)).map_err(|e| format!("{origin}: {e}"))?;
+                parse_show(&self.running, &origin, &source, false).map_err(|e| e.to_string())?
+            }
+            None => {
+                if !same_file(&instance.scene().origin) {
+                    return Ok(false);
+                }
+                let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
+                parse_scene(&path.display().to_string(), &source).map_err(|e| e.to_string())?
+            }
+        };
         let remap = instance.replace_scene(scene, gpu, &self.running, size).map_err(|e| e.to_string())?;
         report.scene_changed = true;
         report.remap = Some(remap);

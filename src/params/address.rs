@@ -49,6 +49,29 @@ pub enum ControlEvent {
         /// Beats per bar.
         quantum: f64,
     },
+    /// A show command: trigger a clip or a column, move through the cue list.
+    Show(ShowCommand),
+}
+
+/// What a performer asks of a show's clips and cues. Layers, clips, columns and cues are
+/// numbered from 0 here (from 1 in OSC addresses and on the panel).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum ShowCommand {
+    /// Start clip `clip` on layer `layer` through its transition (`None`: empty the layer).
+    Trigger {
+        /// The layer.
+        layer: usize,
+        /// The clip within the layer.
+        clip: Option<usize>,
+    },
+    /// Trigger clip `n` on every layer that has one (a Resolume column).
+    Column(usize),
+    /// The next cue (the first, before any).
+    CueGo,
+    /// The previous cue.
+    CueBack,
+    /// Cue `n`.
+    CueGoto(usize),
 }
 
 impl ControlEvent {
@@ -66,7 +89,7 @@ impl ControlEvent {
                 seconds: *seconds,
             }),
             ControlEvent::ResumeTracks => Some(ControlEvent::ResumeTracks),
-            ControlEvent::Tempo { .. } | ControlEvent::Phase { .. } => Some(self.clone()),
+            ControlEvent::Tempo { .. } | ControlEvent::Phase { .. } | ControlEvent::Show(_) => Some(self.clone()),
         }
     }
 }

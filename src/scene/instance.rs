@@ -10,6 +10,7 @@
 use std::collections::BTreeSet;
 
 use super::load::Scene;
+use super::show::{Show, ShowRuntime, ShowState};
 use crate::assets::Assets;
 use crate::gpu::{Gpu, ShaderError};
 use crate::graph::{FrameGraph, FrameOutput, GraphError, GraphRuntime};
@@ -29,6 +30,8 @@ pub struct SceneView<'a> {
     pub params: &'a [ParamSet],
     /// The show's tempo and beat position.
     pub tempo: TempoClock,
+    /// A show's plan and play state (`None` for a scene).
+    pub show: Option<(&'a Show, &'a ShowState)>,
 }
 
 impl<'a> SceneView<'a> {
@@ -53,6 +56,8 @@ pub struct SceneInstance {
     /// Parameters a non-finite value was refused for (each told once), and the messages.
     refused: BTreeSet<(usize, usize)>,
     messages: Vec<String>,
+    /// A show's clips, transitions and cues (`None` for a scene).
+    show: Option<ShowRuntime>,
 }
 
 impl SceneInstance {
@@ -61,7 +66,13 @@ impl SceneInstance {
         let params: Vec<ParamSet> = scene.nodes.iter().map(|n| n.params.clone()).collect();
         let nodes = create_nodes(&scene, &params, gpu, assets, output_size)?;
         let tempo = TempoClock::new(scene.bpm);
+        let show = ShowRuntime::new(gpu, assets, &scene, output_size)?;
+        let mut messages = Vec::new();
+        for (clip, why) in scene.show.iter().flat_map(|s| &s.broken) {
+            messages.push(format!("clip '{clip}' is left out: {why}"));
+        }
         Ok(Self {
+            show,
             tempo,
             scene,
             params,
@@ -71,13 +82,19 @@ impl SceneInstance {
             morph: None,
             pending_morph: None,
             refused: BTreeSet::new(),
-            messages: Vec::new(),
+            messages,
         })
     }
 
     /// What the control layer reads (see [`SceneView`]).
     pub fn view(&self) -> SceneView<'_> {
-        SceneView { scene: &self.scene, params: &self.params, tempo: self.tempo }
+        let show = self.show.as_ref().map(|s| (s.plan(), s.state()));
+        SceneView { scene: &self.scene, params: &self.params, tempo: self.tempo, show }
+    }
+
+    /// A show's plan and play state (`None` for a scene).
+    pub fn show(&self) -> Option<(&Show, &ShowState)> {
+        self.show.as_ref().map(|s| (s.plan(), s.state()))
     }
 
     /// The validated scene.
@@ -130,6 +147,13 @@ impl SceneInstance {
                 ControlEvent::ResumeTracks => self.overridden.clear(),
                 ControlEvent::Tempo { bpm, resync } => self.tempo.set(*bpm, *resync),
                 ControlEvent::Phase { phase, quantum } => self.tempo.align(*phase, *quantum),
+                ControlEvent::Show(command) => {
+                    let refused = match &mut self.show {
+                        Some(show) => show.request(*command).err(),
+                        None => Some(format!("{command:?}: '{}' is a scene, not a show", self.scene.name)),
+                    };
+                    self.messages.extend(refused);
+                }
             }
         }
     }
@@ -159,12 +183,17 @@ impl SceneInstance {
 
     /// Runs one fixed step at `time`: tracks, preset morph, smoothing, simulation.
     pub fn advance(&mut self, time: &FrameTime) {
+        if let Some(show) = &mut self.show {
+            let messages = show.step(time, self.tempo.beats, &self.scene, &self.params, &mut self.nodes);
+            self.messages.extend(messages);
+        }
         if self.animate {
             for bound in &self.scene.tracks {
                 if self.overridden.contains(&(bound.node, bound.param)) {
                     continue;
                 }
-                let value = bound.track.sample(time.seconds);
+                let Some(local) = self.node_time(bound.node, time) else { continue };
+                let value = bound.track.sample(local.seconds);
                 let params = &mut self.params[bound.node];
                 // Track values come from validated keys: always finite.
                 let _ = match bound.component {
@@ -179,8 +208,9 @@ impl SceneInstance {
             if self.overridden.contains(&(node, param)) {
                 continue;
             }
+            let Some(local) = self.node_time(node, time) else { continue };
             let key = time.seed ^ (i as u64 + 1).wrapping_mul(0xA24B_AED4_963E_E407);
-            let value = lfo.value(time.seconds, self.tempo.beats, key);
+            let value = lfo.value(local.seconds, self.tempo.beats, key);
             let params = &mut self.params[node];
             // LFO values come from validated, finite ranges.
             let _ = match lfo.target.component {
@@ -209,8 +239,9 @@ impl SceneInstance {
         for params in &mut self.params {
             params.advance(time.dt);
         }
-        for (node, params) in self.nodes.iter_mut().zip(&mut self.params) {
-            node.step(params, time);
+        for (i, (node, params)) in self.nodes.iter_mut().zip(&mut self.params).enumerate() {
+            let Some(local) = self.show.as_ref().map_or(Some(*time), |s| s.node_time(i, time)) else { continue };
+            node.step(params, &local);
             for (name, value) in node.take_loaded_values() {
                 if let Some(i) = params.index(name) {
                     params.set_at(i, value);
@@ -223,6 +254,12 @@ impl SceneInstance {
             params.end_step();
         }
         self.tempo.step(f64::from(time.dt));
+    }
+
+    /// The time node `node` runs at (a show's restart clip: its own clock), or `None` while it
+    /// idles (a hidden restart clip).
+    fn node_time(&self, node: usize, time: &FrameTime) -> Option<FrameTime> {
+        self.show.as_ref().map_or(Some(*time), |s| s.node_time(node, time))
     }
 
     /// Whether any node records simulation work in its passes that every fixed step needs
@@ -247,10 +284,14 @@ impl SceneInstance {
             .iter()
             .map(|&i| create_node(&self.scene, i, &self.params[i], gpu, assets, output_size))
             .collect::<Result<Vec<_>, _>>()?;
+        let mixer_uses = self.show.as_ref().is_some_and(|s| s.uses_shader(name));
+        if let Some(show) = self.show.as_mut().filter(|_| mixer_uses) {
+            show.rebuild_mixer(assets)?;
+        }
         for (i, node) in using.iter().zip(rebuilt) {
             self.nodes[*i] = node;
         }
-        Ok(!using.is_empty())
+        Ok(!using.is_empty() || mixer_uses)
     }
 
     /// Recreates every node on `gpu` (a new device after the old one was lost or hung).
@@ -258,7 +299,13 @@ impl SceneInstance {
     /// initial state, since their state lived on the old device. Either every node builds or
     /// nothing changes and the error is returned.
     pub fn rebuild_all(&mut self, gpu: &Gpu, assets: &Assets, output_size: (u32, u32)) -> Result<(), ShaderError> {
-        self.nodes = create_nodes(&self.scene, &self.params, gpu, assets, output_size)?;
+        let nodes = create_nodes(&self.scene, &self.params, gpu, assets, output_size)?;
+        let show = ShowRuntime::new(gpu, assets, &self.scene, output_size)?;
+        self.nodes = nodes;
+        if let (Some(mut show), Some(old)) = (show, self.show.take()) {
+            show.keep_state(old);
+            self.show = Some(show);
+        }
         Ok(())
     }
 
@@ -286,6 +333,7 @@ impl SceneInstance {
                 None => Some(create_node(&scene, i, &n.params, gpu, assets, output_size)?),
             });
         }
+        let mut show = ShowRuntime::new(gpu, assets, &scene, output_size)?;
         let mut old_nodes: Vec<Option<Box<dyn Technique>>> = self.nodes.drain(..).map(Some).collect();
         let mut params = Vec::with_capacity(scene.nodes.len());
         for (n, new) in scene.nodes.iter().zip(fresh.iter_mut()) {
@@ -311,6 +359,10 @@ impl SceneInstance {
         self.nodes = fresh.into_iter().map(|n| n.expect("every node kept or created")).collect();
         self.params = params;
         self.scene = scene;
+        if let (Some(show), Some(old)) = (&mut show, &self.show) {
+            show.carry_over(old, &self.scene, &self.params);
+        }
+        self.show = show;
         self.overridden.clear();
         self.morph = None;
         self.pending_morph = None;
@@ -419,14 +471,25 @@ impl SceneInstance {
     }
 
     fn declare<'r>(&'r mut self, mut graph: FrameGraph<'r>, time: &FrameTime) -> FrameGraph<'r> {
-        let mut outputs = Vec::with_capacity(self.nodes.len());
-        for (i, node) in self.nodes.iter_mut().enumerate() {
-            let inputs: Vec<_> = self.scene.nodes[i].inputs.iter().map(|&j| outputs[j]).collect();
-            outputs.push(node.add_passes(&mut graph, &self.params[i], time, &inputs));
+        let outputs = match &mut self.show {
+            Some(show) => show.declare(&mut graph, &self.scene, &self.params, &mut self.nodes, time),
+            None => {
+                let mut outputs = Vec::with_capacity(self.nodes.len());
+                for (i, node) in self.nodes.iter_mut().enumerate() {
+                    let inputs: Vec<_> = self.scene.nodes[i].inputs.iter().map(|&j| outputs[j]).collect();
+                    outputs.push(node.add_passes(&mut graph, &self.params[i], time, &inputs));
+                }
+                outputs.into_iter().map(Some).collect()
+            }
+        };
+        // The output and every extra output always run (a show's master, its output warps).
+        if let Some(output) = outputs[self.scene.output] {
+            graph.set_output(output);
         }
-        graph.set_output(outputs[self.scene.output]);
         for extra in &self.scene.outputs {
-            graph.add_extra_output(outputs[extra.node]);
+            if let Some(texture) = outputs[extra.node] {
+                graph.add_extra_output(texture);
+            }
         }
         graph
     }

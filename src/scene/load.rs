@@ -43,6 +43,8 @@ pub struct Scene {
     pub osc_aliases: Vec<(String, Target)>,
     /// MIDI mappings declared in the scene's `controls`.
     pub midi: Vec<(MidiMapping, Target)>,
+    /// For a show: its layers, clips, columns and cues over these nodes (`None`: a scene).
+    pub show: Option<std::sync::Arc<super::show::Show>>,
 }
 
 /// An audio mapping, resolved (see the scene file's `controls.audio`).
@@ -211,7 +213,7 @@ impl Scene {
     /// Adds output `output` (from the scene file's `outputs` or the command line): resolves its
     /// source, puts a warp node `output<n>` in between when it names a warp file, and gives
     /// warped outputs their corner addresses.
-    fn attach_output(&mut self, output: &OutputFile) -> Result<(), String> {
+    pub(crate) fn attach_output(&mut self, output: &OutputFile) -> Result<(), String> {
         let number = self.outputs.len() + 1;
         let main = &self.nodes[self.output].id;
         let source_id = output.source.clone().unwrap_or_else(|| main.clone());
@@ -309,7 +311,13 @@ pub fn parse_value_override(text: &str, decl: &ParamDecl) -> Result<ParamValue, 
 
 /// Loads a scene by name or path: an existing file path is read directly, anything else is
 /// looked up in `scenes/` (disk first, then the built-in copies).
+///
+/// A show (`shows/<name>`, or a file whose top level has `layers`) loads as the flat scene of
+/// all its clips (see [`super::show`]): every command takes shows where it takes scenes.
 pub fn load_scene(assets: &Assets, name_or_path: &str) -> Result<Scene, SceneErrors> {
+    if names_a_show(name_or_path) {
+        return super::show::load_show(assets, name_or_path, false);
+    }
     let path = std::path::Path::new(name_or_path);
     let (origin, source) = if path.is_file() {
         std::fs::read_to_string(path)
@@ -320,6 +328,16 @@ pub fn load_scene(assets: &Assets, name_or_path: &str) -> Result<Scene, SceneErr
         (asset.origin, asset.source)
     };
     parse_scene(&origin, &source)
+}
+
+/// Whether `name_or_path` is a show: under `shows/`, or a file whose top level has `layers`.
+pub fn names_a_show(name_or_path: &str) -> bool {
+    let path = std::path::Path::new(name_or_path);
+    if path.is_file() {
+        return crate::files::read_limited(path, 4 << 20)
+            .is_ok_and(|bytes| super::show::is_show(&String::from_utf8_lossy(&bytes)));
+    }
+    name_or_path.starts_with("shows/")
 }
 
 fn one_error(origin: &str, message: String) -> SceneErrors {
@@ -489,6 +507,7 @@ impl Validator<'_> {
             tracks,
             osc_aliases,
             midi,
+            show: None,
         };
         for o in &file.outputs {
             if let Err(e) = scene.attach_output(o) {

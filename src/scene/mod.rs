@@ -6,12 +6,13 @@ mod instance;
 mod load;
 mod player;
 mod schema;
+pub mod show;
 
 pub use error::{SceneError, SceneErrors};
 pub use instance::{SceneInstance, SceneView};
 pub use load::{
-    AudioMapping, BoundTrack, MAX_NAME_CHARS, Scene, SceneNode, SceneOutput, check_audio, load_scene, parse_scene,
-    parse_value_override, resolve_target,
+    AudioMapping, BoundTrack, MAX_NAME_CHARS, Scene, SceneNode, SceneOutput, check_audio, load_scene, names_a_show,
+    parse_scene, parse_value_override, resolve_target,
 };
 pub use player::{Player, SeekError};
 pub use schema::{

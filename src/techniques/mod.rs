@@ -5,10 +5,13 @@
 //! To add a technique: write `src/techniques/<name>/`, `shaders/<name>.wgsl` and
 //! `scenes/<name>.ron`, then add its `INFO` to [`REGISTRY`]. Nothing else.
 
+pub mod blend;
 pub mod cloth;
 pub mod cube_field;
+pub mod fader;
 pub mod grid_fluid;
 pub mod height_image;
+pub mod image_pass;
 pub mod kleinian;
 pub mod poisson;
 pub mod polygon_draw;
@@ -39,6 +42,8 @@ pub const REGISTRY: &[TechniqueInfo] = &[
     height_image::INFO,
     space_colonization::INFO,
     warp::INFO,
+    blend::INFO,
+    fader::INFO,
 ];
 
 /// Finds a technique by the name scenes use.
@@ -145,7 +150,7 @@ impl NodeSetup<'_> {
 }
 
 /// A live instance of a technique inside a scene.
-pub trait Technique {
+pub trait Technique: Send {
     /// Advances the simulation by one fixed step (no-op for stateless techniques).
     fn step(&mut self, _params: &ParamSet, _time: &FrameTime) {}
 

@@ -20,6 +20,7 @@ mod poisson;
 mod polygon_draw;
 mod recovery;
 mod seek;
+mod show;
 mod space_colonization;
 mod star_glow;
 mod tessellation;

@@ -331,7 +331,7 @@ fn feedback_sends_changed_values_to_the_controller() {
     );
 }
 
-fn http_get(addr: std::net::SocketAddr, path: &str) -> (u16, serde_json::Value) {
+pub(crate) fn http_get(addr: std::net::SocketAddr, path: &str) -> (u16, serde_json::Value) {
     use std::io::{Read, Write};
     let mut s = std::net::TcpStream::connect(addr).unwrap();
     write!(s, "GET {path} HTTP/1.0\r\nHost: localhost\r\n\r\n").unwrap();
@@ -347,7 +347,8 @@ fn oscquery_serves_every_parameter_with_type_range_and_value() {
     // The protocol needs the scene and its values, not a device: no GPU is opened here.
     let star_glow = scene("star_glow");
     let values: Vec<indra::params::ParamSet> = star_glow.nodes.iter().map(|n| n.params.clone()).collect();
-    let view = SceneView { scene: &star_glow, params: &values, tempo: indra::params::TempoClock::new(120.0) };
+    let view =
+        SceneView { scene: &star_glow, params: &values, tempo: indra::params::TempoClock::new(120.0), show: None };
     let server = OscQueryServer::start("127.0.0.1:0", 9000).unwrap();
     // Before the show publishes its scene, the tree is not shown as an empty one.
     assert_eq!(http_raw(server.local_addr(), b"GET / HTTP/1.1\r\n\r\n"), 503);
@@ -538,10 +539,10 @@ fn set(instance: &mut SceneInstance, name: &str, value: ParamValue) {
     instance.apply(&[ControlEvent::Write(write)]);
 }
 
-type Socket = tungstenite::WebSocket<tungstenite::stream::MaybeTlsStream<std::net::TcpStream>>;
+pub(crate) type Socket = tungstenite::WebSocket<tungstenite::stream::MaybeTlsStream<std::net::TcpStream>>;
 
 /// The next message within `wait`, skipping pings; None when none came.
-fn next_message(socket: &mut Socket, wait: Duration) -> Option<tungstenite::Message> {
+pub(crate) fn next_message(socket: &mut Socket, wait: Duration) -> Option<tungstenite::Message> {
     if let tungstenite::stream::MaybeTlsStream::Plain(s) = socket.get_mut() {
         s.set_read_timeout(Some(wait)).unwrap();
     }

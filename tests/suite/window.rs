@@ -9,13 +9,13 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// An Xvfb server on a free display number, killed when dropped.
-struct VirtualDisplay {
+pub(crate) struct VirtualDisplay {
     server: Child,
     display: String,
 }
 
 impl VirtualDisplay {
-    fn start() -> Self {
+    pub(crate) fn start() -> Self {
         // Tests run in parallel in one process: each call takes its own range of numbers.
         static CALLS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
         let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
@@ -61,7 +61,7 @@ impl Drop for VirtualDisplay {
 }
 
 /// `indra run` in the virtual display, its log going to a file the test reads.
-struct Show {
+pub(crate) struct Show {
     child: Child,
     log: PathBuf,
 }
@@ -69,7 +69,7 @@ struct Show {
 impl Show {
     /// Starts `indra run <scene> <args>` on `display`, with OSC on a free loopback port and its
     /// presets, learn file and log in `dir`. Returns the show and its OSC port.
-    fn start(display: &VirtualDisplay, dir: &Path, scene: &str, args: &[&std::ffi::OsStr]) -> (Self, u16) {
+    pub(crate) fn start(display: &VirtualDisplay, dir: &Path, scene: &str, args: &[&std::ffi::OsStr]) -> (Self, u16) {
         let port = UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
         let log = dir.join("show.log");
         let child = Command::new(env!("CARGO_BIN_EXE_indra"))
@@ -92,7 +92,7 @@ impl Show {
     }
 
     /// Waits (at most 90 s: debug build on lavapipe) until the log holds `text`; returns the log.
-    fn wait_for(&mut self, text: &str) -> String {
+    pub(crate) fn wait_for(&mut self, text: &str) -> String {
         let deadline = Instant::now() + Duration::from_secs(90);
         loop {
             let mut log = String::new();
@@ -119,14 +119,14 @@ impl Drop for Show {
 }
 
 /// An empty folder of this test process under the temporary folder.
-fn scratch_dir(name: &str) -> PathBuf {
+pub(crate) fn scratch_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("indra-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
 
-fn send(socket: &UdpSocket, port: u16, addr: &str, args: Vec<rosc::OscType>) {
+pub(crate) fn send(socket: &UdpSocket, port: u16, addr: &str, args: Vec<rosc::OscType>) {
     let packet = rosc::OscPacket::Message(rosc::OscMessage { addr: addr.into(), args });
     socket.send_to(&rosc::encoder::encode(&packet).unwrap(), ("127.0.0.1", port)).unwrap();
 }

@@ -1,0 +1,515 @@
+//! Reading a show file into one flat [`Scene`]: each clip's scene loaded and validated on its
+//! own, its nodes renamed `<clip>/<node>` and appended, then one `blend` node per layer and the
+//! `master` fader. Errors are located in the show file (a broken clip's scene error is quoted
+//! at the clip).
+
+use std::collections::BTreeSet;
+use std::path::Path;
+use std::sync::Arc;
+
+use super::file::{ClipFile, CueFile, Hold, ShowFile, TransitionFile};
+use super::{Clip, Cue, Layer, Length, MAX_CLIPS_PER_LAYER, MAX_CUES, MAX_LAYERS, Show, Transition};
+use crate::assets::{AssetKind, Assets};
+use crate::params::{ParamSet, ParamValue, Target, coerce};
+use crate::scene::error::{SceneError, SceneErrors, locate};
+use crate::scene::load::{MAX_NAME_CHARS, MAX_NODES, Scene, SceneNode, load_scene, resolve_target};
+use crate::techniques::{blend, fader};
+
+/// Ids a clip may not take: the show's own addresses start with them.
+const RESERVED_IDS: [&str; 9] = ["layer", "master", "column", "cue", "output", "preset", "record", "tempo", "resume"];
+
+/// The longest clip id.
+const MAX_CLIP_ID_CHARS: usize = 32;
+
+/// The longest transition, seconds or beats (an hour).
+const MAX_TRANSITION: f64 = 3600.0;
+
+/// Loads a show by name (`shows/`) or path. `lenient`: a clip whose scene is missing or broken
+/// is left out with its reason in [`Show::broken`] (a running show plays the rest); otherwise it
+/// is an error located at the clip.
+pub fn load_show(assets: &Assets, name_or_path: &str, lenient: bool) -> Result<Scene, SceneErrors> {
+    let path = Path::new(name_or_path);
+    let one =
+        |message: String| SceneErrors(vec![SceneError { origin: name_or_path.into(), line: 1, column: 1, message }]);
+    let (origin, source) = if path.is_file() {
+        let bytes = crate::files::read_limited(path, SHOW_FILE_LIMIT).map_err(|e| one(format!("cannot read {e}")))?;
+        (path.display().to_string(), String::from_utf8_lossy(&bytes).into_owned())
+    } else {
+        let name = name_or_path.strip_prefix("shows/").unwrap_or(name_or_path);
+        let asset = assets.load(AssetKind::Show, name).map_err(one)?;
+        (asset.origin, asset.source)
+    };
+    parse_show(assets, &origin, &source, lenient)
+}
+
+/// The largest show file read.
+const SHOW_FILE_LIMIT: u64 = 4 << 20;
+
+/// Parses and validates show text; `origin` names it in errors and places relative clip paths.
+pub fn parse_show(assets: &Assets, origin: &str, source: &str, lenient: bool) -> Result<Scene, SceneErrors> {
+    let file: ShowFile = crate::scene::ron_options().from_str(source).map_err(|e| {
+        SceneErrors(vec![SceneError {
+            origin: origin.into(),
+            line: e.span.start.line.max(1),
+            column: e.span.start.col.max(1),
+            message: e.code.to_string(),
+        }])
+    })?;
+    let mut builder = Builder { assets, origin, source, errors: Vec::new(), lenient, kinds: Vec::new() };
+    let scene = builder.build(file);
+    match scene {
+        Some(scene) if builder.errors.is_empty() => Ok(scene),
+        _ => Err(SceneErrors(builder.errors)),
+    }
+}
+
+struct Builder<'a> {
+    assets: &'a Assets,
+    origin: &'a str,
+    source: &'a str,
+    errors: Vec<SceneError>,
+    lenient: bool,
+    kinds: Vec<String>,
+}
+
+impl Builder<'_> {
+    fn error(&mut self, anchors: &[&str], message: String) {
+        if self.errors.len() < 50 {
+            let (line, column) = locate(self.source, anchors);
+            self.errors.push(SceneError { origin: self.origin.into(), line, column, message });
+        }
+    }
+
+    fn build(&mut self, file: ShowFile) -> Option<Scene> {
+        self.check_header(&file);
+        if file.layers.is_empty() || file.layers.len() > MAX_LAYERS {
+            self.error(&["layers"], format!("{} layers; a show has 1 to {MAX_LAYERS}", file.layers.len()));
+            return None;
+        }
+        let default = self.transition(&file.transition, &["transition"]).unwrap_or(Transition {
+            kind: None,
+            length: Length::Seconds(0.0),
+            quantize: Default::default(),
+        });
+        let mut nodes: Vec<SceneNode> = Vec::new();
+        let mut tracks = Vec::new();
+        let mut lfos = Vec::new();
+        let mut audio = Vec::new();
+        let mut clips = Vec::new();
+        let mut layers = Vec::new();
+        let mut broken = Vec::new();
+        let mut sources = vec![self.origin.to_string()];
+        let mut ids = BTreeSet::new();
+        for (l, layer) in file.layers.iter().enumerate() {
+            let anchor = ["layers", "clips"];
+            if layer.clips.len() > MAX_CLIPS_PER_LAYER {
+                self.error(
+                    &anchor,
+                    format!("layer {} has {} clips; at most {MAX_CLIPS_PER_LAYER}", l + 1, layer.clips.len()),
+                );
+                continue;
+            }
+            let layer_transition = match &layer.transition {
+                Some(t) => self.transition(t, &["layers", "transition"]).unwrap_or(default),
+                None => default,
+            };
+            let mut in_layer = Vec::new();
+            for clip in &layer.clips {
+                let scene_anchor = format!("\"{}\"", clip.scene);
+                let id = clip_id(clip);
+                if let Some(problem) = id_problem(&id) {
+                    self.error(&[&scene_anchor], format!("clip '{id}': {problem}"));
+                    continue;
+                }
+                if !ids.insert(id.clone()) {
+                    self.error(
+                        &[&scene_anchor, &scene_anchor],
+                        format!("clip id '{id}' is used twice; give one clip an `id`"),
+                    );
+                    continue;
+                }
+                let transition = match &clip.transition {
+                    Some(t) => self.transition(t, &[&scene_anchor, "transition"]).unwrap_or(layer_transition),
+                    None => layer_transition,
+                };
+                if let Some(problem) = note_problem(clip) {
+                    self.error(&[&scene_anchor, "note"], format!("clip '{id}': {problem}"));
+                }
+                let offset = nodes.len();
+                let output = match self.clip_scene(clip, &id, &scene_anchor) {
+                    Ok(scene) => {
+                        sources.push(scene.origin.clone());
+                        for mut t in scene.tracks {
+                            t.node += offset;
+                            tracks.push(t);
+                        }
+                        for mut lfo in scene.lfos {
+                            lfo.target.node += offset;
+                            lfos.push(lfo);
+                        }
+                        for mut a in scene.audio {
+                            a.target.node += offset;
+                            audio.push(a);
+                        }
+                        for mut node in scene.nodes {
+                            node.id = format!("{id}/{}", node.id);
+                            node.inputs.iter_mut().for_each(|i| *i += offset);
+                            nodes.push(node);
+                        }
+                        Some(offset + scene.output)
+                    }
+                    Err(message) if self.lenient => {
+                        broken.push((id.clone(), message));
+                        None
+                    }
+                    Err(message) => {
+                        self.error(&[&scene_anchor], format!("clip '{id}': {message}"));
+                        None
+                    }
+                };
+                in_layer.push(clips.len());
+                clips.push(Clip {
+                    id,
+                    scene: clip.scene.clone(),
+                    layer: l,
+                    nodes: offset..nodes.len(),
+                    output,
+                    policy: clip.policy,
+                    transition,
+                    note: clip.note.map(|n| (clip.channel, n)),
+                });
+            }
+            let start = match layer.start {
+                Some(0) => None,
+                Some(n) if n as usize <= in_layer.len() => Some(n as usize - 1),
+                Some(n) => {
+                    self.error(
+                        &["start"],
+                        format!("layer {}: start clip {n}, but it has {} clips", l + 1, in_layer.len()),
+                    );
+                    None
+                }
+                None if file.cues.is_empty() && !in_layer.is_empty() => Some(0),
+                None => None,
+            };
+            layers.push(Layer {
+                name: if layer.name.is_empty() { format!("layer {}", l + 1) } else { layer.name.clone() },
+                node: usize::MAX,
+                clips: in_layer,
+                start,
+            });
+        }
+        if nodes.len() + layers.len() + 1 > MAX_NODES {
+            let message = format!("the clips have {} nodes in all; a show may have at most {MAX_NODES}", nodes.len());
+            self.error(&["layers"], message);
+            return None;
+        }
+        for (l, layer) in file.layers.iter().enumerate() {
+            let mut params = ParamSet::new((blend::INFO.params)());
+            let set = |params: &mut ParamSet, name: &str, value: ParamValue| {
+                let index = params.index(name).expect("a blend node declares opacity and blend");
+                params.set_at(index, value)
+            };
+            if !(0.0..=1.0).contains(&layer.opacity) {
+                self.error(&["opacity"], format!("layer {}: opacity {} must be 0–1", l + 1, layer.opacity));
+            }
+            set(&mut params, "opacity", ParamValue::Float(layer.opacity));
+            match blend::BlendMode::OPTIONS.iter().position(|o| o.eq_ignore_ascii_case(&layer.blend)) {
+                Some(i) => {
+                    set(&mut params, "blend", ParamValue::Enum(i as u32));
+                }
+                None => {
+                    let options = blend::BlendMode::OPTIONS.join(", ");
+                    self.error(
+                        &[&format!("\"{}\"", layer.blend)],
+                        format!("blend '{}' is not one of {options}", layer.blend),
+                    );
+                }
+            }
+            params.snap();
+            layers[l].node = nodes.len();
+            nodes.push(SceneNode {
+                id: format!("layer/{}", l + 1),
+                technique: &blend::INFO,
+                params,
+                inputs: Vec::new(),
+            });
+        }
+        let mut master_params = ParamSet::new((fader::INFO.params)());
+        if !(0.0..=1.0).contains(&file.master) {
+            self.error(&["master"], format!("master {} must be 0–1", file.master));
+        }
+        master_params.set_at(0, ParamValue::Float(file.master));
+        master_params.snap();
+        let master = nodes.len();
+        nodes.push(SceneNode {
+            id: "master".into(),
+            technique: &fader::INFO,
+            params: master_params,
+            inputs: Vec::new(),
+        });
+        let columns = (0..layers.iter().map(|l| l.clips.len()).max().unwrap_or(0))
+            .map(|i| file.columns.get(i).cloned().unwrap_or_else(|| format!("column {}", i + 1)))
+            .collect();
+        let mut show = Show {
+            layers,
+            clips,
+            columns,
+            cues: Vec::new(),
+            loop_cues: file.loop_cues,
+            master,
+            kinds: Vec::new(),
+            sources,
+            broken,
+        };
+        if file.cues.len() > MAX_CUES {
+            self.error(&["cues"], format!("{} cues; at most {MAX_CUES}", file.cues.len()));
+        } else {
+            show.cues = file.cues.iter().enumerate().filter_map(|(i, c)| self.cue(&show, i, c)).collect();
+        }
+        show.kinds = std::mem::take(&mut self.kinds);
+        let mut scene = Scene {
+            origin: self.origin.to_string(),
+            name: file.name.clone(),
+            description: file.description.clone(),
+            size: file.size,
+            seed: file.seed,
+            dt: file.dt,
+            bpm: file.bpm,
+            lfos,
+            audio,
+            msaa: file.msaa,
+            nodes,
+            output: master,
+            tracks,
+            outputs: Vec::new(),
+            osc_aliases: vec![("/indra/master".into(), Target { node: master, param: 0, component: None })],
+            midi: Vec::new(),
+            show: None,
+        };
+        self.controls(&file, &mut scene);
+        for output in &file.outputs {
+            if let Err(e) = scene.attach_output(output) {
+                self.error(&["outputs"], e);
+            }
+        }
+        if let Err(e) = budget(&scene, &show) {
+            self.error(&["size"], e);
+        }
+        scene.show = Some(Arc::new(show));
+        Some(scene)
+    }
+
+    fn check_header(&mut self, file: &ShowFile) {
+        if file.size.0 == 0 || file.size.1 == 0 || file.size.0 > 16384 || file.size.1 > 16384 {
+            self.error(&["size"], format!("size {:?} must be between 1 and 16384 on each axis", file.size));
+        }
+        if file.name.chars().count() > MAX_NAME_CHARS {
+            self.error(
+                &["name"],
+                format!("the name has {} characters; at most {MAX_NAME_CHARS}", file.name.chars().count()),
+            );
+        }
+        if ![1, 2, 4, 8].contains(&file.msaa) {
+            self.error(&["msaa"], format!("msaa {} must be 1, 2, 4 or 8 samples per pixel", file.msaa));
+        }
+        if !(file.dt > 0.0 && file.dt <= 1.0) {
+            self.error(&["dt"], format!("dt {} must be in (0, 1] seconds", file.dt));
+        }
+        let (lo, hi) = crate::params::lfo::BPM_RANGE;
+        if !(file.bpm >= lo && file.bpm <= hi) {
+            self.error(&["bpm"], format!("bpm {} must be between {lo} and {hi}", file.bpm));
+        }
+    }
+
+    /// The clip's scene, validated, with the clip's start values applied.
+    fn clip_scene(&self, clip: &ClipFile, id: &str, _anchor: &str) -> Result<Scene, String> {
+        // A relative path is taken from the show file's folder first.
+        let beside = Path::new(self.origin).parent().map(|d| d.join(&clip.scene)).filter(|p| p.is_file());
+        let name = beside.map(|p| p.display().to_string()).unwrap_or_else(|| clip.scene.clone());
+        let text = Path::new(&name).is_file().then(|| std::fs::read_to_string(&name).unwrap_or_default());
+        if text.as_deref().is_some_and(super::file::is_show) {
+            return Err(format!("'{}' is a show; a clip plays a scene", clip.scene));
+        }
+        let mut scene = load_scene(self.assets, &name).map_err(|e| e.to_string())?;
+        for (target, raw) in &clip.params {
+            let t = resolve_target(&scene.nodes, target).map_err(|e| format!("params: {e}"))?;
+            let params = &mut scene.nodes[t.node].params;
+            let decl = &params.decls()[t.param];
+            let accepted = match (t.component, raw) {
+                (Some(c), crate::params::RawValue::Number(x)) => params.set_component(t.param, c, *x as f32),
+                (Some(_), other) => return Err(format!("params: {target}: {other:?} is not a number")),
+                (None, raw) => {
+                    let value = coerce(raw, decl.ty(), &decl.options)
+                        .ok_or_else(|| format!("params: {target}: {raw:?} does not fit a {}", decl.ty()))?;
+                    params.set_at(t.param, value)
+                }
+            };
+            if !accepted {
+                return Err(format!("params: {target}: not a finite number"));
+            }
+            params.snap();
+        }
+        let _ = id;
+        Ok(scene)
+    }
+
+    /// A transition, its shader kind registered; `None` after reporting what is wrong.
+    fn transition(&mut self, t: &TransitionFile, anchors: &[&str]) -> Option<Transition> {
+        let length = match (t.seconds, t.beats) {
+            (Some(_), Some(_)) => {
+                self.error(anchors, "give seconds or beats, not both".into());
+                return None;
+            }
+            (_, Some(b)) => Length::Beats(b),
+            (s, None) => Length::Seconds(s.unwrap_or(1.0)),
+        };
+        let (Length::Seconds(x) | Length::Beats(x)) = length;
+        if !(0.0..=MAX_TRANSITION).contains(&x) {
+            self.error(anchors, format!("a transition of {x} must last 0 to {MAX_TRANSITION}"));
+            return None;
+        }
+        if t.kind == "cut" {
+            return Some(Transition { kind: None, length: Length::Seconds(0.0), quantize: t.quantize });
+        }
+        if t.kind.is_empty() || !t.kind.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_') {
+            self.error(anchors, format!("transition kind '{}': use cut or a name of a-z, 0-9 and _", t.kind));
+            return None;
+        }
+        let kind = match self.kinds.iter().position(|k| *k == t.kind) {
+            Some(i) => i,
+            None => {
+                let file = super::transition_file(&t.kind);
+                if let Err(e) = self.assets.load(AssetKind::Shader, &file) {
+                    let anchor = format!("\"{}\"", t.kind);
+                    self.error(&[&anchor], format!("transition '{}': {e}", t.kind));
+                    return None;
+                }
+                self.kinds.push(t.kind.clone());
+                self.kinds.len() - 1
+            }
+        };
+        Some(Transition { kind: Some(kind), length, quantize: t.quantize })
+    }
+
+    fn cue(&mut self, show: &Show, i: usize, cue: &CueFile) -> Option<Cue> {
+        let anchor = if cue.name.is_empty() { "cues".to_string() } else { format!("\"{}\"", cue.name) };
+        let at = |message: String| (anchor.clone(), format!("cue {}: {message}", i + 1));
+        let mut problems = Vec::new();
+        let column = match cue.column {
+            Some(c) if c >= 1 && (c as usize) <= show.columns.len() => Some(c as usize - 1),
+            Some(c) => {
+                problems.push(at(format!("column {c}: the show has {} columns", show.columns.len())));
+                None
+            }
+            None => None,
+        };
+        let mut clips = Vec::new();
+        for &(layer, clip) in &cue.clips {
+            let Some(l) = (layer as usize).checked_sub(1).filter(|&l| l < show.layers.len()) else {
+                problems.push(at(format!("layer {layer}: the show has {} layers", show.layers.len())));
+                continue;
+            };
+            match clip {
+                0 => clips.push((l, None)),
+                c if (c as usize) <= show.layers[l].clips.len() => clips.push((l, Some(c as usize - 1))),
+                c => problems.push(at(format!("clip {c}: layer {layer} has {} clips", show.layers[l].clips.len()))),
+            }
+        }
+        let hold = match cue.hold {
+            None => None,
+            Some(Hold::Seconds(s)) if s.is_finite() && s > 0.0 => Some(Length::Seconds(s)),
+            Some(Hold::Beats(b)) if b.is_finite() && b > 0.0 => Some(Length::Beats(b)),
+            Some(h) => {
+                problems.push(at(format!("hold {h:?} must be a positive number")));
+                None
+            }
+        };
+        let transition = cue.transition.as_ref().and_then(|t| self.transition(t, &[&anchor, "transition"]));
+        for (a, message) in problems {
+            self.error(&[&a], message);
+        }
+        Some(Cue { name: cue.name.clone(), column, clips, transition, hold })
+    }
+
+    fn controls(&mut self, file: &ShowFile, scene: &mut Scene) {
+        for (address, target) in &file.controls.osc {
+            if !address.starts_with('/') {
+                self.error(&[&format!("\"{address}\"")], format!("OSC alias '{address}' must start with /"));
+                continue;
+            }
+            match resolve_target(&scene.nodes, target) {
+                Ok(t) => scene.osc_aliases.push((address.clone(), t)),
+                Err(e) => self.error(&[&format!("\"{target}\"")], format!("OSC alias {address}: {e}")),
+            }
+        }
+        for m in &file.controls.midi {
+            let anchor = format!("\"{}\"", m.target);
+            if let Some(problem) = m.problem() {
+                self.error(&[&anchor], format!("MIDI mapping: {problem}"));
+                continue;
+            }
+            match resolve_target(&scene.nodes, &m.target) {
+                Ok(t) => scene.midi.push((m.clone(), t)),
+                Err(e) => self.error(&[&anchor], format!("MIDI mapping: {e}")),
+            }
+        }
+        if !file.controls.lfo.is_empty() || !file.controls.audio.is_empty() {
+            self.error(
+                &["lfo", "audio"],
+                "a show's controls take osc and midi; put LFOs and audio in the clips' scenes".into(),
+            );
+        }
+    }
+}
+
+/// The clip's id: given, or the scene's file stem.
+fn clip_id(clip: &ClipFile) -> String {
+    clip.id.clone().unwrap_or_else(|| {
+        Path::new(&clip.scene).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+    })
+}
+
+fn id_problem(id: &str) -> Option<String> {
+    if id.is_empty() || id.chars().count() > MAX_CLIP_ID_CHARS {
+        return Some(format!("an id needs 1 to {MAX_CLIP_ID_CHARS} characters"));
+    }
+    if !id.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+        return Some("an id is letters, digits, _ and - (it becomes an OSC address)".into());
+    }
+    RESERVED_IDS
+        .contains(&id)
+        .then(|| format!("'{id}' is reserved for the show's own addresses; give the clip an `id`"))
+}
+
+fn note_problem(clip: &ClipFile) -> Option<String> {
+    if clip.note.is_some_and(|n| n > 127) {
+        return Some("note must be 0–127".into());
+    }
+    if clip.channel.is_some_and(|c| !(1..=16).contains(&c)) {
+        return Some("channel must be 1–16".into());
+    }
+    None
+}
+
+/// Whether the show's textures fit the scene budget; if not, one sentence on which clips take what.
+fn budget(scene: &Scene, show: &Show) -> Result<(), String> {
+    scene.check_texture_budget(scene.size).map_err(|_| {
+        let per_node = scene.texture_bytes(scene.size) / scene.nodes.len().max(1) as u64;
+        let gib = |b: u64| b as f64 / f64::from(1u32 << 30);
+        let clips: Vec<String> = show
+            .clips
+            .iter()
+            .map(|c| format!("{} {:.1} GiB", c.id, gib(per_node * c.nodes.len() as u64)))
+            .collect();
+        format!(
+            "the show needs about {:.1} GiB of textures at {}x{} with msaa {}, over the {:.0} GiB a show may use: {} (lower the size or the msaa, or move clips to another show)",
+            gib(scene.texture_bytes(scene.size)),
+            scene.size.0,
+            scene.size.1,
+            scene.msaa,
+            gib(crate::scene::load::MAX_TEXTURE_BYTES),
+            clips.join(", ")
+        )
+    })
+}

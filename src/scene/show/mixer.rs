@@ -1,0 +1,157 @@
+//! The passes a show draws between its clips and its layers: a layer in transition mixes its
+//! outgoing and incoming clips with a transition shader. Every kind the show names is compiled
+//! when the show is built, so a trigger never waits for a pipeline.
+//!
+//! A transition shader is `shaders/transition_<kind>.wgsl`, starting `// extends:
+//! transition.wgsl`, and defines `fn transition(uv: vec2<f32>, progress: f32) -> vec4<f32>`:
+//! the colour at `uv` (0–1 from the top left) when it is `progress` (0 → 1) of the way from the
+//! outgoing clip (`from_color(uv)`) to the incoming one (`to_color(uv)`). The base declares the
+//! bindings and helpers (see `shaders/transition.wgsl`); indra adds the entry point.
+
+use crate::assets::{AssetKind, Assets};
+use crate::gpu::{Gpu, JoinedSource, ShaderError};
+use crate::graph::{FrameGraph, TextureHandle};
+use crate::techniques::image_pass::{ImageKernel, ImagePass};
+
+use super::{LayerView, Show};
+
+/// The file every transition extends.
+pub const TRANSITION_BASE: &str = "transition.wgsl";
+
+/// The file of transition kind `kind`.
+pub fn transition_file(kind: &str) -> String {
+    format!("transition_{kind}.wgsl")
+}
+
+/// The entry point indra appends to every transition: one invocation per output pixel.
+const ENTRY_POINT: &str = "
+@compute @workgroup_size(8, 8)
+fn transition_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(dst);
+    if id.x >= size.x || id.y >= size.y {
+        return;
+    }
+    let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(size);
+    textureStore(dst, vec2<i32>(id.xy), transition(uv, clamp(u.progress, 0.0, 1.0)));
+}
+";
+
+/// The base's uniform block.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct TransitionUniforms {
+    /// 0 → 1.
+    pub progress: f32,
+    /// Seconds since the transition began.
+    pub seconds: f32,
+    /// Width / height of the output.
+    pub aspect: f32,
+    /// Padding.
+    pub pad: f32,
+    /// Output size in pixels.
+    pub size: [f32; 2],
+    /// Padding to 32 bytes.
+    pub pad2: [f32; 2],
+}
+
+/// The show's transition pipelines, and one pass per layer.
+pub struct Mixer {
+    kernels: Vec<ImageKernel>,
+    passes: Vec<ImagePass>,
+    files: Vec<String>,
+}
+
+impl Mixer {
+    /// Compiles every transition `show` names, with `assets`' shaders.
+    pub fn new(gpu: &Gpu, assets: &Assets, show: &Show) -> Result<Self, ShaderError> {
+        let device = &gpu.device;
+        let load = |name: &str| assets.load(AssetKind::Shader, name).map(|a| (a.origin, a.source));
+        let mut kernels = Vec::with_capacity(show.kinds.len());
+        for kind in &show.kinds {
+            let file = transition_file(kind);
+            let located = |message: String| ShaderError { origin: file.clone(), line: 1, column: 1, message };
+            let (origin, source) = load(&file).map_err(located)?;
+            let joined = JoinedSource::with_bases(&origin, &source, load).map_err(located)?;
+            let text = format!("{}\n{ENTRY_POINT}", joined.source);
+            let size = size_of::<TransitionUniforms>() as u64;
+            let kernel = ImageKernel::new(device, (joined.origin(), &text), "transition_main", 2, size)
+                .map_err(|e| joined.relocate(e))?;
+            kernels.push(kernel);
+        }
+        let passes = match kernels.first() {
+            Some(k) => show.layers.iter().map(|_| ImagePass::new(device, k)).collect(),
+            None => Vec::new(),
+        };
+        let mut files: Vec<String> = show.kinds.iter().map(|k| transition_file(k)).collect();
+        files.push(TRANSITION_BASE.into());
+        Ok(Self { kernels, passes, files })
+    }
+
+    /// Whether the mixer was built from shader file `name` (to rebuild it after an edit).
+    pub fn uses(&self, name: &str) -> bool {
+        self.files.iter().any(|f| f == name)
+    }
+
+    /// This frame's use of the mixer: each layer's pass lent out once.
+    pub fn frame(&mut self) -> MixerFrame<'_> {
+        MixerFrame { kernels: &self.kernels, passes: self.passes.iter_mut().map(Some).collect() }
+    }
+}
+
+/// The mixer during one frame's declaration (see [`Mixer::frame`]).
+pub struct MixerFrame<'r> {
+    kernels: &'r [ImageKernel],
+    passes: Vec<Option<&'r mut ImagePass>>,
+}
+
+impl<'r> MixerFrame<'r> {
+    /// Declares layer `layer`'s transition from `from` to `to` at `view`'s progress; returns the
+    /// mixed image (`to` when no transition runs, or the layer's pass was used this frame).
+    pub fn declare(
+        &mut self,
+        graph: &mut FrameGraph<'r>,
+        layer: usize,
+        view: &LayerView,
+        from: TextureHandle,
+        to: TextureHandle,
+    ) -> TextureHandle {
+        let Some(kernel) = view.kind.and_then(|k| self.kernels.get(k)) else { return to };
+        let Some(pass) = self.passes.get_mut(layer).and_then(Option::take) else { return to };
+        let (w, h) = graph.output_size();
+        let uniforms = TransitionUniforms {
+            progress: view.progress,
+            seconds: view.seconds,
+            aspect: w as f32 / h.max(1) as f32,
+            pad: 0.0,
+            size: [w as f32, h as f32],
+            pad2: [0.0; 2],
+        };
+        pass.declare(graph, "show/transition", kernel, uniforms, &[from, to])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uniform_layout_matches_the_wgsl_struct() {
+        let source = include_str!("../../../shaders/transition.wgsl");
+        let size = crate::gpu::wgsl_struct_size(source, "TransitionUniforms");
+        assert_eq!(size, Some(size_of::<TransitionUniforms>() as u32));
+    }
+
+    #[test]
+    fn every_bundled_transition_validates_with_the_entry_point() {
+        let base = include_str!("../../../shaders/transition.wgsl");
+        for (name, source) in [
+            ("crossfade", include_str!("../../../shaders/transition_crossfade.wgsl")),
+            ("fade_black", include_str!("../../../shaders/transition_fade_black.wgsl")),
+            ("wipe", include_str!("../../../shaders/transition_wipe.wgsl")),
+            ("luma", include_str!("../../../shaders/transition_luma.wgsl")),
+        ] {
+            let text = format!("{base}\n{source}\n{ENTRY_POINT}");
+            crate::gpu::validate_wgsl(name, &text).unwrap_or_else(|e| panic!("{name}: {e}"));
+        }
+    }
+}

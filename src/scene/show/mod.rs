@@ -1,0 +1,147 @@
+//! A show: layers of clips composited live, transitions between clips, columns and a cue list.
+//! A show is loaded into one flat [`Scene`](super::Scene) — every clip's nodes, renamed
+//! `<clip>/<node>`, plus a `blend` node per layer (`layer/<n>`) and a `fader` (`master`) — so
+//! parameters, OSC, OSCQuery, MIDI, presets, recordings and seeking work on a show as on a scene.
+//! What is a show's own lives here: the plan ([`Show`]), its play state ([`ShowState`]: which
+//! clip each layer plays, running transitions, pending quantized triggers, the cue), the
+//! transition passes ([`Mixer`]) and the fresh copies of restarting clips ([`Spares`]).
+
+mod file;
+mod load;
+mod mixer;
+mod runtime;
+mod spares;
+mod state;
+
+pub use file::{ClipFile, ClipPolicy, CueFile, Hold, LayerFile, Quantize, ShowFile, TransitionFile, is_show};
+pub use load::{load_show, parse_show};
+pub use mixer::{Mixer, MixerFrame, TRANSITION_BASE, TransitionUniforms, transition_file};
+pub use runtime::ShowRuntime;
+pub use spares::Spares;
+pub use state::{BEATS_PER_BAR, Clock, LayerView, ShowState, StepChanges};
+
+use std::ops::Range;
+
+/// The most layers a show may have.
+pub const MAX_LAYERS: usize = 8;
+/// The most clips on one layer.
+pub const MAX_CLIPS_PER_LAYER: usize = 64;
+/// The most cues.
+pub const MAX_CUES: usize = 1024;
+
+/// A validated show: what the flat scene's nodes mean.
+#[derive(Clone, Debug)]
+pub struct Show {
+    /// Layers, bottom first.
+    pub layers: Vec<Layer>,
+    /// Every clip of every layer.
+    pub clips: Vec<Clip>,
+    /// Column names (column n triggers clip n of each layer); as many as the longest layer.
+    pub columns: Vec<String>,
+    /// The cue list.
+    pub cues: Vec<Cue>,
+    /// After the last cue, GO goes to the first.
+    pub loop_cues: bool,
+    /// Index of the master fader node.
+    pub master: usize,
+    /// Transition shader kinds in use (`crossfade` → `transition_crossfade.wgsl`), by index.
+    pub kinds: Vec<String>,
+    /// Every file the show was built from (the show file and its clips' scenes), for reload.
+    pub sources: Vec<String>,
+    /// Clips that could not be loaded (a lenient load, for a running show): clip id and why.
+    pub broken: Vec<(String, String)>,
+}
+
+/// One layer.
+#[derive(Clone, Debug)]
+pub struct Layer {
+    /// Its name.
+    pub name: String,
+    /// Index of its `blend` node.
+    pub node: usize,
+    /// Its clips (indices into [`Show::clips`]).
+    pub clips: Vec<usize>,
+    /// The clip within the layer playing at start.
+    pub start: Option<usize>,
+}
+
+/// One clip: a scene's nodes in the flat scene.
+#[derive(Clone, Debug)]
+pub struct Clip {
+    /// Its id (`/indra/<id>/<node>/<param>`).
+    pub id: String,
+    /// The scene it plays.
+    pub scene: String,
+    /// Its layer.
+    pub layer: usize,
+    /// Its nodes in the flat scene (empty for a broken clip).
+    pub nodes: Range<usize>,
+    /// The node whose image is the clip's.
+    pub output: Option<usize>,
+    /// Restart or continue.
+    pub policy: ClipPolicy,
+    /// Its transition.
+    pub transition: Transition,
+    /// The MIDI note (and channel) that triggers it.
+    pub note: Option<(Option<u8>, u8)>,
+}
+
+/// A transition, resolved.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Transition {
+    /// Index into [`Show::kinds`]; `None`: a cut.
+    pub kind: Option<usize>,
+    /// How long it lasts.
+    pub length: Length,
+    /// When it starts.
+    pub quantize: Quantize,
+}
+
+/// A length on the fixed clock or the tempo.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Length {
+    /// Seconds.
+    Seconds(f64),
+    /// Beats.
+    Beats(f64),
+}
+
+/// One cue, resolved.
+#[derive(Clone, Debug)]
+pub struct Cue {
+    /// Its name.
+    pub name: String,
+    /// Column to trigger first.
+    pub column: Option<usize>,
+    /// (layer, clip within the layer or none) triggers.
+    pub clips: Vec<(usize, Option<usize>)>,
+    /// Its transition, over the clips' own.
+    pub transition: Option<Transition>,
+    /// How long it holds; `None`: until GO.
+    pub hold: Option<Length>,
+}
+
+impl Show {
+    /// The clip node `node` belongs to, if any.
+    pub fn clip_of(&self, node: usize) -> Option<usize> {
+        self.clips.iter().position(|c| c.nodes.contains(&node))
+    }
+
+    /// The layer whose `blend` node is `node`, if any.
+    pub fn layer_of_node(&self, node: usize) -> Option<usize> {
+        self.layers.iter().position(|l| l.node == node)
+    }
+
+    /// Clip `clip` of layer `layer` as an index into [`Show::clips`].
+    pub fn clip_at(&self, layer: usize, clip: usize) -> Option<usize> {
+        self.layers.get(layer)?.clips.get(clip).copied()
+    }
+
+    /// The cue named `name`, or numbered `name` from 1.
+    pub fn cue_named(&self, name: &str) -> Option<usize> {
+        self.cues
+            .iter()
+            .position(|c| c.name == name)
+            .or_else(|| name.parse::<usize>().ok().filter(|n| (1..=self.cues.len()).contains(n)).map(|n| n - 1))
+    }
+}

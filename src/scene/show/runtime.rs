@@ -1,0 +1,269 @@
+//! A show running inside a scene instance: the play state, the transition mixer and the fresh
+//! copies of restarting clips, and the rules that tie them to the flat scene's nodes — which
+//! nodes step and draw (a hidden restart clip does neither), on which clock (a restart clip's
+//! own, from its trigger), and how the layers composite.
+
+use std::sync::Arc;
+
+use super::spares::Build;
+use super::state::Clock;
+use super::{ClipPolicy, Mixer, Show, ShowState, Spares};
+use crate::assets::Assets;
+use crate::gpu::{Gpu, ShaderError};
+use crate::graph::{FrameGraph, TextureHandle};
+use crate::params::{ParamSet, ShowCommand};
+use crate::scene::Scene;
+use crate::techniques::Technique;
+use crate::time::FrameTime;
+
+/// The running part of a show.
+pub struct ShowRuntime {
+    plan: Arc<Show>,
+    state: ShowState,
+    mixer: Mixer,
+    spares: Spares,
+    /// The clip each node belongs to.
+    node_clip: Vec<Option<usize>>,
+    gpu: Gpu,
+    assets: Assets,
+    output_size: (u32, u32),
+}
+
+impl ShowRuntime {
+    /// The runtime of `scene`'s show (`None` for a plain scene), its transitions compiled.
+    pub fn new(
+        gpu: &Gpu,
+        assets: &Assets,
+        scene: &Scene,
+        output_size: (u32, u32),
+    ) -> Result<Option<Self>, ShaderError> {
+        let Some(plan) = scene.show.clone() else { return Ok(None) };
+        let mixer = Mixer::new(gpu, assets, &plan)?;
+        Ok(Some(Self {
+            node_clip: (0..scene.nodes.len()).map(|n| plan.clip_of(n)).collect(),
+            state: ShowState::new(&plan),
+            spares: Spares::new(plan.clips.len()),
+            plan,
+            mixer,
+            gpu: gpu.clone(),
+            assets: assets.clone(),
+            output_size,
+        }))
+    }
+
+    /// The plan.
+    pub fn plan(&self) -> &Show {
+        &self.plan
+    }
+
+    /// The play state.
+    pub fn state(&self) -> &ShowState {
+        &self.state
+    }
+
+    /// Takes over the play state of the show this one replaces (a hot reload); clips whose nodes
+    /// ran before are no longer fresh, and hidden ones get fresh copies.
+    pub fn carry_over(&mut self, old: &ShowRuntime, scene: &Scene, params: &[ParamSet]) {
+        self.state = old.state.carried(&old.plan, &self.plan);
+        for c in 0..self.plan.clips.len() {
+            self.spares.mark_stale(c);
+        }
+        self.prepare_hidden(scene, params);
+    }
+
+    /// After every node was rebuilt on a new device: the play state stays; clips on screen run
+    /// on from their fresh state.
+    pub fn keep_state(&mut self, old: ShowRuntime) {
+        self.state = old.state;
+        for c in 0..self.plan.clips.len() {
+            if self.state.visible(c) {
+                self.spares.mark_stale(c);
+            }
+        }
+    }
+
+    /// Whether the transitions were built from shader `name`.
+    pub fn uses_shader(&self, name: &str) -> bool {
+        self.mixer.uses(name)
+    }
+
+    /// Rebuilds the transitions with `assets` (a shader edit); on error the old ones stay.
+    pub fn rebuild_mixer(&mut self, assets: &Assets) -> Result<(), ShaderError> {
+        self.mixer = Mixer::new(&self.gpu, assets, &self.plan)?;
+        self.assets = assets.clone();
+        Ok(())
+    }
+
+    /// Queues a command for the next step.
+    pub fn request(&mut self, command: ShowCommand) -> Result<(), String> {
+        self.state.request(&self.plan, command)
+    }
+
+    /// The time node `node` runs at, or `None` while it idles (a hidden restart clip).
+    pub fn node_time(&self, node: usize, time: &FrameTime) -> Option<FrameTime> {
+        clip_time(&self.plan, &self.state, self.node_clip.get(node).copied().flatten(), time)
+    }
+
+    /// The show's part of a step at `time` (before the nodes step): commands, triggers, cues;
+    /// clips that start get fresh nodes, clips that leave get fresh copies prepared. Returns
+    /// what to tell the performer.
+    pub fn step(
+        &mut self,
+        time: &FrameTime,
+        beats: f64,
+        scene: &Scene,
+        params: &[ParamSet],
+        nodes: &mut [Box<dyn Technique>],
+    ) -> Vec<String> {
+        let mut messages = Vec::new();
+        for (clip, result) in self.spares.finished() {
+            self.install(clip, result, nodes, &mut messages);
+        }
+        let clock = Clock { frame: time.frame, seconds: time.seconds, beats };
+        let changes = self.state.step(&self.plan, clock);
+        messages.extend(changes.messages);
+        for &(layer, clip) in &changes.switched {
+            let name = &self.plan.layers[layer].name;
+            match clip.map(|c| &self.plan.clips[c]) {
+                Some(c) => log::info!("frame {}: layer {} '{name}' plays clip '{}'", time.frame, layer + 1, c.id),
+                None => log::info!("frame {}: layer {} '{name}' is empty", time.frame, layer + 1),
+            }
+        }
+        for &c in &changes.started {
+            let (plan, gpu, assets, size) = (&self.plan, &self.gpu, &self.assets, self.output_size);
+            let result = self.spares.take_for_start(c, || clip_build(plan, gpu, assets, size, c, scene, params));
+            match result {
+                Ok(Some(fresh)) => self.swap_in(c, fresh, nodes),
+                Ok(None) => {}
+                Err(e) => messages.push(format!("clip '{}' restarts from where it was: {e}", self.plan.clips[c].id)),
+            }
+        }
+        for c in changes.hidden {
+            if self.plan.clips[c].policy == ClipPolicy::Restart {
+                let build = self.build(c, scene, params);
+                if let Some(result) = self.spares.prepare(c, build, self.assets.load_wait()) {
+                    self.install(c, result, nodes, &mut messages);
+                }
+            }
+        }
+        messages
+    }
+
+    /// Starts fresh copies of every hidden restart clip whose nodes ran.
+    fn prepare_hidden(&mut self, scene: &Scene, params: &[ParamSet]) {
+        for c in 0..self.plan.clips.len() {
+            if self.plan.clips[c].policy == ClipPolicy::Restart && !self.state.visible(c) {
+                let build = self.build(c, scene, params);
+                // A build done at once (renders) is taken up at the next step's `finished`
+                // only when on a thread; here the nodes ran, so a synchronous copy is dropped
+                // and the clip rebuilds when it starts.
+                let _ = self.spares.prepare(c, build, crate::files::LoadWait::Background);
+            }
+        }
+    }
+
+    fn install(
+        &mut self,
+        clip: usize,
+        result: Result<Vec<Box<dyn Technique>>, ShaderError>,
+        nodes: &mut [Box<dyn Technique>],
+        messages: &mut Vec<String>,
+    ) {
+        match result {
+            Ok(fresh) if !self.state.visible(clip) => {
+                self.swap_in(clip, fresh, nodes);
+                self.spares.mark_fresh(clip);
+            }
+            // Triggered while it was built: the trigger took its own copy.
+            Ok(_) => {}
+            Err(e) => messages.push(format!("clip '{}' could not be prepared: {e}", self.plan.clips[clip].id)),
+        }
+    }
+
+    fn swap_in(&mut self, clip: usize, fresh: Vec<Box<dyn Technique>>, nodes: &mut [Box<dyn Technique>]) {
+        let range = self.plan.clips[clip].nodes.clone();
+        for (slot, node) in nodes[range].iter_mut().zip(fresh) {
+            *slot = node;
+        }
+    }
+
+    fn build(&self, clip: usize, scene: &Scene, params: &[ParamSet]) -> Build {
+        clip_build(&self.plan, &self.gpu, &self.assets, self.output_size, clip, scene, params)
+    }
+
+    /// Declares this frame of the show: every running clip's passes, each layer's transition and
+    /// blend, the master. Returns each node's image (a hidden clip's: none).
+    pub fn declare<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        scene: &Scene,
+        params: &[ParamSet],
+        nodes: &'r mut [Box<dyn Technique>],
+        time: &FrameTime,
+    ) -> Vec<Option<TextureHandle>> {
+        let mut outputs: Vec<Option<TextureHandle>> = vec![None; nodes.len()];
+        let black = crate::techniques::image_pass::black(graph);
+        let mut below = black;
+        let Self { plan, state, mixer, node_clip, .. } = self;
+        let mut mixer = mixer.frame();
+        for (i, node) in nodes.iter_mut().enumerate() {
+            let image_of = |clip: Option<usize>, outputs: &[Option<TextureHandle>]| {
+                clip.and_then(|c| plan.clips[c].output).and_then(|n| outputs[n])
+            };
+            outputs[i] = if let Some(l) = plan.layer_of_node(i) {
+                let view = state.view(l);
+                let to = image_of(view.to, &outputs);
+                let image = if view.fading() {
+                    let from = image_of(view.from, &outputs).unwrap_or(black);
+                    Some(mixer.declare(graph, l, &view, from, to.unwrap_or(black)))
+                } else {
+                    to
+                };
+                // An empty layer leaves the image below as it is.
+                if let Some(image) = image {
+                    below = node.add_passes(graph, &params[i], time, &[below, image]);
+                }
+                Some(below)
+            } else if i == plan.master {
+                Some(node.add_passes(graph, &params[i], time, &[below]))
+            } else {
+                clip_time(plan, state, node_clip[i], time).map(|t| {
+                    let inputs: Vec<TextureHandle> =
+                        scene.nodes[i].inputs.iter().map(|&j| outputs[j].unwrap_or(black)).collect();
+                    node.add_passes(graph, &params[i], &t, &inputs)
+                })
+            };
+        }
+        outputs
+    }
+}
+
+/// The time a node of `clip` (none: a layer, the master, an output) runs at, or `None` while
+/// it idles: a restart clip runs on its own clock from its trigger, and only while shown.
+fn clip_time(plan: &Show, state: &ShowState, clip: Option<usize>, time: &FrameTime) -> Option<FrameTime> {
+    let Some(c) = clip else { return Some(*time) };
+    match plan.clips[c].policy {
+        ClipPolicy::Continue => Some(*time),
+        ClipPolicy::Restart => state.visible(c).then(|| time.since(state.started(c))),
+    }
+}
+
+/// What building clip `clip`'s nodes afresh takes, with their parameters now.
+fn clip_build(
+    plan: &Show,
+    gpu: &Gpu,
+    assets: &Assets,
+    output_size: (u32, u32),
+    clip: usize,
+    scene: &Scene,
+    params: &[ParamSet],
+) -> Build {
+    Build {
+        gpu: gpu.clone(),
+        assets: assets.clone(),
+        nodes: plan.clips[clip].nodes.clone().map(|n| (scene.nodes[n].clone(), params[n].clone())).collect(),
+        output_size,
+        msaa: scene.msaa,
+        seed: scene.seed,
+    }
+}
