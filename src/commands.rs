@@ -217,6 +217,10 @@ pub struct BenchArgs {
     /// Hold tracks still (measure one parameter set, not an animation).
     #[arg(long)]
     pub no_animation: bool,
+    /// For a show with a cue list: GO every this many seconds of the fixed clock, and report
+    /// the worst frame at a switch against the median frame.
+    #[arg(long, value_name = "SECONDS")]
+    pub cue_every: Option<f64>,
 }
 
 fn parse_msaa(text: &str) -> Result<u32, String> {
@@ -543,6 +547,39 @@ pub fn list(assets: &Assets) -> Result<(), String> {
     Ok(())
 }
 
+/// A measured frame at which `bench --cue-every` triggered a cue.
+struct Switch {
+    /// Its position among the measured frames.
+    index: usize,
+    /// The show's frame.
+    frame: u64,
+    /// Milliseconds spent stepping and recording it (the rest of its wall time is the GPU's).
+    cpu: f64,
+}
+
+/// Each switch frame against the median of the frames that follow it until the next switch
+/// (the same clips on screen, so a costly clip does not count as a costly switch), and the
+/// worst switch against the median of all frames.
+fn report_switches(switches: &[Switch], walls: &[f64], median: f64, every: u64) {
+    let mut worst = (0.0f64, 0.0f64);
+    for s in switches {
+        let ms = walls[s.index];
+        let mut after: Vec<f64> = walls.iter().skip(s.index + 1).take(every as usize - 1).copied().collect();
+        after.sort_by(f64::total_cmp);
+        let steady = after.get(after.len() / 2).copied().unwrap_or(ms);
+        let ratio = ms / steady.max(1e-9);
+        say!("switch     frame {}: {ms:.3} ms ({:.3} ms on the CPU), then {steady:.3} ms: {ratio:.2}×", s.frame, s.cpu);
+        worst = (worst.0.max(ms), worst.1.max(ratio));
+    }
+    say!(
+        "{:<28} {:>9.3} ms  ({:.2}× the median frame)",
+        "worst frame at a switch",
+        worst.0,
+        worst.0 / median.max(1e-9)
+    );
+    say!("{:<28} {:>9.2}×  ({} switches)", "worst switch / frames after", worst.1, switches.len());
+}
+
 /// A show's layers, clips (with their trigger addresses) and cues.
 fn list_show(show: &indra::scene::show::Show) {
     for (l, layer) in show.layers.iter().enumerate() {
@@ -569,6 +606,15 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     let assets = &with_scene_folder(assets, &args.scene);
     let scene = scene_with_sets(assets, &args.scene, &args.sets, args.msaa)?;
     scene.check_texture_budget(args.size)?;
+    let cue_steps = match args.cue_every {
+        None => None,
+        Some(s) if s.is_finite() && s > 0.0 && scene.show.as_ref().is_some_and(|show| !show.cues.is_empty()) => {
+            Some(((s / f64::from(scene.dt)).round() as u64).max(1))
+        }
+        Some(_) => return Err("--cue-every takes a positive number of seconds and a show with a cue list".into()),
+    };
+    // Measured as it plays live: clips prepare on worker threads, files load in the background.
+    let assets = &assets.with_load_wait(indra::files::LoadWait::Background);
     let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
     let adapter = device.adapter_label();
     let timestamps = device.has_timestamps();
@@ -582,18 +628,34 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     }
     renderer.restart_timings();
     let mut walls = Vec::with_capacity(args.frames.min(1 << 16) as usize);
+    let mut switches = Vec::new();
     let mut last = Instant::now();
     let mut stats = None;
-    for _ in 0..args.frames {
-        let (_, s) = renderer.render_only().map_err(|e| e.to_string())?;
+    for i in 0..args.frames {
+        let go = cue_steps.is_some_and(|n| i > 0 && i % n == 0);
+        if go {
+            let frame = renderer.next_frame();
+            renderer.schedule(frame, vec![indra::params::ControlEvent::Show(indra::params::ShowCommand::CueGo)]);
+        }
+        let (time, s) = renderer.render_only().map_err(|e| e.to_string())?;
+        let recorded = Instant::now();
         // Waiting each frame makes wall time the frame's full latency, not queue depth.
         let _ = renderer.gpu().device.poll(wgpu::PollType::wait_indefinitely());
         let now = Instant::now();
-        walls.push((now - last).as_secs_f64() * 1e3);
+        let ms = (now - last).as_secs_f64() * 1e3;
+        walls.push(ms);
+        if go {
+            switches.push(Switch {
+                index: walls.len() - 1,
+                frame: time.frame,
+                cpu: (recorded - last).as_secs_f64() * 1e3,
+            });
+        }
         last = now;
         stats = Some(s);
     }
     renderer.finish_timings();
+    let in_order = walls.clone();
     walls.sort_by(f64::total_cmp);
     let wall_median = walls.get(walls.len() / 2).copied().unwrap_or(0.0);
     say!("scene      {name}");
@@ -632,6 +694,9 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         say!("(this adapter has no TIMESTAMP_QUERY_INSIDE_ENCODERS: wall-clock only)");
     }
     say!("{:<28} {:>9.3} ms  ({:.1} fps)", "frame wall time (median)", wall_median, 1e3 / wall_median.max(1e-9));
+    if !switches.is_empty() {
+        report_switches(&switches, &in_order, wall_median, cue_steps.unwrap_or(1));
+    }
     for line in renderer.instance_mut().bench_reports() {
         say!("node       {line}");
     }

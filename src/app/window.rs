@@ -173,7 +173,12 @@ impl WindowApp {
                 Err(e) => overlay.report(e),
             }
         }
-        let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
+        let mut runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
+        let mut instance = instance;
+        // A show's clips draw a throwaway frame each before the first: no trigger allocates.
+        if let Err(e) = instance.warm_up(&mut runtime) {
+            overlay.report(format!("preparing the clips: {e}"));
+        }
         let blit = Blit::new(&gpu.device);
         let (egui_state, egui_renderer) = egui_parts(&window, &gpu, config.format);
         let mut hub = hub;

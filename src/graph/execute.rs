@@ -66,6 +66,12 @@ impl GraphRuntime {
         &self.pool
     }
 
+    /// Keeps idle pool textures instead of dropping them after two seconds (see
+    /// [`TexturePool::set_hold`]).
+    pub fn hold_transients(&mut self, hold: bool) {
+        self.pool.set_hold(hold);
+    }
+
     /// Compiles and records `graph` into `encoder`. Submit the encoder, then call `after_submit`.
     pub fn execute(
         &mut self,

@@ -36,6 +36,8 @@ pub struct TexturePool {
     entries: Vec<Entry>,
     frame: u64,
     created_this_frame: usize,
+    /// Keep idle textures (a show: a clip that comes back finds its textures).
+    hold: bool,
 }
 
 impl TexturePool {
@@ -90,12 +92,20 @@ impl TexturePool {
     /// Ends a frame: everything becomes free; textures idle for long are dropped.
     pub(crate) fn end_frame(&mut self) {
         let frame = self.frame;
-        self.entries.retain(|e| frame.saturating_sub(e.last_frame) < EVICT_AFTER_FRAMES);
+        if !self.hold {
+            self.entries.retain(|e| frame.saturating_sub(e.last_frame) < EVICT_AFTER_FRAMES);
+        }
         for e in &mut self.entries {
             e.in_use = false;
         }
         self.frame += 1;
         self.created_this_frame = 0;
+    }
+
+    /// Whether idle textures stay (`true`: a show, whose clips come and go) or are dropped after
+    /// two seconds unused (a scene: after a resize, the old sizes go).
+    pub fn set_hold(&mut self, hold: bool) {
+        self.hold = hold;
     }
 
     /// Textures created during the current frame (0 in a steady state).

@@ -49,8 +49,15 @@ impl OffscreenRenderer {
     ) -> Result<Self, crate::gpu::ShaderError> {
         let size = size.unwrap_or(scene.size);
         let clock = FixedClock::new(dt.unwrap_or(scene.dt), seed.unwrap_or(scene.seed));
-        let instance = SceneInstance::new(&gpu, assets, scene, size)?;
-        let runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
+        let mut instance = SceneInstance::new(&gpu, assets, scene, size)?;
+        let mut runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
+        // A show's clips draw a throwaway frame each before the first: no trigger allocates.
+        instance.warm_up(&mut runtime).map_err(|e| crate::gpu::ShaderError {
+            origin: instance.scene().origin.clone(),
+            line: 1,
+            column: 1,
+            message: format!("preparing the clips: {e}"),
+        })?;
         let blit = Blit::new(&gpu.device);
         let target = display_target(&gpu, size);
         let guard = GpuGuard::new(DEFAULT_STALL_TIMEOUT);

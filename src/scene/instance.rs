@@ -262,6 +262,16 @@ impl SceneInstance {
         self.show.as_ref().map_or(Some(*time), |s| s.node_time(node, time))
     }
 
+    /// Prepares a show's clips before the show starts (see [`ShowRuntime::warm_up`]): one
+    /// throwaway frame of each drawn through `runtime`, then fresh copies. Nothing for a scene.
+    pub fn warm_up(&mut self, runtime: &mut GraphRuntime) -> Result<(), GraphError> {
+        if let Some(show) = &mut self.show {
+            let messages = show.warm_up(runtime, &self.scene, &self.params, &mut self.nodes)?;
+            self.messages.extend(messages);
+        }
+        Ok(())
+    }
+
     /// Whether any node records simulation work in its passes that every fixed step needs
     /// (GPU state). Seeking builds a simulation-only frame for each skipped step only then.
     pub fn simulates_on_gpu(&self) -> bool {

@@ -74,18 +74,25 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
 }
 
 impl HeightImage {
-    /// A node showing a 1×1 black image until its path loads.
+    /// A node showing its path's image, read and decoded now (a show prepares clips on a worker
+    /// thread, so a triggered clip has its image before its first frame); a 1×1 black image and
+    /// a message when it cannot be read. Later paths load in the background.
     pub fn new(setup: &NodeSetup<'_>) -> Self {
         let device = &setup.gpu.device;
-        let texture = upload(device, &setup.gpu.queue, &image::RgbaImage::new(1, 1));
+        let path = Settings::read(setup.params).path.as_str().trim().to_string();
+        let max_side = device.limits().max_texture_dimension_2d;
+        let (image, messages) = match read_image(setup.assets, &path, max_side) {
+            Ok(image) => (image, Vec::new()),
+            Err(e) => (image::RgbaImage::new(1, 1), vec![e]),
+        };
         Self {
+            texture: upload(device, &setup.gpu.queue, &image),
             device: device.clone(),
             queue: setup.gpu.queue.clone(),
             assets: setup.assets.clone(),
             loader: Loader::new(setup.assets.load_wait()),
-            requested: None,
-            texture,
-            messages: Vec::new(),
+            requested: Some(path),
+            messages,
         }
     }
 
@@ -165,14 +172,10 @@ impl Technique for HeightImage {
     fn add_passes<'r>(
         &'r mut self,
         graph: &mut FrameGraph<'r>,
-        params: &ParamSet,
-        time: &FrameTime,
+        _params: &ParamSet,
+        _time: &FrameTime,
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
-        // A frame drawn before any step still shows the image.
-        if self.requested.is_none() {
-            self.step(params, time);
-        }
         graph.import_texture("height_image/image", &self.texture)
     }
 }
