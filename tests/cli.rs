@@ -392,3 +392,60 @@ fn in_range_values_too_large_together_and_hostile_files_get_one_sentence() {
     let t = text(&o);
     assert!(o.status.success() && !t.contains("inf") && !t.contains("crosses itself"), "{t}");
 }
+
+#[test]
+fn a_show_renders_its_cue_list_the_same_whole_split_or_sought() {
+    // A cue list of a limit set and a cloth: cue 2 goes at 0.2 s (frame 12) and crossfades over
+    // 0.2 s, cue 1 comes back at frame 24 and the cloth restarts at frame 36; frames 5–45 span it.
+    let dir = temp_dir("show-file");
+    let show = dir.join("cues.ron");
+    std::fs::write(
+        &show,
+        r#"(name: "cues", size: (64, 36), transition: (kind: "crossfade", seconds: 0.2),
+            layers: [(clips: [(scene: "kleinian"), (scene: "cloth")])],
+            cues: [(clips: [(1, 1)], hold: Seconds(0.2)), (clips: [(1, 2)], hold: Seconds(0.2))])"#,
+    )
+    .unwrap();
+    let (whole, first, second) = (temp_dir("show-whole"), temp_dir("show-a"), temp_dir("show-b"));
+    let render = |out: &PathBuf, start: &str, frames: &str| {
+        let args = [
+            "render",
+            show.to_str().unwrap(),
+            "--size",
+            "48x27",
+            "--start",
+            start,
+            "--frames",
+            frames,
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        let o = indra(&args);
+        assert!(o.status.success(), "{}", text(&o));
+    };
+    render(&whole, "5", "40");
+    render(&first, "5", "14");
+    render(&second, "19", "26");
+    let png = |dir: &PathBuf, frame: u32| std::fs::read(dir.join(format!("cues_{frame:05}.png"))).unwrap();
+    for frame in 5..45 {
+        let part = if frame < 19 { &first } else { &second };
+        assert!(png(&whole, frame) == png(part, frame), "frame {frame} of the split show render differs");
+    }
+    assert!(png(&whole, 8) != png(&whole, 20), "the cue list did not change the picture");
+}
+
+#[test]
+fn check_and_list_take_shows_and_locate_a_bad_clip() {
+    let o = indra(&["list"]);
+    let t = text(&o);
+    assert!(t.contains("shows/set — ") && t.contains("/indra/layer/2/clip/1/connect"), "{t}");
+    let dir = temp_dir("check-show");
+    let path = dir.join("broken-show.ron");
+    let source = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/shows/set.ron")).unwrap();
+    std::fs::write(&path, source.replace("(scene: \"kleinian\",", "(scene: \"kleinain\",")).unwrap();
+    let o = indra(&["check", path.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let line = source.lines().position(|l| l.contains("(scene: \"kleinian\",")).unwrap() + 1;
+    let expected = format!("broken-show.ron:{line}:21: clip 'kleinain'");
+    assert!(text(&o).contains(&expected), "expected «{expected}» in:\n{}", text(&o));
+}

@@ -42,7 +42,8 @@ fn temp(name: &str) -> PathBuf {
     dir
 }
 
-fn hub(dir: &std::path::Path, scene: &Scene) -> ControlHub {
+/// A hub with no network, MIDI port or audio, its files in `dir`.
+pub(crate) fn hub(dir: &std::path::Path, scene: &Scene) -> ControlHub {
     let options = ControlOptions {
         osc: None,
         midi: false,

@@ -34,7 +34,7 @@ fn shown(r: &mut OffscreenRenderer) -> RenderedFrame {
 }
 
 /// Polls until the watcher reports something (or 5 s pass).
-fn wait_for_reload(r: &mut OffscreenRenderer, live: &mut LiveReload) -> ReloadReport {
+pub(crate) fn wait_for_reload(r: &mut OffscreenRenderer, live: &mut LiveReload) -> ReloadReport {
     let start = Instant::now();
     loop {
         let report = r.poll_reload(live);
@@ -45,7 +45,7 @@ fn wait_for_reload(r: &mut OffscreenRenderer, live: &mut LiveReload) -> ReloadRe
     }
 }
 
-fn edit(path: &Path, from: &str, to: &str) {
+pub(crate) fn edit(path: &Path, from: &str, to: &str) {
     let text = std::fs::read_to_string(path).unwrap();
     assert!(text.contains(from), "{from} not in {}", path.display());
     std::fs::write(path, text.replacen(from, to, 1)).unwrap();

@@ -488,3 +488,66 @@ fn an_osc_trigger_changes_the_playing_clip_and_the_oscquery_tree() {
         std::thread::sleep(std::time::Duration::from_millis(100));
     }
 }
+
+#[test]
+fn a_show_reloads_when_a_clip_changes_and_keeps_playing_through_a_broken_edit() {
+    use crate::live::{edit, wait_for_reload};
+    let root = common::sandbox("show-reload");
+    std::fs::create_dir_all(root.join("shows")).unwrap();
+    let show_file = root.join("shows/live.ron");
+    std::fs::write(&show_file, TWO_COLOURS).unwrap();
+    let assets = indra::assets::Assets::new(Some(root.clone()));
+    let scene = load_scene(&assets, "shows/live").unwrap();
+    let mut live = indra::live::LiveReload::new(&assets).unwrap();
+    let mut r = OffscreenRenderer::new(gpu(), &assets, scene, Some((48, 27)), None, None).unwrap();
+    let before = r.render_next().unwrap().rgba;
+    // An edit of a clip's scene reloads the show.
+    edit(&root.join("scenes/kleinian_classic.ron"), r#""scale": 2.4"#, r#""scale": 1.2"#);
+    let report = wait_for_reload(&mut r, &mut live);
+    assert!(report.errors.is_empty() && !report.applied.is_empty(), "{report:?}");
+    let zoomed = r.render_next().unwrap().rgba;
+    assert!(zoomed != before, "the clip's edit did not reach the show");
+    // A broken clip keeps the last good show playing, with the error located at the clip.
+    edit(&root.join("scenes/kleinian_classic.ron"), r#""scale": 1.2,"#, r#""scale": 1.2,,"#);
+    let report = wait_for_reload(&mut r, &mut live);
+    assert!(report.errors.iter().any(|e| e.contains("clip 'red'")), "{report:?}");
+    assert!(r.render_next().unwrap().rgba == zoomed, "a broken clip changed the picture");
+    // The show file's own edit applies.
+    edit(&root.join("scenes/kleinian_classic.ron"), r#""scale": 1.2,,"#, r#""scale": 1.2,"#);
+    let fixed = |r: &mut OffscreenRenderer, live: &mut indra::live::LiveReload| {
+        // The watcher may report an earlier save again first: wait for the one that applies.
+        let mut reports = Vec::new();
+        for _ in 0..4 {
+            let report = wait_for_reload(r, live);
+            if report.errors.is_empty() && !report.applied.is_empty() {
+                return;
+            }
+            reports.push(report);
+        }
+        panic!("the fixed show was not applied: {reports:?}");
+    };
+    fixed(&mut r, &mut live);
+    edit(&show_file, "seed: 1,", "seed: 1, master: 0.0,");
+    fixed(&mut r, &mut live);
+    let black = r.render_next().unwrap().rgba;
+    assert!(black.chunks(4).all(|p| p[..3] == [0, 0, 0]), "the master fader at 0 is not black");
+}
+
+#[test]
+fn show_commands_survive_a_recording_and_midi_notes_trigger_clips() {
+    let scene = show_from(&TWO_COLOURS.replace(r#"id: "blue","#, r#"id: "blue", note: 40, channel: 2,"#));
+    // A note-on on the clip's channel triggers it; another channel or note does not.
+    let dir = crate::window::scratch_dir("show-record");
+    let triggered = |bytes: &[u8]| crate::control::hub(&dir, &scene).midi_bytes(bytes, &scene, 0.0);
+    assert_eq!(triggered(&[0x91, 40, 100]), [ControlEvent::Show(ShowCommand::Trigger { layer: 0, clip: Some(1) })]);
+    assert!(triggered(&[0x90, 40, 100]).is_empty() && triggered(&[0x91, 41, 100]).is_empty());
+    // Recorded and read back, a show command is the same command at the same frame.
+    let path = dir.join("take.ron");
+    let mut recorder = indra::control::record::Recorder::create(&path).unwrap();
+    let events =
+        [trigger(0, 1), ControlEvent::Show(ShowCommand::CueGoto(0)), ControlEvent::Show(ShowCommand::Column(1))];
+    recorder.record(12, &events, &scene).unwrap();
+    recorder.finish().unwrap();
+    let replay = indra::control::record::read_replay(&path, &scene).unwrap();
+    assert_eq!(replay.get(&12).map(Vec::as_slice), Some(&events[..]));
+}

@@ -208,7 +208,7 @@ impl Builder<'_> {
             let mut params = ParamSet::new((blend::INFO.params)());
             let set = |params: &mut ParamSet, name: &str, value: ParamValue| {
                 let index = params.index(name).expect("a blend node declares opacity and blend");
-                params.set_at(index, value)
+                set_start(params, index, Start::Value(value))
             };
             if !(0.0..=1.0).contains(&layer.opacity) {
                 self.error(&["opacity"], format!("layer {}: opacity {} must be 0–1", l + 1, layer.opacity));
@@ -226,7 +226,6 @@ impl Builder<'_> {
                     );
                 }
             }
-            params.snap();
             layers[l].node = nodes.len();
             nodes.push(SceneNode {
                 id: format!("layer/{}", l + 1),
@@ -239,8 +238,7 @@ impl Builder<'_> {
         if !(0.0..=1.0).contains(&file.master) {
             self.error(&["master"], format!("master {} must be 0–1", file.master));
         }
-        master_params.set_at(0, ParamValue::Float(file.master));
-        master_params.snap();
+        set_start(&mut master_params, 0, Start::Value(ParamValue::Float(file.master)));
         let master = nodes.len();
         nodes.push(SceneNode {
             id: "master".into(),
@@ -336,19 +334,17 @@ impl Builder<'_> {
             let t = resolve_target(&scene.nodes, target).map_err(|e| format!("params: {e}"))?;
             let params = &mut scene.nodes[t.node].params;
             let decl = &params.decls()[t.param];
-            let accepted = match (t.component, raw) {
-                (Some(c), crate::params::RawValue::Number(x)) => params.set_component(t.param, c, *x as f32),
+            let value = match (t.component, raw) {
+                (Some(c), crate::params::RawValue::Number(x)) => Start::Component(c, *x as f32),
                 (Some(_), other) => return Err(format!("params: {target}: {other:?} is not a number")),
-                (None, raw) => {
-                    let value = coerce(raw, decl.ty(), &decl.options)
-                        .ok_or_else(|| format!("params: {target}: {raw:?} does not fit a {}", decl.ty()))?;
-                    params.set_at(t.param, value)
-                }
+                (None, raw) => Start::Value(
+                    coerce(raw, decl.ty(), &decl.options)
+                        .ok_or_else(|| format!("params: {target}: {raw:?} does not fit a {}", decl.ty()))?,
+                ),
             };
-            if !accepted {
+            if !set_start(params, t.param, value) {
                 return Err(format!("params: {target}: not a finite number"));
             }
-            params.snap();
         }
         let _ = id;
         Ok(scene)
@@ -461,6 +457,31 @@ impl Builder<'_> {
             );
         }
     }
+}
+
+/// A start value the show gives a parameter: the whole value or one component.
+enum Start {
+    Value(ParamValue),
+    Component(usize, f32),
+}
+
+/// Makes `value` parameter `index`'s start value — its declared default, as a scene file's
+/// values are, so that a reload which changes it applies (clamped to its range). False if it is
+/// not a finite number.
+fn set_start(params: &mut ParamSet, index: usize, value: Start) -> bool {
+    let mut probe = params.clone();
+    let accepted = match value {
+        Start::Value(v) => probe.set_at(index, v),
+        Start::Component(c, x) => probe.set_component(index, c, x),
+    };
+    if !accepted {
+        return false;
+    }
+    probe.snap();
+    let mut decls = params.decls().to_vec();
+    decls[index].default = probe.target_at(index);
+    *params = ParamSet::new(decls);
+    true
 }
 
 /// The clip's id: given, or the scene's file stem.
