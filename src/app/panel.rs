@@ -244,11 +244,9 @@ fn preset_panel(
 fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub) -> Vec<ParamWrite> {
     let mut writes = Vec::new();
     for node in 0..instance.scene().nodes.len() {
-        // A show lists the nodes of the clips on screen; its faders are in the show panel.
+        // A show lists the nodes of the clips on screen (and its layers and master, to learn).
         if let Some((show, state)) = instance.show()
-            && (show.clip_of(node).is_some_and(|c| !state.visible(c))
-                || show.layer_of_node(node).is_some()
-                || node == show.master)
+            && show.clip_of(node).is_some_and(|c| !state.visible(c))
         {
             continue;
         }

@@ -346,15 +346,50 @@ fn one_error(origin: &str, message: String) -> SceneErrors {
 
 /// Parses and validates scene text; `origin` names it in errors.
 pub fn parse_scene(origin: &str, source: &str) -> Result<Scene, SceneErrors> {
-    let file: SceneFile = super::schema::ron_options().from_str(source).map_err(|e| {
+    let file: SceneFile = read_ron(origin, source)?;
+    Validator { origin, source, errors: Vec::new(), more: 0 }.validate(file)
+}
+
+/// RON text as `T` (a scene or a show file), a syntax or schema error located in `origin`.
+pub(crate) fn read_ron<T: serde::de::DeserializeOwned>(origin: &str, source: &str) -> Result<T, SceneErrors> {
+    super::schema::ron_options().from_str(source).map_err(|e| {
         SceneErrors(vec![SceneError {
             origin: origin.into(),
             line: e.span.start.line.max(1),
             column: e.span.start.col.max(1),
             message: e.code.to_string(),
         }])
-    })?;
-    Validator { origin, source, errors: Vec::new(), more: 0 }.validate(file)
+    })
+}
+
+/// What is wrong with the settings a scene and a show both have (each with the field it is
+/// at): the size, the name's length (it reaches the window title, which the display server
+/// bounds), the sample count, the step and the tempo.
+pub(crate) fn header_problems(
+    name: &str,
+    size: (u32, u32),
+    msaa: u32,
+    dt: f32,
+    bpm: f64,
+) -> Vec<(&'static str, String)> {
+    let mut problems = Vec::new();
+    if size.0 == 0 || size.1 == 0 || size.0 > 16384 || size.1 > 16384 {
+        problems.push(("size", format!("size {size:?} must be between 1 and 16384 on each axis")));
+    }
+    if name.chars().count() > MAX_NAME_CHARS {
+        problems.push(("name", format!("the name has {} characters; at most {MAX_NAME_CHARS}", name.chars().count())));
+    }
+    if ![1, 2, 4, 8].contains(&msaa) {
+        problems.push(("msaa", format!("msaa {msaa} must be 1, 2, 4 or 8 samples per pixel")));
+    }
+    if !(dt > 0.0 && dt <= 1.0) {
+        problems.push(("dt", format!("dt {dt} must be in (0, 1] seconds")));
+    }
+    let (lo, hi) = crate::params::lfo::BPM_RANGE;
+    if !(bpm >= lo && bpm <= hi) {
+        problems.push(("bpm", format!("bpm {bpm} must be between {lo} and {hi}")));
+    }
+    problems
 }
 
 /// `/indra/output/<n>/corner/<i>` for every output that shows a warp node: a controller can
@@ -423,25 +458,8 @@ impl Validator<'_> {
     }
 
     fn validate(mut self, file: SceneFile) -> Result<Scene, SceneErrors> {
-        if file.size.0 == 0 || file.size.1 == 0 || file.size.0 > 16384 || file.size.1 > 16384 {
-            self.error(&["size"], format!("size {:?} must be between 1 and 16384 on each axis", file.size));
-        }
-        if file.name.chars().count() > MAX_NAME_CHARS {
-            // The name reaches the window title, which the display server bounds.
-            self.error(
-                &["name"],
-                format!("the name has {} characters; at most {MAX_NAME_CHARS}", file.name.chars().count()),
-            );
-        }
-        if ![1, 2, 4, 8].contains(&file.msaa) {
-            self.error(&["msaa"], format!("msaa {} must be 1, 2, 4 or 8 samples per pixel", file.msaa));
-        }
-        if !(file.dt > 0.0 && file.dt <= 1.0) {
-            self.error(&["dt"], format!("dt {} must be in (0, 1] seconds", file.dt));
-        }
-        let (lo, hi) = crate::params::lfo::BPM_RANGE;
-        if !(file.bpm >= lo && file.bpm <= hi) {
-            self.error(&["bpm"], format!("bpm {} must be between {lo} and {hi}", file.bpm));
+        for (anchor, message) in header_problems(&file.name, file.size, file.msaa, file.dt, file.bpm) {
+            self.error(&[anchor], message);
         }
         if file.nodes.len() > MAX_NODES {
             let message = format!("{} nodes; a scene may have at most {MAX_NODES}", file.nodes.len());

@@ -243,19 +243,19 @@ pub enum MidiCurve {
     Exponential,
 }
 
-fn default_msaa() -> u32 {
+pub(crate) fn default_msaa() -> u32 {
     4
 }
 
-fn default_bpm() -> f64 {
+pub(crate) fn default_bpm() -> f64 {
     crate::params::lfo::DEFAULT_BPM
 }
 
-fn default_dt() -> f32 {
+pub(crate) fn default_dt() -> f32 {
     1.0 / 60.0
 }
 
-fn one() -> f32 {
+pub(crate) fn one() -> f32 {
     1.0
 }
 

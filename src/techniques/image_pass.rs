@@ -7,6 +7,7 @@
 //! Bindings (checked against the WGSL by name): `u` (0) the uniform block, `linear_clamp` (1) a
 //! linear sampler, `src0`… (2…) the inputs, `dst` (8) the `rgba16float` storage output.
 
+use super::NodeSetup;
 use crate::gpu::{BindGroupCache, ComputeKernel, DEFAULT_MAX_AGE, ShaderError};
 use crate::graph::{FrameGraph, PassContext, TextureDesc, TextureHandle};
 
@@ -186,6 +187,36 @@ impl ImagePass {
                 })
             })
             .clone()
+    }
+}
+
+/// A node that is one image pass: its kernel and its pass (a blend, a fader).
+pub struct ImageNode<U> {
+    kernel: ImageKernel,
+    pass: ImagePass,
+    name: &'static str,
+    uniforms: std::marker::PhantomData<U>,
+}
+
+impl<U: bytemuck::Pod> ImageNode<U> {
+    /// Entry `entry` of shader `file` (checked against its bindings), taking `inputs` images and
+    /// uniforms `U`; its pass is named after the entry.
+    pub fn new(setup: &NodeSetup<'_>, file: &str, entry: &'static str, inputs: usize) -> Result<Self, ShaderError> {
+        let (origin, source) = setup.shader_source(file, &bindings(inputs))?;
+        let device = &setup.gpu.device;
+        let kernel = ImageKernel::new(device, (&origin, &source), entry, inputs, size_of::<U>() as u64)?;
+        let pass = ImagePass::new(device, &kernel);
+        Ok(Self { kernel, pass, name: entry, uniforms: std::marker::PhantomData })
+    }
+
+    /// Declares this frame's pass over `inputs`; returns its image.
+    pub fn declare<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        uniforms: U,
+        inputs: &[TextureHandle],
+    ) -> TextureHandle {
+        self.pass.declare(graph, self.name, &self.kernel, uniforms, inputs)
     }
 }
 

@@ -24,7 +24,7 @@ use std::collections::BTreeMap;
 use serde::Deserialize;
 
 use crate::params::RawValue;
-use crate::scene::schema::{ControlsFile, OutputFile};
+use crate::scene::schema::{ControlsFile, OutputFile, default_bpm, default_dt, default_msaa, one};
 
 /// A whole show file.
 #[derive(Clone, Debug, Deserialize)]
@@ -202,22 +202,6 @@ pub enum Hold {
     Seconds(f64),
     /// Beats of the show's tempo.
     Beats(f64),
-}
-
-fn default_dt() -> f32 {
-    1.0 / 60.0
-}
-
-fn default_bpm() -> f64 {
-    crate::params::lfo::DEFAULT_BPM
-}
-
-fn default_msaa() -> u32 {
-    4
-}
-
-fn one() -> f32 {
-    1.0
 }
 
 fn yes() -> bool {

@@ -12,7 +12,7 @@ use super::{Clip, Cue, Layer, Length, MAX_CLIPS_PER_LAYER, MAX_CUES, MAX_LAYERS,
 use crate::assets::{AssetKind, Assets};
 use crate::params::{ParamSet, ParamValue, Target, coerce};
 use crate::scene::error::{SceneError, SceneErrors, locate};
-use crate::scene::load::{MAX_NAME_CHARS, MAX_NODES, Scene, SceneNode, load_scene, resolve_target};
+use crate::scene::load::{MAX_NODES, Scene, SceneNode, header_problems, load_scene, read_ron, resolve_target};
 use crate::techniques::{blend, fader};
 
 /// Ids a clip may not take: the show's own addresses start with them.
@@ -47,14 +47,7 @@ const SHOW_FILE_LIMIT: u64 = 4 << 20;
 
 /// Parses and validates show text; `origin` names it in errors and places relative clip paths.
 pub fn parse_show(assets: &Assets, origin: &str, source: &str, lenient: bool) -> Result<Scene, SceneErrors> {
-    let file: ShowFile = crate::scene::ron_options().from_str(source).map_err(|e| {
-        SceneErrors(vec![SceneError {
-            origin: origin.into(),
-            line: e.span.start.line.max(1),
-            column: e.span.start.col.max(1),
-            message: e.code.to_string(),
-        }])
-    })?;
+    let file: ShowFile = read_ron(origin, source)?;
     let mut builder = Builder { assets, origin, source, errors: Vec::new(), lenient, kinds: Vec::new() };
     let scene = builder.build(file);
     match scene {
@@ -299,24 +292,8 @@ impl Builder<'_> {
     }
 
     fn check_header(&mut self, file: &ShowFile) {
-        if file.size.0 == 0 || file.size.1 == 0 || file.size.0 > 16384 || file.size.1 > 16384 {
-            self.error(&["size"], format!("size {:?} must be between 1 and 16384 on each axis", file.size));
-        }
-        if file.name.chars().count() > MAX_NAME_CHARS {
-            self.error(
-                &["name"],
-                format!("the name has {} characters; at most {MAX_NAME_CHARS}", file.name.chars().count()),
-            );
-        }
-        if ![1, 2, 4, 8].contains(&file.msaa) {
-            self.error(&["msaa"], format!("msaa {} must be 1, 2, 4 or 8 samples per pixel", file.msaa));
-        }
-        if !(file.dt > 0.0 && file.dt <= 1.0) {
-            self.error(&["dt"], format!("dt {} must be in (0, 1] seconds", file.dt));
-        }
-        let (lo, hi) = crate::params::lfo::BPM_RANGE;
-        if !(file.bpm >= lo && file.bpm <= hi) {
-            self.error(&["bpm"], format!("bpm {} must be between {lo} and {hi}", file.bpm));
+        for (anchor, message) in header_problems(&file.name, file.size, file.msaa, file.dt, file.bpm) {
+            self.error(&[anchor], message);
         }
     }
 

@@ -9,7 +9,7 @@ use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 
-use super::image_pass::{ImageKernel, ImagePass};
+use super::image_pass::ImageNode;
 use super::{NodeSetup, Technique, TechniqueInfo};
 
 /// The registry entry.
@@ -69,20 +69,11 @@ pub struct BlendUniforms {
     pub pad: [u32; 2],
 }
 
-struct Blend {
-    kernel: ImageKernel,
-    pass: ImagePass,
-}
-
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
-    let (origin, source) = setup.shader_source("blend.wgsl", &super::image_pass::bindings(2))?;
-    let device = &setup.gpu.device;
-    let kernel = ImageKernel::new(device, (&origin, &source), "blend", 2, size_of::<BlendUniforms>() as u64)?;
-    let pass = ImagePass::new(device, &kernel);
-    Ok(Box::new(Blend { kernel, pass }))
+    Ok(Box::new(ImageNode::<BlendUniforms>::new(setup, "blend.wgsl", "blend", 2)?))
 }
 
-impl Technique for Blend {
+impl Technique for ImageNode<BlendUniforms> {
     fn add_passes<'r>(
         &'r mut self,
         graph: &mut FrameGraph<'r>,
@@ -93,7 +84,7 @@ impl Technique for Blend {
         let s = Settings::read(params);
         let uniforms = BlendUniforms { mode: s.blend.index(), opacity: s.opacity, pad: [0; 2] };
         match inputs {
-            [below, over, ..] => self.pass.declare(graph, "blend", &self.kernel, uniforms, &[*below, *over]),
+            [below, over, ..] => self.declare(graph, uniforms, &[*below, *over]),
             // A node missing an input shows what it has (scene validation wires both).
             [only] => *only,
             [] => super::image_pass::black(graph),

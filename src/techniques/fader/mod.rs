@@ -8,7 +8,7 @@ use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 
-use super::image_pass::{ImageKernel, ImagePass};
+use super::image_pass::ImageNode;
 use super::{NodeSetup, Technique, TechniqueInfo};
 
 /// The registry entry.
@@ -46,20 +46,11 @@ pub struct FaderUniforms {
     pub pad: [f32; 3],
 }
 
-struct Fader {
-    kernel: ImageKernel,
-    pass: ImagePass,
-}
-
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
-    let (origin, source) = setup.shader_source("fader.wgsl", &super::image_pass::bindings(1))?;
-    let device = &setup.gpu.device;
-    let kernel = ImageKernel::new(device, (&origin, &source), "fader", 1, size_of::<FaderUniforms>() as u64)?;
-    let pass = ImagePass::new(device, &kernel);
-    Ok(Box::new(Fader { kernel, pass }))
+    Ok(Box::new(ImageNode::<FaderUniforms>::new(setup, "fader.wgsl", "fader", 1)?))
 }
 
-impl Technique for Fader {
+impl Technique for ImageNode<FaderUniforms> {
     fn add_passes<'r>(
         &'r mut self,
         graph: &mut FrameGraph<'r>,
@@ -69,9 +60,7 @@ impl Technique for Fader {
     ) -> TextureHandle {
         let level = Settings::read(params).level;
         match inputs.first() {
-            Some(&image) => {
-                self.pass.declare(graph, "fader", &self.kernel, FaderUniforms { level, pad: [0.0; 3] }, &[image])
-            }
+            Some(&image) => self.declare(graph, FaderUniforms { level, pad: [0.0; 3] }, &[image]),
             None => super::image_pass::black(graph),
         }
     }
