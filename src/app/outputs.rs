@@ -18,7 +18,6 @@ use winit::window::{Fullscreen, Window, WindowId};
 use crate::gpu::{Blit, BlitTarget, Gpu};
 use crate::params::{ControlEvent, ParamValue, ParamWrite, Source};
 use crate::scene::{SceneInstance, SceneOutput};
-use crate::techniques::warp::CORNERS;
 
 /// What edit mode moves: a corner of the pin, or a control point of the mesh.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -189,11 +188,11 @@ impl OutputWindow {
             }
             Key::Named(NamedKey::Tab) => {
                 let next = match self.picked {
-                    Pick::Corner(c) => (c + 1) % CORNERS.len(),
+                    Pick::Corner(c) => (c + 1) % CORNER_COUNT,
                     Pick::MeshPoint(_) => 0,
                 };
                 self.picked = Pick::Corner(next);
-                log::info!("output {}: corner {next} ({}) picked", self.number, CORNERS[next]);
+                log::info!("output {}: corner {next} picked (clockwise from the top left)", self.number);
                 return Vec::new();
             }
             Key::Named(NamedKey::ArrowLeft) => [-step / w, 0.0],
@@ -230,7 +229,7 @@ impl OutputWindow {
         let (w, h) = (self.config.width as f32, self.config.height as f32);
         let pointer = self.view_position();
         let mesh_points = instance.handles(warp.node).len();
-        let picks = (0..CORNERS.len()).map(Pick::Corner).chain((0..mesh_points).map(Pick::MeshPoint));
+        let picks = (0..CORNER_COUNT).map(Pick::Corner).chain((0..mesh_points).map(Pick::MeshPoint));
         picks
             .filter_map(|pick| {
                 let at = warp.position(instance, pick)?;
@@ -243,6 +242,9 @@ impl OutputWindow {
     }
 }
 
+/// A corner pin's corners, clockwise from the top left (see [`crate::techniques::StageEdit`]).
+const CORNER_COUNT: usize = 4;
+
 /// The parameters of an output's warp node that edit mode writes.
 struct WarpControls {
     node: usize,
@@ -253,20 +255,18 @@ struct WarpControls {
 }
 
 impl WarpControls {
-    /// Those of node `node`, if it is a warp node.
+    /// Those of node `node`, if its technique maps outputs onto walls.
     fn of(instance: &SceneInstance, node: usize) -> Option<Self> {
         let scene_node = instance.scene().nodes.get(node)?;
-        if scene_node.technique.name != crate::techniques::warp::INFO.name {
-            return None;
-        }
+        let edit = scene_node.technique.stage?;
         let index = |name: &str| scene_node.params.index(name);
-        let [a, b, c, d] = CORNERS.map(index);
+        let [a, b, c, d] = edit.corners.map(index);
         Some(Self {
             node,
             corners: [a?, b?, c?, d?],
-            mesh_point: index("mesh_point")?,
-            grid: index("grid")?,
-            save: index("save")?,
+            mesh_point: index(edit.mesh_point)?,
+            grid: index(edit.grid)?,
+            save: index(edit.save)?,
         })
     }
 

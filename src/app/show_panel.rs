@@ -79,15 +79,18 @@ fn layer_faders(ui: &mut egui::Ui, instance: &SceneInstance) -> Vec<ControlEvent
     let nodes = show.layers.iter().map(|l| (l.node, l.name.clone())).chain([(show.master, "master".to_string())]);
     for (node, name) in nodes {
         let params = instance.params(node);
-        ui.horizontal(|ui| {
-            ui.label(name);
-            for (p, decl) in params.decls().iter().enumerate() {
-                let mut value = params.target_at(p);
-                if super::panel::param_widget(ui, decl, &mut value) {
-                    let write = ParamWrite { node, param: p, component: None, value, source: Source::Ui };
-                    events.push(ControlEvent::Write(write));
+        // One id scope per node: every layer has a `blend` menu.
+        ui.push_id(node, |ui| {
+            ui.horizontal(|ui| {
+                ui.label(name);
+                for (p, decl) in params.decls().iter().enumerate() {
+                    let mut value = params.target_at(p);
+                    if super::panel::param_widget(ui, decl, &mut value) {
+                        let write = ParamWrite { node, param: p, component: None, value, source: Source::Ui };
+                        events.push(ControlEvent::Write(write));
+                    }
                 }
-            }
+            })
         });
     }
     events

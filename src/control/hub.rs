@@ -281,7 +281,7 @@ impl ControlHub {
         let mut events = Vec::new();
         let was_learning = self.mapper.learning.is_some();
         for e in self.parser.feed(bytes) {
-            events.extend(super::midi::clip_triggers(e, scene).into_iter().map(ControlEvent::Show));
+            events.extend(super::midi::show_commands(e, scene).into_iter().map(ControlEvent::Show));
             let (writes, program) = self.mapper.handle(e, scene, seconds);
             events.extend(writes.into_iter().map(ControlEvent::Write));
             if let Some(p) = program

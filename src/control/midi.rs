@@ -114,18 +114,30 @@ impl MidiParser {
     }
 }
 
-/// The clips a note-on triggers: each show clip whose `note` (and channel, if given) it is.
-pub fn clip_triggers(event: MidiEvent, scene: &Scene) -> Vec<crate::params::ShowCommand> {
+/// What a note-on asks of a show: GO or back when it is the show's cue note, and a trigger of
+/// each clip whose `note` (and channel, if given) it is.
+pub fn show_commands(event: MidiEvent, scene: &Scene) -> Vec<crate::params::ShowCommand> {
+    use crate::params::ShowCommand;
     let (MidiEvent::NoteOn { channel, note, .. }, Some(show)) = (event, &scene.show) else { return Vec::new() };
-    show.layers
-        .iter()
-        .enumerate()
-        .flat_map(|(l, layer)| layer.clips.iter().enumerate().map(move |(c, &clip)| (l, c, clip)))
-        .filter(|&(_, _, clip)| {
-            show.clips[clip].note.is_some_and(|(ch, n)| n == note && ch.is_none_or(|ch| ch == channel))
-        })
-        .map(|(layer, c, _)| crate::params::ShowCommand::Trigger { layer, clip: Some(c) })
-        .collect()
+    let cues = !show.cues.is_empty();
+    let mut commands = Vec::new();
+    if cues && show.cue_notes.go == Some(note) {
+        commands.push(ShowCommand::CueGo);
+    }
+    if cues && show.cue_notes.back == Some(note) {
+        commands.push(ShowCommand::CueBack);
+    }
+    commands.extend(
+        show.layers
+            .iter()
+            .enumerate()
+            .flat_map(|(l, layer)| layer.clips.iter().enumerate().map(move |(c, &clip)| (l, c, clip)))
+            .filter(|&(_, _, clip)| {
+                show.clips[clip].note.is_some_and(|(ch, n)| n == note && ch.is_none_or(|ch| ch == channel))
+            })
+            .map(|(layer, c, _)| ShowCommand::Trigger { layer, clip: Some(c) }),
+    );
+    commands
 }
 
 /// Tempo from MIDI clock (24 pulses per quarter note) and transport state.

@@ -225,11 +225,14 @@ impl Scene {
             if self.node_index(&id).is_some() {
                 return Err(format!("output {number}: the scene already has a node '{id}'"));
             }
-            let mut params = ParamSet::new((techniques::warp::INFO.params)());
-            let index = params.index("file").expect("a warp node has a file parameter");
+            let (technique, edit) = techniques::stage_output()
+                .ok_or_else(|| format!("output {number}: this build has no warp technique"))?;
+            let mut params = ParamSet::new((technique.params)());
+            let index =
+                params.index(edit.file).ok_or_else(|| format!("output {number}: the warp has no file parameter"))?;
             params.set_at(index, ParamValue::Text(crate::params::Text::new(file)));
             params.snap();
-            self.nodes.push(SceneNode { id, technique: &techniques::warp::INFO, params, inputs: vec![node] });
+            self.nodes.push(SceneNode { id, technique, params, inputs: vec![node] });
             node = self.nodes.len() - 1;
         }
         self.outputs.push(SceneOutput { node, monitor: output.monitor, fullscreen: output.fullscreen });
@@ -398,10 +401,8 @@ fn corner_aliases(outputs: &[SceneOutput], nodes: &[SceneNode]) -> Vec<(String, 
     let mut aliases = Vec::new();
     for (i, output) in outputs.iter().enumerate() {
         let node = &nodes[output.node];
-        if node.technique.name != techniques::warp::INFO.name {
-            continue;
-        }
-        for (c, name) in techniques::warp::CORNERS.iter().enumerate() {
+        let Some(edit) = node.technique.stage else { continue };
+        for (c, name) in edit.corners.iter().enumerate() {
             if let Some(param) = node.params.index(name) {
                 aliases.push((
                     format!("/indra/output/{}/corner/{c}", i + 1),

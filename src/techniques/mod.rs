@@ -13,6 +13,7 @@ pub mod grid_fluid;
 pub mod height_image;
 pub mod image_pass;
 pub mod kleinian;
+pub mod mesh2d_draw;
 pub mod poisson;
 pub mod polygon_draw;
 pub mod runner;
@@ -71,6 +72,31 @@ pub struct TechniqueInfo {
     /// one sentence; `indra check` and scene loading apply it, and the node keeps to the same
     /// rule when such values arrive live.
     pub check: Option<SettingsCheck>,
+    /// For a stage output (a projection-mapping warp): the parameters the scene loader and the
+    /// output windows work through — so neither knows a technique by name.
+    pub stage: Option<StageEdit>,
+}
+
+/// The parameters, by name, of a technique that maps an image onto a wall: what an output's
+/// `warp: FILE` sets, what `/indra/output/<n>/corner/<i>` drives, what an output window's edit
+/// mode drags, shows and saves.
+#[derive(Clone, Copy, Debug)]
+pub struct StageEdit {
+    /// The text parameter naming the file it reads its settings from.
+    pub file: &'static str,
+    /// The four corner parameters (`vec2`, view units), clockwise from the top left.
+    pub corners: [&'static str; 4],
+    /// A `vec3` parameter (index, x, y) moving one mesh point (see [`Technique::handles`]).
+    pub mesh_point: &'static str,
+    /// A bool parameter showing the mesh.
+    pub grid: &'static str,
+    /// A trigger parameter saving the file.
+    pub save: &'static str,
+}
+
+/// The technique that maps a scene's outputs onto walls, and its parameters (see [`StageEdit`]).
+pub fn stage_output() -> Option<(&'static TechniqueInfo, StageEdit)> {
+    REGISTRY.iter().find_map(|t| t.stage.map(|edit| (t, edit)))
 }
 
 /// See [`TechniqueInfo::check`]: `Err` says in one sentence what does not fit.

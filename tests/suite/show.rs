@@ -126,6 +126,7 @@ fn mixer_show(kinds: &[&str]) -> Show {
         cues: Vec::new(),
         loop_cues: true,
         master: 1,
+        cue_notes: Default::default(),
         kinds: kinds.iter().map(|k| k.to_string()).collect(),
         sources: Vec::new(),
         broken: Vec::new(),
@@ -541,6 +542,14 @@ fn show_commands_survive_a_recording_and_midi_notes_trigger_clips() {
     let triggered = |bytes: &[u8]| crate::control::hub(&dir, &scene).midi_bytes(bytes, &scene, 0.0);
     assert_eq!(triggered(&[0x91, 40, 100]), [ControlEvent::Show(ShowCommand::Trigger { layer: 0, clip: Some(1) })]);
     assert!(triggered(&[0x90, 40, 100]).is_empty() && triggered(&[0x91, 41, 100]).is_empty());
+    // The show's GO note, on any channel, when it has cues.
+    let cued = show_from(
+        &TWO_COLOURS
+            .replace("layers:", "go_note: 60, back_note: 59, cues: [(clips: [(1, 1)]), (clips: [(1, 2)])], layers:"),
+    );
+    let mut hub = crate::control::hub(&dir, &cued);
+    assert_eq!(hub.midi_bytes(&[0x95, 60, 1], &cued, 0.0), [ControlEvent::Show(ShowCommand::CueGo)]);
+    assert_eq!(hub.midi_bytes(&[0x90, 59, 1], &cued, 0.0), [ControlEvent::Show(ShowCommand::CueBack)]);
     // Recorded and read back, a show command is the same command at the same frame.
     let path = dir.join("take.ron");
     let mut recorder = indra::control::record::Recorder::create(&path).unwrap();

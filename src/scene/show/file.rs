@@ -64,6 +64,12 @@ pub struct ShowFile {
     /// After the last cue, GO goes to the first (default true).
     #[serde(default = "yes")]
     pub loop_cues: bool,
+    /// A MIDI note (0–127, any channel) that is GO.
+    #[serde(default)]
+    pub go_note: Option<u8>,
+    /// A MIDI note that goes back a cue.
+    #[serde(default)]
+    pub back_note: Option<u8>,
     /// The master fader at start, 0 (black) to 1.
     #[serde(default = "one")]
     pub master: f32,

@@ -8,7 +8,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use super::file::{ClipFile, CueFile, Hold, ShowFile, TransitionFile};
-use super::{Clip, Cue, Layer, Length, MAX_CLIPS_PER_LAYER, MAX_CUES, MAX_LAYERS, Show, Transition};
+use super::{Clip, Cue, CueNotes, Layer, Length, MAX_CLIPS_PER_LAYER, MAX_CUES, MAX_LAYERS, Show, Transition};
 use crate::assets::{AssetKind, Assets};
 use crate::params::{ParamSet, ParamValue, Target, coerce};
 use crate::scene::error::{SceneError, SceneErrors, locate};
@@ -248,11 +248,15 @@ impl Builder<'_> {
             columns,
             cues: Vec::new(),
             loop_cues: file.loop_cues,
+            cue_notes: CueNotes { go: file.go_note, back: file.back_note },
             master,
             kinds: Vec::new(),
             sources,
             broken,
         };
+        if [file.go_note, file.back_note].iter().flatten().any(|&n| n > 127) {
+            self.error(&["go_note", "back_note"], "a cue note must be 0–127".into());
+        }
         if file.cues.len() > MAX_CUES {
             self.error(&["cues"], format!("{} cues; at most {MAX_CUES}", file.cues.len()));
         } else {

@@ -42,6 +42,8 @@ pub struct Show {
     pub cues: Vec<Cue>,
     /// After the last cue, GO goes to the first.
     pub loop_cues: bool,
+    /// MIDI notes (any channel) for GO and back.
+    pub cue_notes: CueNotes,
     /// Index of the master fader node.
     pub master: usize,
     /// Transition shader kinds in use (`crossfade` → `transition_crossfade.wgsl`), by index.
@@ -50,6 +52,15 @@ pub struct Show {
     pub sources: Vec<String>,
     /// Clips that could not be loaded (a lenient load, for a running show): clip id and why.
     pub broken: Vec<(String, String)>,
+}
+
+/// MIDI notes that move through the cue list.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CueNotes {
+    /// The next cue.
+    pub go: Option<u8>,
+    /// The previous cue.
+    pub back: Option<u8>,
 }
 
 /// One layer.

@@ -22,6 +22,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &["blend.wgsl"],
     create,
     check: None,
+    stage: None,
 };
 
 crate::param_enum! {

@@ -34,6 +34,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &["cloth.wgsl", "cloth_render.wgsl"],
     create,
     check: None,
+    stage: None,
 };
 
 /// The colour target format.

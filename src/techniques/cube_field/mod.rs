@@ -27,6 +27,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &["cube_field.wgsl"],
     create,
     check: None,
+    stage: None,
 };
 
 /// Colour target format: linear HDR.

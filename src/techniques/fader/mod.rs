@@ -21,6 +21,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &["fader.wgsl"],
     create,
     check: None,
+    stage: None,
 };
 
 crate::technique_params! {

@@ -38,6 +38,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &["grid_fluid.wgsl"],
     create,
     check: None,
+    stage: None,
 };
 
 /// The output format (density in R, G and B).

@@ -31,6 +31,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &[],
     create,
     check: None,
+    stage: None,
 };
 
 /// The bundled height maps, by the path scenes use.

@@ -24,6 +24,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &["kleinian.wgsl"],
     create,
     check: None,
+    stage: None,
 };
 
 /// The output format: linear HDR so that post effects (StarGlow) can follow.

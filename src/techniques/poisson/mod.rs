@@ -23,6 +23,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &["poisson.wgsl", "msaa_samples.wgsl"],
     create,
     check: Some(check_settings),
+    stage: None,
 };
 
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;

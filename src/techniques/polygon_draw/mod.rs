@@ -9,14 +9,12 @@
 //! sets `cursor` and fires `add`, a right click fires `close`, U and C fire `undo` and `clear`.
 //! Shader: `shaders/polygon_draw.wgsl`.
 
-pub(crate) mod gpu;
-
+use super::mesh2d_draw::{self as gpu, DrawStyle};
 use crate::geometry::triangulate::{Mesh2D, Triangulator};
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
-use gpu::DrawStyle;
 
 use super::{NodeSetup, Technique, TechniqueInfo};
 
@@ -30,6 +28,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &["polygon_draw.wgsl"],
     create,
     check: None,
+    stage: None,
 };
 
 crate::param_enum! {

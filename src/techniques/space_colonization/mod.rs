@@ -71,6 +71,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &["space_colonization.wgsl", "space_colonization_draw.wgsl", "prefix_sum.wgsl"],
     create,
     check: None,
+    stage: None,
 };
 
 /// The colour format.

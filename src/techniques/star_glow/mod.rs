@@ -33,6 +33,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &["star_glow.wgsl"],
     create,
     check: None,
+    stage: None,
 };
 
 /// Intermediate and output format.

@@ -45,6 +45,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &["tessellation.wgsl", "tessellation_raster.wgsl", "msaa_samples.wgsl"],
     create,
     check: None,
+    stage: None,
 };
 
 /// The colour format.

@@ -13,7 +13,7 @@ use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue, Text};
 use crate::time::FrameTime;
 
-use super::polygon_draw::gpu::{DrawStyle, Renderer};
+use super::mesh2d_draw::{DrawStyle, Renderer};
 use super::{NodeSetup, Technique, TechniqueInfo};
 
 /// The registry entry.
@@ -26,6 +26,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &["polygon_draw.wgsl"],
     create,
     check: None,
+    stage: None,
 };
 
 /// The bundled font.

@@ -31,6 +31,13 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     shaders: &["warp.wgsl"],
     create,
     check: None,
+    stage: Some(super::StageEdit {
+        file: "file",
+        corners: CORNERS,
+        mesh_point: "mesh_point",
+        grid: "grid",
+        save: "save",
+    }),
 };
 
 /// Output format: linear HDR like every node.

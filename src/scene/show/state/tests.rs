@@ -24,6 +24,7 @@ fn show(transition: Transition, cues: Vec<Cue>) -> Show {
         columns: vec!["first".into(), "second".into()],
         cues,
         loop_cues: true,
+        cue_notes: Default::default(),
         master: 5,
         kinds: vec!["crossfade".into()],
         sources: Vec::new(),

@@ -1,12 +1,13 @@
-//! Pipelines and buffers of the drawing node: the textured fill, the wireframe (line list over
-//! the same vertices) and the open loop being drawn (line strip).
+//! Drawing a triangulated 2-D mesh, shared by chapter 5's two techniques (`polygon_draw` and
+//! `text_mesh`): the textured fill, the wireframe (line list over the same vertices) and the
+//! open loop being drawn (line strip), with `shaders/polygon_draw.wgsl`.
 
 use crate::geometry::triangulate::Mesh2D;
 use crate::gpu::{GrowableBuffer, RasterDesc, ShaderError, UniformBlock};
 use crate::graph::{FrameGraph, PassContext, RasterTargets, TextureHandle};
 use crate::time::FrameTime;
 
-use super::super::NodeSetup;
+use super::NodeSetup;
 
 /// Colour target format: linear HDR like every node.
 pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -204,7 +205,7 @@ mod tests {
 
     #[test]
     fn uniform_layout_matches_the_wgsl_struct() {
-        let source = include_str!("../../../shaders/polygon_draw.wgsl");
+        let source = include_str!("../../shaders/polygon_draw.wgsl");
         assert_eq!(crate::gpu::wgsl_struct_size(source, "PolygonUniforms"), Some(size_of::<PolygonUniforms>() as u32));
     }
 }
