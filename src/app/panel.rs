@@ -178,7 +178,7 @@ pub fn draw_ui(
                     events.extend(audio_panel(ui, &frame));
                 }
                 ui.small(hub.status());
-                events.extend(super::show_panel::show_panel(ui, instance));
+                events.extend(super::show_panel::show_panel(ui, instance, hub));
                 events.extend(param_panel(ui, instance, hub).into_iter().map(ControlEvent::Write));
                 ui.separator();
                 events.extend(preset_panel(ui, instance, overlay, hub));

@@ -2,12 +2,14 @@
 //! triggers it), each layer's fader and blend menu, the columns, the master, and the cue list
 //! with GO. Everything it does is a control event, as OSC and MIDI send them.
 
+use crate::control::ControlHub;
 use crate::params::{ControlEvent, ParamWrite, ShowCommand, Source};
 use crate::scene::SceneInstance;
 use crate::scene::show::ClipPolicy;
 
-/// Draws the show controls of `instance` (nothing for a scene); returns what was clicked.
-pub fn show_panel(ui: &mut egui::Ui, instance: &SceneInstance) -> Vec<ControlEvent> {
+/// Draws the show controls of `instance` (nothing for a scene); returns what was clicked. A
+/// right click on a clip starts MIDI learn for it (the next note triggers it).
+pub fn show_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub) -> Vec<ControlEvent> {
     let mut events = Vec::new();
     let Some((show, state)) = instance.show() else { return events };
     let mut trigger = |command| events.push(ControlEvent::Show(command));
@@ -36,9 +38,23 @@ pub fn show_panel(ui: &mut egui::Ui, instance: &SceneInstance) -> Vec<ControlEve
                 if broken {
                     hint.push_str(" — could not be loaded");
                 }
-                let label = if broken { format!("{} !", info.id) } else { info.id.clone() };
-                if ui.selectable_label(playing, label).on_hover_text(hint).clicked() {
+                let learning = hub.mapper.learning_clip == Some((l, c));
+                let learned =
+                    hub.mapper.clip_bindings().iter().any(|b| (b.layer, b.clip) == (l, c)) || info.note.is_some();
+                // ASCII marks: egui's bundled fonts lack the usual dot glyphs.
+                let mark = match (broken, learning, learned) {
+                    (true, _, _) => " !",
+                    (_, true, _) => " ?",
+                    (_, _, true) => " M",
+                    _ => "",
+                };
+                hint.push_str(" — right-click, then play a note: MIDI learn");
+                let cell = ui.selectable_label(playing, format!("{}{mark}", info.id)).on_hover_text(hint);
+                if cell.clicked() {
                     trigger(ShowCommand::Trigger { layer: l, clip: Some(c) });
+                }
+                if cell.secondary_clicked() {
+                    hub.learn_clip(l, c);
                 }
             }
             ui.end_row();

@@ -279,9 +279,13 @@ impl ControlHub {
     /// Feeds raw MIDI bytes (from a port, or a test) through the parser and mappings.
     pub fn midi_bytes(&mut self, bytes: &[u8], scene: &Scene, seconds: f64) -> Vec<ControlEvent> {
         let mut events = Vec::new();
-        let was_learning = self.mapper.learning.is_some();
+        let was_learning = self.mapper.is_learning();
         for e in self.parser.feed(bytes) {
-            events.extend(super::midi::show_commands(e, scene).into_iter().map(ControlEvent::Show));
+            // The note that is being learned only binds; it triggers from then on.
+            if !self.mapper.is_learning() {
+                let commands = super::midi::show_commands(e, scene).into_iter().chain(self.mapper.clip_commands(e));
+                events.extend(commands.map(ControlEvent::Show));
+            }
             let (writes, program) = self.mapper.handle(e, scene, seconds);
             events.extend(writes.into_iter().map(ControlEvent::Write));
             if let Some(p) = program
@@ -290,7 +294,7 @@ impl ControlHub {
                 events.extend(self.recall(&name, 0.0, scene));
             }
         }
-        if was_learning && self.mapper.learning.is_none() {
+        if was_learning && !self.mapper.is_learning() {
             self.persist_learned(scene);
         }
         events
@@ -328,7 +332,15 @@ impl ControlHub {
 
     /// Starts MIDI learn for `target`: the next control moved is bound to it.
     pub fn learn(&mut self, target: Target) {
+        self.mapper.learning_clip = None;
         self.mapper.learning = Some(target);
+    }
+
+    /// Starts MIDI learn for clip `clip` of layer `layer` of a show (from 0): the next note
+    /// triggers it from then on, and is saved in the learn file.
+    pub fn learn_clip(&mut self, layer: usize, clip: usize) {
+        self.mapper.learning = None;
+        self.mapper.learning_clip = Some((layer, clip));
     }
 
     /// Removes a parameter's MIDI bindings and saves the learn file.

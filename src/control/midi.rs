@@ -175,10 +175,34 @@ pub struct Binding {
     pub target: Target,
 }
 
+/// A note bound to a show's clip (learned on the panel: the mapping's target is
+/// `layer/<n>/clip/<m>`, numbered from 1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClipBinding {
+    /// As saved in the learn file.
+    pub mapping: MidiMapping,
+    /// The layer, from 0.
+    pub layer: usize,
+    /// The clip within the layer, from 0.
+    pub clip: usize,
+}
+
+/// The layer and clip (from 0) of a learn file target `layer/<n>/clip/<m>`, if `scene` has them.
+fn clip_target(target: &str, scene: &Scene) -> Option<(usize, usize)> {
+    let rest = target.strip_prefix("layer/")?;
+    let (layer, clip) = rest.split_once("/clip/")?;
+    let (layer, clip) = (layer.parse::<usize>().ok()?.checked_sub(1)?, clip.parse::<usize>().ok()?.checked_sub(1)?);
+    scene.show.as_ref()?.clip_at(layer, clip).map(|_| (layer, clip))
+}
+
 /// Maps events to writes; pairs 14-bit controllers; learns new bindings.
 #[derive(Debug, Default)]
 pub struct MidiMapper {
     bindings: Vec<Binding>,
+    /// Notes learned for a show's clips.
+    clips: Vec<ClipBinding>,
+    /// The show clip (layer, clip) waiting for a note (MIDI learn).
+    pub learning_clip: Option<(usize, usize)>,
     /// Last MSB per (channel, controller 0–31), for 14-bit pairs.
     msb: [[u8; 32]; 16],
     /// The parameter waiting for a control to be moved (MIDI learn).
@@ -192,12 +216,35 @@ impl MidiMapper {
     pub fn new(scene: &Scene, learned: &[MidiMapping]) -> Self {
         let mut bindings: Vec<Binding> =
             scene.midi.iter().map(|(mapping, target)| Binding { mapping: mapping.clone(), target: *target }).collect();
+        let mut clips = Vec::new();
         for m in learned {
-            if let Ok(target) = resolve_target(&scene.nodes, &m.target) {
+            if let Some((layer, clip)) = clip_target(&m.target, scene).filter(|_| m.note.is_some()) {
+                clips.push(ClipBinding { mapping: m.clone(), layer, clip });
+            } else if let Ok(target) = resolve_target(&scene.nodes, &m.target) {
                 bindings.push(Binding { mapping: m.clone(), target });
             }
         }
-        Self { bindings, ..Default::default() }
+        Self { bindings, clips, ..Default::default() }
+    }
+
+    /// Whether a parameter or a clip waits for a control to be moved.
+    pub fn is_learning(&self) -> bool {
+        self.learning.is_some() || self.learning_clip.is_some()
+    }
+
+    /// The notes learned for clips.
+    pub fn clip_bindings(&self) -> &[ClipBinding] {
+        &self.clips
+    }
+
+    /// The triggers of the clips whose learned note `event` is.
+    pub fn clip_commands(&self, event: MidiEvent) -> Vec<crate::params::ShowCommand> {
+        let MidiEvent::NoteOn { channel, note, .. } = event else { return Vec::new() };
+        self.clips
+            .iter()
+            .filter(|b| b.mapping.note == Some(note) && b.mapping.channel.is_none_or(|c| c == channel))
+            .map(|b| crate::params::ShowCommand::Trigger { layer: b.layer, clip: Some(b.clip) })
+            .collect()
     }
 
     /// Every binding.
@@ -224,6 +271,24 @@ impl MidiMapper {
             MidiEvent::Stop => self.clock.playing = false,
             MidiEvent::Program { program, .. } => return (Vec::new(), Some(program)),
             _ => {}
+        }
+        if let (Some((layer, clip)), MidiEvent::NoteOn { channel, note, .. }) = (self.learning_clip, event) {
+            self.learning_clip = None;
+            self.clips.retain(|b| (b.layer, b.clip) != (layer, clip));
+            let target = format!("layer/{}/clip/{}", layer + 1, clip + 1);
+            log::info!("MIDI learn: note {note} on channel {channel} → {target}");
+            let mapping = MidiMapping {
+                channel: Some(channel),
+                cc: None,
+                note: Some(note),
+                target,
+                range: None,
+                curve: Default::default(),
+                invert: false,
+                fine: false,
+            };
+            self.clips.push(ClipBinding { mapping, layer, clip });
+            return (Vec::new(), None);
         }
         if let Some(target) = self.learning {
             if let Some(mapping) = learned_mapping(event, target, scene) {
@@ -385,8 +450,13 @@ impl LearnStore {
 
     /// Saves the learned (non-scene) bindings of `mapper`.
     pub fn save(&self, mapper: &MidiMapper, scene: &Scene) -> Result<(), String> {
-        let learned: Vec<&MidiMapping> =
-            mapper.bindings().iter().map(|b| &b.mapping).filter(|m| !scene.midi.iter().any(|(s, _)| s == *m)).collect();
+        let learned: Vec<&MidiMapping> = mapper
+            .bindings()
+            .iter()
+            .map(|b| &b.mapping)
+            .filter(|m| !scene.midi.iter().any(|(s, _)| s == *m))
+            .chain(mapper.clip_bindings().iter().map(|b| &b.mapping))
+            .collect();
         let text = ron::ser::to_string_pretty(&learned, Default::default()).map_err(|e| e.to_string())?;
         crate::atomic_file::write(&self.path, text.as_bytes())
             .map_err(|e| format!("cannot write {}: {e}", self.path.display()))

@@ -550,6 +550,15 @@ fn show_commands_survive_a_recording_and_midi_notes_trigger_clips() {
     let mut hub = crate::control::hub(&dir, &cued);
     assert_eq!(hub.midi_bytes(&[0x95, 60, 1], &cued, 0.0), [ControlEvent::Show(ShowCommand::CueGo)]);
     assert_eq!(hub.midi_bytes(&[0x90, 59, 1], &cued, 0.0), [ControlEvent::Show(ShowCommand::CueBack)]);
+    // MIDI learn of a clip: the next note binds (and does not trigger), then triggers it, and
+    // the binding is saved for the next run.
+    let mut hub = crate::control::hub(&dir, &scene);
+    hub.learn_clip(0, 0);
+    assert!(hub.midi_bytes(&[0x93, 50, 90], &scene, 0.0).is_empty(), "the learned note fired at once");
+    assert_eq!(hub.midi_bytes(&[0x93, 50, 90], &scene, 0.0), [trigger(0, 0)]);
+    let saved = std::fs::read_to_string(dir.join("midi-learn.ron")).unwrap();
+    assert!(saved.contains("layer/1/clip/1"), "{saved}");
+    assert_eq!(crate::control::hub(&dir, &scene).midi_bytes(&[0x93, 50, 90], &scene, 0.0), [trigger(0, 0)]);
     // Recorded and read back, a show command is the same command at the same frame.
     let path = dir.join("take.ron");
     let mut recorder = indra::control::record::Recorder::create(&path).unwrap();
