@@ -40,3 +40,21 @@ struct Display {
     height: u32,
 };
 @group(0) @binding(1) var<uniform> display: Display;
+
+// The same encode in compute, into a storage image (off-screen renders, recordings): one
+// invocation per target pixel at its centre, as the fragment path samples. A compute pass
+// skips the raster path's fixed cost, which on compute-first GPUs grows with the pixels.
+@group(0) @binding(2) var target_image: texture_storage_2d<rgba8unorm, write>;
+
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let dst = textureDimensions(target_image);
+    if id.x >= dst.x || id.y >= dst.y {
+        return;
+    }
+    let src_size = vec2<f32>(textureDimensions(source));
+    let centre = vec2<f32>(id.xy) + 0.5;
+    let texel = vec2<i32>(floor(centre * src_size / vec2<f32>(dst)));
+    let c = textureLoad(source, texel, 0);
+    textureStore(target_image, vec2<i32>(id.xy), vec4<f32>(linear_to_srgb(c.rgb), 1.0));
+}

@@ -418,7 +418,7 @@ impl Running {
                     BlitTarget { view: &target, format: self.config.format, size },
                 );
                 if let Some(video) = self.video.as_mut() {
-                    video.capture(&self.gpu.device, &self.gpu.queue, &mut encoder, &output.view, steps);
+                    video.capture(&self.gpu.device, &mut encoder, &output.view, steps);
                 }
                 for (i, window) in self.outputs.iter_mut().enumerate() {
                     let Some(Some((_, view))) = output.extras.get(window.number - 1) else { continue };

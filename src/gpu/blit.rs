@@ -17,7 +17,9 @@ pub fn display_target(device: &wgpu::Device, label: &str, size: (u32, u32)) -> w
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
         format: DISPLAY_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
         view_formats: &[],
     })
 }
@@ -38,6 +40,8 @@ pub struct Blit {
     module: wgpu::ShaderModule,
     pipelines: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
     uniform: wgpu::Buffer,
+    /// The compute encode into a [`display_target`] (made on first use).
+    compute: Option<(wgpu::BindGroupLayout, wgpu::ComputePipeline)>,
 }
 
 impl Blit {
@@ -76,7 +80,34 @@ impl Blit {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Self { layout, module, pipelines: HashMap::new(), uniform }
+        Self { layout, module, pipelines: HashMap::new(), uniform, compute: None }
+    }
+
+    /// Records the same encode as [`Blit::record`] as a compute pass into `target`, a
+    /// [`display_target`] (off-screen renders and recordings): on the H200 a raster pass has a
+    /// fixed cost that grows with the pixels, a compute pass does not.
+    pub fn record_compute(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        source: &wgpu::TextureView,
+        target: &wgpu::Texture,
+    ) {
+        let (layout, pipeline) = self.compute.get_or_insert_with(|| compute_pipeline(device, &self.module));
+        let view = target.create_view(&Default::default());
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("display_compute_bind_group"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(source) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&view) },
+            ],
+        });
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("display_encode"), timestamp_writes: None });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups(target.width().div_ceil(8), target.height().div_ceil(8), 1);
     }
 
     /// Records a pass that draws `source` over the whole of `target`.
@@ -145,4 +176,51 @@ impl Blit {
             })
         })
     }
+}
+
+/// The compute encode's layout and pipeline (entry `cs_main` of the display shader).
+fn compute_pipeline(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+) -> (wgpu::BindGroupLayout, wgpu::ComputePipeline) {
+    let stage = wgpu::ShaderStages::COMPUTE;
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("display_compute_layout"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: stage,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: stage,
+                ty: wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: DISPLAY_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            },
+        ],
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("display_compute_pipeline_layout"),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("display_compute"),
+        layout: Some(&pipeline_layout),
+        module,
+        entry_point: Some("cs_main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    (layout, pipeline)
 }

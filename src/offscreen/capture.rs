@@ -14,7 +14,7 @@ use std::sync::mpsc::{Receiver, SyncSender, TrySendError};
 use std::thread::JoinHandle;
 
 use super::video::{VideoError, VideoSettings, VideoWriter};
-use crate::gpu::{Blit, BlitTarget, DISPLAY_FORMAT};
+use crate::gpu::Blit;
 
 /// Readback buffers in flight by default: enough to cover a few frames of GPU latency.
 pub const DEFAULT_IN_FLIGHT: usize = 4;
@@ -92,7 +92,6 @@ struct Pending {
 /// A live recording.
 pub struct LiveRecorder {
     target: wgpu::Texture,
-    target_view: wgpu::TextureView,
     blit: Blit,
     size: (u32, u32),
     padded_row: u32,
@@ -117,7 +116,6 @@ impl LiveRecorder {
             .spawn(move || encode(writer, receiver))
             .map_err(|e| VideoError::Settings(format!("cannot start the encoder thread: {e}")))?;
         let target = crate::gpu::display_target(device, "capture_target", size);
-        let target_view = target.create_view(&Default::default());
         let padded_row = (size.0 * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let slots = (0..in_flight.max(1))
             .map(|_| Slot {
@@ -132,7 +130,6 @@ impl LiveRecorder {
             .collect::<Vec<_>>();
         Ok(Self {
             target,
-            target_view,
             blit: Blit::new(device),
             size,
             padded_row,
@@ -167,7 +164,6 @@ impl LiveRecorder {
     pub fn capture(
         &mut self,
         device: &wgpu::Device,
-        queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         source: &wgpu::TextureView,
         repeats: u32,
@@ -180,8 +176,7 @@ impl LiveRecorder {
             self.counts.dropped_busy += u64::from(repeats);
             return;
         };
-        let target = BlitTarget { view: &self.target_view, format: DISPLAY_FORMAT, size: self.size };
-        self.blit.record(device, queue, encoder, source, target);
+        self.blit.record_compute(device, encoder, source, &self.target);
         encoder.copy_texture_to_buffer(
             self.target.as_image_copy(),
             wgpu::TexelCopyBufferInfo {

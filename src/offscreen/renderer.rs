@@ -4,7 +4,7 @@ use std::path::Path;
 
 use crate::assets::Assets;
 use crate::gpu::DEFAULT_STALL_TIMEOUT;
-use crate::gpu::{Blit, BlitTarget, DISPLAY_FORMAT, Gpu, read_texture_rgba8};
+use crate::gpu::{Blit, Gpu, read_texture_rgba8};
 use crate::graph::{FrameStats, GraphRuntime};
 use crate::live::{GpuGuard, GpuState, GpuTrouble, LiveReload, ReloadReport};
 use crate::params::ControlEvent;
@@ -157,14 +157,7 @@ impl OffscreenRenderer {
                 crate::graph::GraphError::ReadOfUnwritten { pass: "<output>".into(), resource: format!("output {n}") }
             })?,
         };
-        let target_view = self.target.create_view(&Default::default());
-        self.blit.record(
-            &self.gpu.device,
-            &self.gpu.queue,
-            &mut encoder,
-            &shown,
-            BlitTarget { view: &target_view, format: DISPLAY_FORMAT, size: self.size },
-        );
+        self.blit.record_compute(&self.gpu.device, &mut encoder, &shown, &self.target);
         let index = self.gpu.queue.submit([encoder.finish()]);
         self.guard.submitted(index);
         self.runtime.after_submit();
