@@ -408,7 +408,7 @@ impl Running {
         let mut projected = Vec::new();
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("window_frame") });
-        match self.player.encode(&self.gpu, &mut self.runtime, &mut encoder, size) {
+        match self.player.encode(&self.gpu, &mut self.runtime, &mut encoder, size, |_| {}) {
             Ok(output) => {
                 self.blit.record(
                     &self.gpu.device,

@@ -159,6 +159,11 @@ impl<'r> FrameGraph<'r> {
         self.output
     }
 
+    /// Extra output `n` (from 0, in the order added), if any.
+    pub fn extra_output(&self, n: usize) -> Option<TextureHandle> {
+        self.extra_outputs.get(n).copied()
+    }
+
     /// Starts declaring a pass named `name` (use `<technique>/<pass>`; it labels timings too).
     pub fn add_pass(&mut self, name: impl Into<String>) -> PassBuilder<'_, 'r> {
         PassBuilder {

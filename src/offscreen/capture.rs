@@ -176,7 +176,8 @@ impl LiveRecorder {
             self.counts.dropped_busy += u64::from(repeats);
             return;
         };
-        self.blit.record_compute(device, encoder, source, &self.target);
+        let target = self.target.create_view(&Default::default());
+        self.blit.record_compute(device, encoder, source, &target, self.size);
         encoder.copy_texture_to_buffer(
             self.target.as_image_copy(),
             wgpu::TexelCopyBufferInfo {

@@ -5,7 +5,7 @@ use std::path::Path;
 use crate::assets::Assets;
 use crate::gpu::DEFAULT_STALL_TIMEOUT;
 use crate::gpu::{Blit, Gpu, read_texture_rgba8};
-use crate::graph::{FrameStats, GraphRuntime};
+use crate::graph::{FrameStats, GraphRuntime, PersistentTexture};
 use crate::live::{GpuGuard, GpuState, GpuTrouble, LiveReload, ReloadReport};
 use crate::params::ControlEvent;
 use crate::scene::{Player, Scene, SceneInstance, SeekError};
@@ -31,7 +31,7 @@ pub struct OffscreenRenderer {
     runtime: GraphRuntime,
     blit: Blit,
     size: (u32, u32),
-    target: wgpu::Texture,
+    target: PersistentTexture,
     guard: GpuGuard,
     /// Which output is read back: 0 the scene's output, n its n-th extra output.
     shown: usize,
@@ -150,14 +150,23 @@ impl OffscreenRenderer {
         let time = self.player.step();
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("offscreen_frame") });
-        let output = self.player.encode(&self.gpu, &mut self.runtime, &mut encoder, self.size)?;
-        let shown = match self.shown {
-            0 => output.view.clone(),
-            n => output.extras.get(n - 1).cloned().flatten().map(|(_, view)| view).ok_or_else(|| {
-                crate::graph::GraphError::ReadOfUnwritten { pass: "<output>".into(), resource: format!("output {n}") }
-            })?,
-        };
-        self.blit.record_compute(&self.gpu.device, &mut encoder, &shown, &self.target);
+        let (blit, target, shown, size) = (&mut self.blit, &self.target, self.shown, self.size);
+        let mut encoded = false;
+        let output = self.player.encode(&self.gpu, &mut self.runtime, &mut encoder, self.size, |graph| {
+            // The display encode is a pass of the frame: timed with the others, after them.
+            let source = if shown == 0 { graph.output() } else { graph.extra_output(shown - 1) };
+            let Some(source) = source else { return };
+            let written = graph.import_texture("display/target", target);
+            graph.add_pass("display/encode").read(source).write(written).record(move |ctx| {
+                let (from, to) = (ctx.view(source).clone(), ctx.view(written).clone());
+                blit.record_compute(ctx.device, ctx.encoder, &from, &to, size);
+            });
+            encoded = true;
+        })?;
+        if !encoded {
+            let resource = format!("output {}", self.shown);
+            return Err(crate::graph::GraphError::ReadOfUnwritten { pass: "<output>".into(), resource });
+        }
         let index = self.gpu.queue.submit([encoder.finish()]);
         self.guard.submitted(index);
         self.runtime.after_submit();
@@ -167,7 +176,7 @@ impl OffscreenRenderer {
     /// Renders the next frame and reads it back.
     pub fn render_next(&mut self) -> Result<RenderedFrame, RenderError> {
         let (time, stats) = self.render_only()?;
-        let rgba = read_texture_rgba8(&self.gpu.device, &self.gpu.queue, &self.target)?;
+        let rgba = read_texture_rgba8(&self.gpu.device, &self.gpu.queue, &self.target.texture)?;
         Ok(RenderedFrame { time, rgba, size: self.size, stats })
     }
 
@@ -190,8 +199,8 @@ impl OffscreenRenderer {
 }
 
 /// The texture a frame is encoded into for readback.
-fn display_target(gpu: &Gpu, size: (u32, u32)) -> wgpu::Texture {
-    crate::gpu::display_target(&gpu.device, "offscreen_target", size)
+fn display_target(gpu: &Gpu, size: (u32, u32)) -> PersistentTexture {
+    PersistentTexture::new(&gpu.device, "offscreen_target", size, crate::gpu::DISPLAY_FORMAT)
 }
 
 /// Why an off-screen frame could not be produced; each is one sentence for the user.

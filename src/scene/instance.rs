@@ -519,17 +519,19 @@ impl SceneInstance {
         runtime.simulate(&gpu.device, &gpu.queue, graph, encoder).map(|_| ())
     }
 
-    /// Builds and records the frame into `encoder`; the caller encodes the output for display
-    /// and submits.
-    pub fn encode(
-        &mut self,
+    /// Builds and records the frame into `encoder`, after `finish` added its passes to the
+    /// declared frame (a display encode, timed with the rest); the caller submits.
+    pub fn encode<'r>(
+        &'r mut self,
         gpu: &Gpu,
         runtime: &mut GraphRuntime,
         encoder: &mut wgpu::CommandEncoder,
         output_size: (u32, u32),
         time: &FrameTime,
+        finish: impl FnOnce(&mut FrameGraph<'r>),
     ) -> Result<FrameOutput, GraphError> {
-        let graph = self.build_graph(output_size, time);
+        let mut graph = self.build_graph(output_size, time);
+        finish(&mut graph);
         runtime.execute(&gpu.device, &gpu.queue, graph, encoder)
     }
 }

@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 
 use super::instance::SceneInstance;
 use crate::gpu::Gpu;
-use crate::graph::{FrameOutput, GraphError, GraphRuntime};
+use crate::graph::{FrameGraph, FrameOutput, GraphError, GraphRuntime};
 use crate::params::{ControlEvent, Remap};
 use crate::time::{FixedClock, FrameTime};
 
@@ -129,17 +129,18 @@ impl Player {
         Ok(())
     }
 
-    /// Records the frame of the last step into `encoder`; the caller encodes the output for
-    /// display and submits.
-    pub fn encode(
-        &mut self,
+    /// Records the frame of the last step into `encoder`, with the passes `finish` adds to it
+    /// (see [`SceneInstance::encode`]); the caller submits.
+    pub fn encode<'r>(
+        &'r mut self,
         gpu: &Gpu,
         runtime: &mut GraphRuntime,
         encoder: &mut wgpu::CommandEncoder,
         output_size: (u32, u32),
+        finish: impl FnOnce(&mut FrameGraph<'r>),
     ) -> Result<FrameOutput, GraphError> {
         let time = self.last;
-        self.instance.encode(gpu, runtime, encoder, output_size, &time)
+        self.instance.encode(gpu, runtime, encoder, output_size, &time, finish)
     }
 }
 
