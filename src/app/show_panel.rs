@@ -39,8 +39,7 @@ pub fn show_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut Control
                     hint.push_str(" — could not be loaded");
                 }
                 let learning = hub.mapper.learning_clip == Some((l, c));
-                let learned =
-                    hub.mapper.clip_bindings().iter().any(|b| (b.layer, b.clip) == (l, c)) || info.note.is_some();
+                let learned = hub.mapper.clip_bindings().iter().any(|b| (b.layer, b.clip) == (l, c));
                 // ASCII marks: egui's bundled fonts lack the usual dot glyphs.
                 let mark = match (broken, learning, learned) {
                     (true, _, _) => " !",

@@ -283,7 +283,7 @@ impl ControlHub {
         for e in self.parser.feed(bytes) {
             // The note that is being learned only binds; it triggers from then on.
             if !self.mapper.is_learning() {
-                let commands = super::midi::show_commands(e, scene).into_iter().chain(self.mapper.clip_commands(e));
+                let commands = super::midi::cue_commands(e, scene).into_iter().chain(self.mapper.clip_commands(e));
                 events.extend(commands.map(ControlEvent::Show));
             }
             let (writes, program) = self.mapper.handle(e, scene, seconds);

@@ -114,30 +114,43 @@ impl MidiParser {
     }
 }
 
-/// What a note-on asks of a show: GO or back when it is the show's cue note, and a trigger of
-/// each clip whose `note` (and channel, if given) it is.
-pub fn show_commands(event: MidiEvent, scene: &Scene) -> Vec<crate::params::ShowCommand> {
+/// GO or back, when a note-on is the show's cue note (any channel) and the show has cues.
+pub fn cue_commands(event: MidiEvent, scene: &Scene) -> Vec<crate::params::ShowCommand> {
     use crate::params::ShowCommand;
-    let (MidiEvent::NoteOn { channel, note, .. }, Some(show)) = (event, &scene.show) else { return Vec::new() };
+    let (MidiEvent::NoteOn { note, .. }, Some(show)) = (event, &scene.show) else { return Vec::new() };
     let cues = !show.cues.is_empty();
-    let mut commands = Vec::new();
-    if cues && show.cue_notes.go == Some(note) {
-        commands.push(ShowCommand::CueGo);
+    let go = (cues && show.cue_notes.go == Some(note)).then_some(ShowCommand::CueGo);
+    let back = (cues && show.cue_notes.back == Some(note)).then_some(ShowCommand::CueBack);
+    go.into_iter().chain(back).collect()
+}
+
+/// The clip notes a show file gives (`note`, `channel`), as bindings.
+fn show_clip_notes(scene: &Scene) -> Vec<ClipBinding> {
+    let Some(show) = &scene.show else { return Vec::new() };
+    let mut bindings = Vec::new();
+    for (layer, l) in show.layers.iter().enumerate() {
+        for (clip, &c) in l.clips.iter().enumerate() {
+            let Some((channel, note)) = show.clips[c].note else { continue };
+            let target = format!("layer/{}/clip/{}", layer + 1, clip + 1);
+            let mapping = note_mapping(channel, note, target);
+            bindings.push(ClipBinding { mapping, learned: false, layer, clip });
+        }
     }
-    if cues && show.cue_notes.back == Some(note) {
-        commands.push(ShowCommand::CueBack);
+    bindings
+}
+
+/// A note mapping to `target` (a clip trigger's).
+fn note_mapping(channel: Option<u8>, note: u8, target: String) -> MidiMapping {
+    MidiMapping {
+        channel,
+        cc: None,
+        note: Some(note),
+        target,
+        range: None,
+        curve: Default::default(),
+        invert: false,
+        fine: false,
     }
-    commands.extend(
-        show.layers
-            .iter()
-            .enumerate()
-            .flat_map(|(l, layer)| layer.clips.iter().enumerate().map(move |(c, &clip)| (l, c, clip)))
-            .filter(|&(_, _, clip)| {
-                show.clips[clip].note.is_some_and(|(ch, n)| n == note && ch.is_none_or(|ch| ch == channel))
-            })
-            .map(|(layer, c, _)| ShowCommand::Trigger { layer, clip: Some(c) }),
-    );
-    commands
 }
 
 /// Tempo from MIDI clock (24 pulses per quarter note) and transport state.
@@ -175,12 +188,14 @@ pub struct Binding {
     pub target: Target,
 }
 
-/// A note bound to a show's clip (learned on the panel: the mapping's target is
-/// `layer/<n>/clip/<m>`, numbered from 1).
+/// A note bound to a show's clip: a clip's `note` in the show file, or one learned on the panel
+/// (saved with the target `layer/<n>/clip/<m>`, numbered from 1).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ClipBinding {
-    /// As saved in the learn file.
+    /// The note and channel, and the target as the learn file writes it.
     pub mapping: MidiMapping,
+    /// Learned (saved in the learn file), not from the show file.
+    pub learned: bool,
     /// The layer, from 0.
     pub layer: usize,
     /// The clip within the layer, from 0.
@@ -216,10 +231,12 @@ impl MidiMapper {
     pub fn new(scene: &Scene, learned: &[MidiMapping]) -> Self {
         let mut bindings: Vec<Binding> =
             scene.midi.iter().map(|(mapping, target)| Binding { mapping: mapping.clone(), target: *target }).collect();
-        let mut clips = Vec::new();
+        let mut clips = show_clip_notes(scene);
         for m in learned {
             if let Some((layer, clip)) = clip_target(&m.target, scene).filter(|_| m.note.is_some()) {
-                clips.push(ClipBinding { mapping: m.clone(), layer, clip });
+                // A learned note replaces the show file's for that clip.
+                clips.retain(|b| (b.layer, b.clip) != (layer, clip));
+                clips.push(ClipBinding { mapping: m.clone(), learned: true, layer, clip });
             } else if let Ok(target) = resolve_target(&scene.nodes, &m.target) {
                 bindings.push(Binding { mapping: m.clone(), target });
             }
@@ -277,17 +294,8 @@ impl MidiMapper {
             self.clips.retain(|b| (b.layer, b.clip) != (layer, clip));
             let target = format!("layer/{}/clip/{}", layer + 1, clip + 1);
             log::info!("MIDI learn: note {note} on channel {channel} → {target}");
-            let mapping = MidiMapping {
-                channel: Some(channel),
-                cc: None,
-                note: Some(note),
-                target,
-                range: None,
-                curve: Default::default(),
-                invert: false,
-                fine: false,
-            };
-            self.clips.push(ClipBinding { mapping, layer, clip });
+            let mapping = note_mapping(Some(channel), note, target);
+            self.clips.push(ClipBinding { mapping, learned: true, layer, clip });
             return (Vec::new(), None);
         }
         if let Some(target) = self.learning {
@@ -455,7 +463,7 @@ impl LearnStore {
             .iter()
             .map(|b| &b.mapping)
             .filter(|m| !scene.midi.iter().any(|(s, _)| s == *m))
-            .chain(mapper.clip_bindings().iter().map(|b| &b.mapping))
+            .chain(mapper.clip_bindings().iter().filter(|b| b.learned).map(|b| &b.mapping))
             .collect();
         let text = ron::ser::to_string_pretty(&learned, Default::default()).map_err(|e| e.to_string())?;
         crate::atomic_file::write(&self.path, text.as_bytes())

@@ -370,7 +370,8 @@ impl SceneInstance {
         self.params = params;
         self.scene = scene;
         if let (Some(show), Some(old)) = (&mut show, &self.show) {
-            show.carry_over(old, &self.scene, &self.params);
+            let messages = show.carry_over(old, &self.scene, &self.params, &mut self.nodes);
+            self.messages.extend(messages);
         }
         self.show = show;
         self.overridden.clear();

@@ -422,7 +422,7 @@ pub const MAX_ID_CHARS: usize = 64;
 
 /// Errors located and reported per file; the rest are counted. Locating scans the source, so a
 /// file with tens of thousands of mistakes would otherwise take quadratic time to check.
-const MAX_REPORTED_ERRORS: usize = 50;
+pub(crate) const MAX_REPORTED_ERRORS: usize = 50;
 /// Most nodes a scene may have (each builds pipelines and textures): a bound that `check` reports,
 /// rather than a render that runs out of memory.
 pub const MAX_NODES: usize = 256;

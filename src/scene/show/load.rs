@@ -12,7 +12,10 @@ use super::{Clip, Cue, CueNotes, Layer, Length, MAX_CLIPS_PER_LAYER, MAX_CUES, M
 use crate::assets::{AssetKind, Assets};
 use crate::params::{ParamSet, ParamValue, Target, coerce};
 use crate::scene::error::{SceneError, SceneErrors, locate};
-use crate::scene::load::{MAX_NODES, Scene, SceneNode, header_problems, load_scene, read_ron, resolve_target};
+use crate::scene::load::{
+    MAX_NODES, MAX_REPORTED_ERRORS, Scene, SceneNode, header_problems, load_scene, names_a_show, read_ron,
+    resolve_target,
+};
 use crate::techniques::{blend, fader};
 
 /// Ids a clip may not take: the show's own addresses start with them.
@@ -67,7 +70,7 @@ struct Builder<'a> {
 
 impl Builder<'_> {
     fn error(&mut self, anchors: &[&str], message: String) {
-        if self.errors.len() < 50 {
+        if self.errors.len() < MAX_REPORTED_ERRORS {
             let (line, column) = locate(self.source, anchors);
             self.errors.push(SceneError { origin: self.origin.into(), line, column, message });
         }
@@ -129,7 +132,7 @@ impl Builder<'_> {
                     self.error(&[&scene_anchor, "note"], format!("clip '{id}': {problem}"));
                 }
                 let offset = nodes.len();
-                let output = match self.clip_scene(clip, &id, &scene_anchor) {
+                let output = match self.clip_scene(clip) {
                     Ok(scene) => {
                         sources.push(scene.origin.clone());
                         for mut t in scene.tracks {
@@ -302,12 +305,11 @@ impl Builder<'_> {
     }
 
     /// The clip's scene, validated, with the clip's start values applied.
-    fn clip_scene(&self, clip: &ClipFile, id: &str, _anchor: &str) -> Result<Scene, String> {
+    fn clip_scene(&self, clip: &ClipFile) -> Result<Scene, String> {
         // A relative path is taken from the show file's folder first.
         let beside = Path::new(self.origin).parent().map(|d| d.join(&clip.scene)).filter(|p| p.is_file());
         let name = beside.map(|p| p.display().to_string()).unwrap_or_else(|| clip.scene.clone());
-        let text = Path::new(&name).is_file().then(|| std::fs::read_to_string(&name).unwrap_or_default());
-        if text.as_deref().is_some_and(super::file::is_show) {
+        if names_a_show(&name) {
             return Err(format!("'{}' is a show; a clip plays a scene", clip.scene));
         }
         let mut scene = load_scene(self.assets, &name).map_err(|e| e.to_string())?;
@@ -327,7 +329,6 @@ impl Builder<'_> {
                 return Err(format!("params: {target}: not a finite number"));
             }
         }
-        let _ = id;
         Ok(scene)
     }
 

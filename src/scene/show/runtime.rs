@@ -68,12 +68,22 @@ impl ShowRuntime {
 
     /// Takes over the play state of the show this one replaces (a hot reload); clips whose nodes
     /// ran before are no longer fresh, and hidden ones get fresh copies.
-    pub fn carry_over(&mut self, old: &ShowRuntime, scene: &Scene, params: &[ParamSet]) {
+    pub fn carry_over(
+        &mut self,
+        old: &ShowRuntime,
+        scene: &Scene,
+        params: &[ParamSet],
+        nodes: &mut [Box<dyn Technique>],
+    ) -> Vec<String> {
         self.state = old.state.carried(&old.plan, &self.plan);
+        let mut messages = Vec::new();
         for c in 0..self.plan.clips.len() {
             self.spares.mark_stale(c);
+            if self.plan.clips[c].policy == ClipPolicy::Restart && !self.state.visible(c) {
+                self.prepare(c, scene, params, nodes, &mut messages);
+            }
         }
-        self.prepare_hidden(scene, params);
+        messages
     }
 
     /// After every node was rebuilt on a new device: the play state stays; clips on screen run
@@ -145,10 +155,7 @@ impl ShowRuntime {
         }
         for c in changes.hidden {
             if self.plan.clips[c].policy == ClipPolicy::Restart {
-                let build = self.build(c, scene, params);
-                if let Some(result) = self.spares.prepare(c, build, self.assets.load_wait()) {
-                    self.install(c, result, nodes, &mut messages);
-                }
+                self.prepare(c, scene, params, nodes, &mut messages);
             }
         }
         messages
@@ -193,24 +200,24 @@ impl ShowRuntime {
             queue.submit([encoder.finish()]);
             runtime.after_submit();
             self.spares.mark_stale(c);
-            let build = self.build(c, scene, params);
-            if let Some(result) = self.spares.prepare(c, build, self.assets.load_wait()) {
-                self.install(c, result, nodes, &mut messages);
-            }
+            self.prepare(c, scene, params, nodes, &mut messages);
         }
         Ok(messages)
     }
 
-    /// Starts fresh copies of every hidden restart clip whose nodes ran.
-    fn prepare_hidden(&mut self, scene: &Scene, params: &[ParamSet]) {
-        for c in 0..self.plan.clips.len() {
-            if self.plan.clips[c].policy == ClipPolicy::Restart && !self.state.visible(c) {
-                let build = self.build(c, scene, params);
-                // A build done at once (renders) is taken up at the next step's `finished`
-                // only when on a thread; here the nodes ran, so a synchronous copy is dropped
-                // and the clip rebuilds when it starts.
-                let _ = self.spares.prepare(c, build, crate::files::LoadWait::Background);
-            }
+    /// Starts a fresh copy of clip `clip` (its nodes ran): built now in renders, on a worker
+    /// thread in a live show; one built now is swapped in at once.
+    fn prepare(
+        &mut self,
+        clip: usize,
+        scene: &Scene,
+        params: &[ParamSet],
+        nodes: &mut [Box<dyn Technique>],
+        messages: &mut Vec<String>,
+    ) {
+        let build = self.build(clip, scene, params);
+        if let Some(result) = self.spares.prepare(clip, build, self.assets.load_wait()) {
+            self.install(clip, result, nodes, messages);
         }
     }
 
