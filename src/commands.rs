@@ -53,6 +53,21 @@ pub struct RunArgs {
     /// Serve the OSCQuery address tree over HTTP here (e.g. 127.0.0.1:9001).
     #[arg(long)]
     pub oscquery: Option<String>,
+    /// Serve the browser control surface, with the OSCQuery tree, here: 127.0.0.1:8080 when
+    /// given no address; 0.0.0.0:8080 opens it to the venue network. The printed URL (and QR
+    /// code) carries the access token the page needs.
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = indra::control::web::DEFAULT_ADDR, conflicts_with = "oscquery")]
+    pub web: Option<String>,
+    /// Browser pages show the values but cannot change them (a display of the show's state).
+    #[arg(long, requires = "web")]
+    pub web_read_only: bool,
+    /// The access token (12–128 characters of A-Z a-z 0-9 - _) instead of a new random one each
+    /// start: for a bookmarked URL or a printed QR code at an installation.
+    #[arg(long, value_name = "TOKEN", requires = "web")]
+    pub web_token: Option<String>,
+    /// WebSocket sessions open at once: browser pages and OSCQuery clients together (1–256).
+    #[arg(long, value_name = "N", default_value_t = 16, value_parser = parse_web_sessions)]
+    pub web_sessions: usize,
     /// Only MIDI input ports whose name contains this (default: all ports).
     #[arg(long)]
     pub midi: Option<String>,
@@ -114,6 +129,10 @@ impl Default for RunArgs {
             no_osc: false,
             osc_out: None,
             oscquery: None,
+            web: None,
+            web_read_only: false,
+            web_token: None,
+            web_sessions: 16,
             midi: None,
             no_midi: false,
             audio_in: None,
@@ -322,10 +341,22 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         watch: !args.no_watch,
         record_video: args.record_video.clone(),
     };
+    let web = match &args.web {
+        Some(addr) => {
+            let token = match &args.web_token {
+                Some(chosen) => indra::control::web::AccessToken::chosen(chosen)?,
+                None => indra::control::web::AccessToken::random()?,
+            };
+            let (read_only, sessions) = (args.web_read_only, args.web_sessions);
+            Some(indra::control::web::WebOptions { addr: addr.clone(), read_only, token, sessions })
+        }
+        None => None,
+    };
     let control = indra::control::ControlOptions {
         osc: (!args.no_osc).then(|| args.osc.clone()),
         osc_out: args.osc_out.clone(),
         oscquery: args.oscquery.clone(),
+        web,
         midi: !args.no_midi,
         audio_in: (!args.no_audio).then(|| args.audio_in.clone()),
         midi_filter: args.midi.clone(),
@@ -336,6 +367,15 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         link: args.link,
     };
     indra::app::run(assets.clone(), gpu.clone(), scene, options, control, notices)
+}
+
+/// `--web-sessions`: a count within [`indra::control::web::SESSIONS`].
+fn parse_web_sessions(text: &str) -> Result<usize, String> {
+    let range = indra::control::web::SESSIONS;
+    text.parse::<usize>()
+        .ok()
+        .filter(|n| range.contains(n))
+        .ok_or_else(|| format!("{text}: WebSocket sessions are {} to {}", range.start(), range.end()))
 }
 
 /// Prints the audio input devices, one per line.

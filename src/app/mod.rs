@@ -7,6 +7,7 @@ mod outputs;
 mod panel;
 mod show_panel;
 mod surface;
+mod web_panel;
 mod window;
 
 use crate::assets::Assets;

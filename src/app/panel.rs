@@ -178,6 +178,7 @@ pub fn draw_ui(
                     events.extend(audio_panel(ui, &frame));
                 }
                 ui.small(hub.status());
+                super::web_panel::web_panel(ui, &hub.web_urls);
                 events.extend(super::show_panel::show_panel(ui, instance, hub));
                 events.extend(param_panel(ui, instance, hub).into_iter().map(ControlEvent::Write));
                 ui.separator();

@@ -13,6 +13,7 @@ use super::oscquery::OscQueryServer;
 use super::presets::PresetStore;
 use super::record::Recorder;
 use super::tempo::TempoInput;
+use super::web::WebOptions;
 use crate::params::{ControlEvent, Remap, Target};
 use crate::scene::{AudioSource, Scene, SceneView};
 
@@ -25,6 +26,9 @@ pub struct ControlOptions {
     pub osc_out: Option<String>,
     /// OSCQuery HTTP listen address.
     pub oscquery: Option<String>,
+    /// The browser control surface (served with OSCQuery at its address, which replaces
+    /// `oscquery`'s).
+    pub web: Option<WebOptions>,
     /// Open MIDI inputs.
     pub midi: bool,
     /// Only MIDI ports whose name contains this.
@@ -50,6 +54,7 @@ impl Default for ControlOptions {
             osc: Some("127.0.0.1:9000".into()),
             osc_out: None,
             oscquery: None,
+            web: None,
             midi: true,
             midi_filter: None,
             record: None,
@@ -72,6 +77,8 @@ pub struct ControlHub {
     changes: ParamChanges,
     /// OSCQuery server, if open.
     pub oscquery: Option<OscQueryServer>,
+    /// The browser surface's URLs (with the token), when it is served.
+    pub web_urls: Vec<String>,
     midi: Option<MidiInput>,
     parser: MidiParser,
     /// MIDI mappings, learn state and clock.
@@ -119,14 +126,23 @@ impl ControlHub {
                 notices.push(e);
             }
         };
-        let osc = options.osc.as_deref().and_then(|a| OscReceiver::bind(a).map_err(|e| report(Err(e))).ok());
+        let mut osc = options.osc.as_deref().and_then(|a| OscReceiver::bind(a).map_err(|e| report(Err(e))).ok());
         let feedback =
             options.osc_out.as_deref().and_then(|a| OscFeedback::connect(a).map_err(|e| report(Err(e))).ok());
         let osc_port = osc.as_ref().map_or(0, |o| o.local_addr().port());
-        let oscquery = options
-            .oscquery
-            .as_deref()
-            .and_then(|a| OscQueryServer::start(a, osc_port).map_err(|e| report(Err(e))).ok());
+        // The browser's writes are OSC too: with UDP input off they still need the queue.
+        let surface = options.web.as_ref().map(|web| {
+            let inlet = osc.get_or_insert_with(OscReceiver::without_socket).inlet();
+            (web.clone(), inlet)
+        });
+        let query_addr = options.web.as_ref().map(|w| w.addr.as_str()).or(options.oscquery.as_deref());
+        let oscquery =
+            query_addr.and_then(|a| OscQueryServer::start_with(a, osc_port, surface).map_err(|e| report(Err(e))).ok());
+        let web_urls = match (&options.web, &oscquery) {
+            (Some(web), Some(server)) => super::web::urls(server.local_addr(), &web.token),
+            _ => Vec::new(),
+        };
+        announce_surface(&web_urls, options.web.as_ref().is_some_and(|w| w.read_only));
         let midi = if options.midi {
             MidiInput::open(options.midi_filter.as_deref()).map_err(|e| log::info!("{e}")).ok()
         } else {
@@ -155,6 +171,7 @@ impl ControlHub {
             feedback,
             changes: ParamChanges::default(),
             oscquery,
+            web_urls,
             midi,
             parser: MidiParser::default(),
             mapper,
@@ -374,11 +391,12 @@ impl ControlHub {
         if let Some(f) = self.feedback.as_ref() {
             f.send(&changes);
         }
-        if let Some(q) = self.oscquery.as_mut() {
-            q.after_frame(instance, self.frame_count.is_multiple_of(6), &changes);
-        }
         if self.frame_count.is_multiple_of(PRESET_RESCAN_FRAMES) {
             self.preset_names = self.presets.names();
+        }
+        if let Some(q) = self.oscquery.as_mut() {
+            q.set_presets(&self.preset_names);
+            q.after_frame(instance, self.frame_count.is_multiple_of(6), &changes);
         }
         self.frame_count += 1;
     }
@@ -414,6 +432,21 @@ impl ControlHub {
     fn notice(&mut self, message: String) {
         log::warn!("{message}");
         self.notices.push(message);
+    }
+}
+
+/// Tells the performer where the browser surface is: each URL, and a QR code of the first for a
+/// phone's camera when it is open to the network.
+fn announce_surface(urls: &[String], read_only: bool) {
+    let mode = if read_only { " (read-only)" } else { "" };
+    for url in urls {
+        log::info!("control surface{mode} on {url}");
+    }
+    let Some(first) = urls.first().filter(|u| !u.starts_with("http://127.") && !u.starts_with("http://[::1]")) else {
+        return;
+    };
+    if let Some(code) = super::web::qr::terminal(first) {
+        log::info!("scan to open the control surface:\n{code}");
     }
 }
 

@@ -3,6 +3,11 @@
 //! each change of those values as a binary OSC message; a new namespace (another scene) is
 //! announced as `{"COMMAND": "PATH_CHANGED", "DATA": "/indra"}`. The render thread only queues:
 //! a session that falls [`QUEUE`] messages behind loses the overflow, never the show's time.
+//!
+//! A session that may control the show (see [`super::web`]) sends binary OSC packets on the same
+//! socket, as the OSCQuery proposal allows; they go through the [`OscInlet`] UDP packets go
+//! through. A session that sends OSC without that right, or more than [`MAX_PACKET_RATE`]
+//! packets a second, is closed: a flood ends that session only.
 
 use std::collections::HashSet;
 use std::net::TcpStream;
@@ -12,6 +17,8 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use rosc::{OscMessage, OscPacket};
+
+use super::osc::{Intake, OscInlet};
 use serde_json::{Value, json};
 use tungstenite::{Message, WebSocket};
 
@@ -25,6 +32,9 @@ pub const MAX_PATH_LEN: usize = 256;
 pub const MAX_PATH_BYTES: usize = 64 * 1024;
 /// How often a session is pinged; a WebSocket client answers with a pong by itself.
 pub const PING_EVERY: Duration = Duration::from_secs(3);
+/// Packets a controlling session may send in one second (a phone's fingers on sliders send
+/// well under 200); past that the session is closed.
+pub const MAX_PACKET_RATE: u32 = 1000;
 /// A session from which no whole message (a pong included) arrived for this long is closed:
 /// a client that stopped half-way through a frame, or vanished, frees its place.
 pub const SESSION_IDLE: Duration = Duration::from_secs(10);
@@ -102,8 +112,9 @@ impl Listeners {
         self.closed.store(true, Ordering::Relaxed);
     }
 
-    /// Serves one WebSocket session until the client leaves or the server closes.
-    pub fn serve(&self, mut socket: WebSocket<TcpStream>) {
+    /// Serves one WebSocket session until the client leaves or the server closes; its OSC
+    /// packets go to `control` when it may control the show, and end it otherwise.
+    pub fn serve(&self, mut socket: WebSocket<TcpStream>, control: Option<&OscInlet>) {
         let (queue, outgoing) = sync_channel(QUEUE);
         let paths = Arc::new(Mutex::new(HashSet::new()));
         let id = self.next_id.fetch_add(1, Ordering::Relaxed);
@@ -111,11 +122,27 @@ impl Listeners {
             sessions.push(Session { id, paths: paths.clone(), queue });
         }
         let (mut heard, mut pinged) = (Instant::now(), Instant::now());
+        let mut rate = Rate::default();
+        let from = format!("WebSocket session {id}");
         while !self.closed.load(Ordering::Relaxed) && heard.elapsed() < SESSION_IDLE {
             match socket.read() {
                 Ok(Message::Text(text)) => {
                     heard = Instant::now();
                     command(&text, &paths);
+                }
+                Ok(Message::Binary(bytes)) => {
+                    heard = Instant::now();
+                    let Some(inlet) = control else {
+                        log::warn!("OSCQuery: {from} sent OSC without the access token; closed");
+                        break;
+                    };
+                    if !rate.allows(heard) {
+                        log::warn!("OSCQuery: {from} sent more than {MAX_PACKET_RATE} packets a second; closed");
+                        break;
+                    }
+                    if inlet.take(&bytes, &from) == Intake::Closed {
+                        break;
+                    }
                 }
                 Ok(Message::Close(_)) => break,
                 Ok(_) => heard = Instant::now(),
@@ -138,6 +165,24 @@ impl Listeners {
         }
         let _ = socket.close(None);
         let _ = socket.flush();
+    }
+}
+
+/// Packets counted in the current one-second window.
+#[derive(Default)]
+struct Rate {
+    window: Option<Instant>,
+    packets: u32,
+}
+
+impl Rate {
+    /// Counts a packet at `now`; false once the window holds more than [`MAX_PACKET_RATE`].
+    fn allows(&mut self, now: Instant) -> bool {
+        if self.window.is_none_or(|start| now.duration_since(start) >= Duration::from_secs(1)) {
+            (self.window, self.packets) = (Some(now), 0);
+        }
+        self.packets += 1;
+        self.packets <= MAX_PACKET_RATE
     }
 }
 
@@ -176,6 +221,15 @@ fn deliver(socket: &mut WebSocket<TcpStream>, outgoing: &Receiver<Outgoing>) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_packet_rate_is_counted_per_second() {
+        let mut rate = Rate::default();
+        let start = Instant::now();
+        assert!((0..MAX_PACKET_RATE).all(|_| rate.allows(start)));
+        assert!(!rate.allows(start + Duration::from_millis(999)));
+        assert!(rate.allows(start + Duration::from_secs(1)), "a new second starts afresh");
+    }
 
     #[test]
     fn listened_addresses_are_bounded_in_length_and_in_total_bytes() {

@@ -1,4 +1,5 @@
-//! Live control: OSC in and out (with OSCQuery discovery), MIDI with learn, presets, and the
+//! Live control: OSC in and out (with OSCQuery discovery and the browser surface), MIDI with
+//! learn, presets, and the
 //! recording and replay of control streams. Everything becomes [`ControlEvent`]s that the
 //! running scene applies before its next fixed step. Knows nothing of rendering.
 //!
@@ -20,6 +21,7 @@ pub mod oscquery;
 pub mod presets;
 pub mod record;
 pub mod tempo;
+pub mod web;
 
 pub use address::{AddressMap, Route};
 pub use hub::{ControlHub, ControlOptions};

@@ -150,7 +150,8 @@ fn ntp_to_system_near(t: rosc::OscTime, now: SystemTime) -> Option<SystemTime> {
 /// Requested kernel receive buffer for the OSC socket.
 const RECEIVE_BUFFER_BYTES: usize = 4 << 20;
 
-/// The UDP receiver thread and the queue it fills.
+/// The UDP receiver thread and the queue it fills, which other transports (OSCQuery's
+/// WebSocket) fill too through an [`OscInlet`].
 pub struct OscReceiver {
     local: SocketAddr,
     queue: Receiver<(Batch, usize)>,
@@ -164,6 +165,7 @@ pub struct OscReceiver {
     stop: Arc<AtomicBool>,
     thread: Option<JoinHandle<()>>,
     logged: Arc<Mutex<HashSet<String>>>,
+    inlet: OscInlet,
 }
 
 impl OscReceiver {
@@ -175,31 +177,51 @@ impl OscReceiver {
         let _ = socket2::SockRef::from(&socket).set_recv_buffer_size(RECEIVE_BUFFER_BYTES);
         socket.set_read_timeout(Some(Duration::from_millis(50))).map_err(|e| e.to_string())?;
         let local = socket.local_addr().map_err(|e| e.to_string())?;
+        let mut receiver = Self::queue_only(local);
+        let (inlet, stop) = (receiver.inlet.clone(), receiver.stop.clone());
+        let thread = std::thread::Builder::new()
+            .name("indra-osc".into())
+            .spawn(move || receive_loop(&socket, &inlet, &stop))
+            .map_err(|e| e.to_string())?;
+        receiver.thread = Some(thread);
+        log::info!("OSC listening on {local}");
+        Ok(receiver)
+    }
+
+    /// A receiver with no UDP socket, filled only through its [`OscInlet`] (OSC over OSCQuery's
+    /// WebSocket with UDP input off). `local_addr` is the unspecified address, port 0.
+    pub fn without_socket() -> Self {
+        Self::queue_only(SocketAddr::from(([0, 0, 0, 0], 0)))
+    }
+
+    fn queue_only(local: SocketAddr) -> Self {
         let (tx, queue) = sync_channel(MAX_QUEUED);
         let queued_bytes = Arc::new(AtomicUsize::new(0));
         let counters = Arc::new(OscCounters::default());
-        let stop = Arc::new(AtomicBool::new(false));
         let logged = Arc::new(Mutex::new(HashSet::new()));
-        let thread = {
-            let (counters, stop, logged) = (counters.clone(), stop.clone(), logged.clone());
-            let queue = Queue { tx, bytes: queued_bytes.clone() };
-            std::thread::Builder::new()
-                .name("indra-osc".into())
-                .spawn(move || receive_loop(&socket, &queue, &counters, &stop, &logged))
-                .map_err(|e| e.to_string())?
+        let inlet = OscInlet {
+            queue: Queue { tx, bytes: queued_bytes.clone() },
+            counters: counters.clone(),
+            logged: logged.clone(),
         };
-        log::info!("OSC listening on {local}");
-        Ok(Self {
+        Self {
             local,
             queue,
             queued_bytes,
             counters,
             scheduled: Vec::new(),
             scheduled_bytes: 0,
-            stop,
-            thread: Some(thread),
+            stop: Arc::new(AtomicBool::new(false)),
+            thread: None,
             logged,
-        })
+            inlet,
+        }
+    }
+
+    /// Where other transports hand in their packets, to be checked, counted, queued and
+    /// routed exactly as UDP's are.
+    pub fn inlet(&self) -> OscInlet {
+        self.inlet.clone()
     }
 
     /// The bound address (useful with port 0).
@@ -298,8 +320,9 @@ fn describe_args(args: &[OscType]) -> String {
     parts.join(", ")
 }
 
-/// The receiver thread's end of the queue: batches with their [`Batch::bytes`], counted once,
-/// and the bytes the queue holds.
+/// The receiving end of the queue: batches with their [`Batch::bytes`], counted once, and the
+/// bytes the queue holds.
+#[derive(Clone)]
 struct Queue {
     tx: SyncSender<(Batch, usize)>,
     bytes: Arc<AtomicUsize>,
@@ -323,43 +346,80 @@ impl Queue {
     }
 }
 
-fn receive_loop(
-    socket: &UdpSocket,
-    queue: &Queue,
-    counters: &OscCounters,
-    stop: &AtomicBool,
-    logged: &Mutex<HashSet<String>>,
-) {
+/// Where an OSC packet enters, whatever carried it (a UDP datagram, a WebSocket message): it is
+/// decoded, counted and queued for the render loop under one set of limits and counters.
+#[derive(Clone)]
+pub struct OscInlet {
+    queue: Queue,
+    counters: Arc<OscCounters>,
+    logged: Arc<Mutex<HashSet<String>>>,
+}
+
+/// What became of a packet handed to an [`OscInlet`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Intake {
+    /// Queued; `stats`: it asks for `/indra/stats`, which the transport may answer at once.
+    Queued {
+        /// The packet holds a `/indra/stats` message.
+        stats: bool,
+    },
+    /// It did not decode (counted malformed).
+    Malformed,
+    /// The queue was full (counted dropped).
+    Dropped,
+    /// The receiver is gone.
+    Closed,
+}
+
+impl OscInlet {
+    /// Checks, counts and queues one packet from `from` (named in the log).
+    pub fn take(&self, bytes: &[u8], from: &dyn std::fmt::Display) -> Intake {
+        let counters = &self.counters;
+        counters.packets.fetch_add(1, Ordering::Relaxed);
+        let batches = match decode(bytes) {
+            Ok(batches) => batches,
+            Err(e) => {
+                counters.malformed.fetch_add(1, Ordering::Relaxed);
+                log_once(&self.logged, "malformed", &format!("malformed packet from {from}: {e}"));
+                return Intake::Malformed;
+            }
+        };
+        let mut intake = Intake::Queued { stats: false };
+        for batch in batches {
+            counters.messages.fetch_add(batch.messages.len() as u64, Ordering::Relaxed);
+            let stats = batch.messages.iter().any(|m| m.addr == "/indra/stats");
+            match self.queue.push(batch) {
+                Ok(()) => {
+                    if let Intake::Queued { stats: asked } = &mut intake {
+                        *asked |= stats;
+                    }
+                }
+                Err(TrySendError::Full(())) => {
+                    counters.dropped.fetch_add(1, Ordering::Relaxed);
+                    log_once(&self.logged, "queue full", "the render loop is behind; packets are dropped and counted");
+                    intake = Intake::Dropped;
+                }
+                Err(TrySendError::Disconnected(())) => return Intake::Closed,
+            }
+        }
+        intake
+    }
+
+    /// The shared counters.
+    pub fn counters(&self) -> &OscCounters {
+        &self.counters
+    }
+}
+
+fn receive_loop(socket: &UdpSocket, inlet: &OscInlet, stop: &AtomicBool) {
     let mut buf = vec![0u8; 65536];
     while !stop.load(Ordering::Relaxed) {
         let Ok((len, from)) = socket.recv_from(&mut buf) else { continue };
-        counters.packets.fetch_add(1, Ordering::Relaxed);
-        match decode(&buf[..len]) {
-            Ok(batches) => {
-                for batch in batches {
-                    counters.messages.fetch_add(batch.messages.len() as u64, Ordering::Relaxed);
-                    // Stats are answered here, so a client can ask even while frames are slow.
-                    if batch.messages.iter().any(|m| m.addr == "/indra/stats") {
-                        reply_stats(socket, from, counters);
-                    }
-                    match queue.push(batch) {
-                        Ok(()) => {}
-                        Err(TrySendError::Full(())) => {
-                            counters.dropped.fetch_add(1, Ordering::Relaxed);
-                            log_once(
-                                logged,
-                                "queue full",
-                                "the render loop is behind; packets are dropped and counted",
-                            );
-                        }
-                        Err(TrySendError::Disconnected(())) => return,
-                    }
-                }
-            }
-            Err(e) => {
-                counters.malformed.fetch_add(1, Ordering::Relaxed);
-                log_once(logged, "malformed", &format!("malformed packet from {from}: {e}"));
-            }
+        match inlet.take(&buf[..len], &from) {
+            // Stats are answered here, so a client can ask even while frames are slow.
+            Intake::Queued { stats: true } => reply_stats(socket, from, inlet.counters()),
+            Intake::Closed => return,
+            Intake::Queued { stats: false } | Intake::Malformed | Intake::Dropped => {}
         }
     }
 }
@@ -545,6 +605,9 @@ fn show_trigger(command: ShowCommand, args: &[OscType]) -> Option<Routed> {
     let pressed = match args.first() {
         None => true,
         Some(OscType::Bool(b)) => *b,
+        // An impulse (`I`): what OSCQuery clients such as Vidvox's oscqueryhtml send for a
+        // leaf typed `I`.
+        Some(OscType::Inf) => true,
         Some(_) => numbers(&args[..1]).is_some_and(|n| n[0] != 0.0 && n[0].is_finite()),
     };
     Some(if pressed { Routed::Event(ControlEvent::Show(command)) } else { Routed::Released })
@@ -609,6 +672,18 @@ pub fn coerce_args(args: &[OscType], decl: &ParamDecl) -> Option<ParamValue> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_show_trigger_is_pressed_by_nothing_true_non_zero_or_an_impulse() {
+        let go = |args: &[OscType]| show_trigger(ShowCommand::CueGo, args);
+        let fired = Some(Routed::Event(ControlEvent::Show(ShowCommand::CueGo)));
+        for pressed in [&[][..], &[OscType::Inf], &[OscType::Bool(true)], &[OscType::Int(1)], &[OscType::Float(0.5)]] {
+            assert_eq!(go(pressed), fired, "{pressed:?}");
+        }
+        for released in [OscType::Bool(false), OscType::Int(0), OscType::Float(f32::NAN)] {
+            assert_eq!(go(std::slice::from_ref(&released)), Some(Routed::Released), "{released:?}");
+        }
+    }
 
     #[test]
     fn commands_with_infinite_or_nan_numbers_are_refused() {

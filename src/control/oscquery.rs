@@ -11,8 +11,10 @@ use serde_json::{Map, Value, json};
 
 use super::address::param_address;
 use super::discovery::Advertisement;
-use super::http::{HttpServer, Routes};
+use super::http::{HttpServer, Reply, Request, Routes};
 use super::listen::Listeners;
+use super::osc::OscInlet;
+use super::web::WebOptions;
 use crate::params::{ParamDecl, ParamType, ParamValue};
 use crate::scene::SceneView;
 
@@ -49,13 +51,45 @@ fn range_json(decl: &ParamDecl) -> Option<Value> {
     Some(Value::Array(vec![json!({ "MIN": lo, "MAX": hi }); decl.ty().components()]))
 }
 
+/// The control a value asks for where its type tag does not say (an extension: OSCQuery clients
+/// ignore attributes they do not know). `color`: four floats that are an RGBA colour; `xy`: a
+/// 2-D point; `text`: free text.
+fn widget(ty: ParamType) -> Option<&'static str> {
+    match ty {
+        ParamType::Color => Some("color"),
+        ParamType::Vec2 => Some("xy"),
+        ParamType::Text => Some("text"),
+        _ => None,
+    }
+}
+
+/// The engine's own controls: presets (recall with morph seconds, save) and tempo (BPM and tap).
+fn engine_leaves(root: &mut Map<String, Value>, presets: &[String], bpm: f64) {
+    let (lo, hi) = crate::params::lfo::BPM_RANGE;
+    let preset = json!({ "FULL_PATH": "/indra/preset", "CONTENTS": {
+        "recall": { "FULL_PATH": "/indra/preset/recall", "TYPE": "sf", "ACCESS": 2,
+            "RANGE": [{ "VALS": presets }, { "MIN": 0.0, "MAX": 60.0 }],
+            "DESCRIPTION": "recall a preset, morphing over the seconds given" },
+        "save": { "FULL_PATH": "/indra/preset/save", "TYPE": "s", "ACCESS": 2,
+            "DESCRIPTION": "save the current values as a preset of this name" },
+    }});
+    let tempo = json!({ "FULL_PATH": "/indra/tempo", "CONTENTS": {
+        "bpm": { "FULL_PATH": "/indra/tempo/bpm", "TYPE": "f", "ACCESS": 3, "VALUE": [bpm],
+            "RANGE": [{ "MIN": lo, "MAX": hi }], "UNIT": ["BPM"], "DESCRIPTION": "the show's tempo" },
+        "tap": { "FULL_PATH": "/indra/tempo/tap", "TYPE": "I", "ACCESS": 2, "DESCRIPTION": "tap tempo: tap on the beat" },
+    }});
+    root.insert("preset".into(), preset);
+    root.insert("tempo".into(), tempo);
+}
+
 /// The whole address tree of `instance` with current values. Node ids with `/` (a show's
 /// `<clip>/<node>`, `layer/<n>`) nest as their addresses do. A show's tree holds its layers, the
 /// master, the trigger addresses of every clip, column and cue, and the parameters of the clips
 /// on screen — a clip change alters it (see [`shown_clips`]); a hidden clip's parameters still
-/// take writes at their addresses.
-pub fn tree(instance: SceneView<'_>) -> Value {
+/// take writes at their addresses. `presets` are the names `/indra/preset/recall` offers.
+pub fn tree(instance: SceneView<'_>, presets: &[String]) -> Value {
     let mut root = Map::new();
+    engine_leaves(&mut root, presets, instance.tempo.bpm);
     for (n, node) in instance.scene.nodes.iter().enumerate() {
         if let Some((show, state)) = instance.show
             && show.clip_of(n).is_some_and(|c| !state.visible(c))
@@ -72,6 +106,12 @@ pub fn tree(instance: SceneView<'_>) -> Value {
             leaf.insert("VALUE".into(), value_json(&params.target_at(p), decl));
             if let Some(range) = range_json(decl) {
                 leaf.insert("RANGE".into(), range);
+            }
+            if !decl.unit.is_empty() {
+                leaf.insert("UNIT".into(), json!(vec![decl.unit.as_str(); decl.ty().components()]));
+            }
+            if let Some(widget) = widget(decl.ty()) {
+                leaf.insert("WIDGET".into(), json!(widget));
             }
             leaf.insert("DESCRIPTION".into(), json!(decl.doc));
             contents.insert(decl.name.clone(), Value::Object(leaf));
@@ -153,7 +193,7 @@ pub fn host_info(osc_port: u16) -> Value {
         "OSC_TRANSPORT": "UDP",
         "EXTENSIONS": {
             "ACCESS": true, "VALUE": true, "RANGE": true, "DESCRIPTION": true, "TYPE": true,
-            "LISTEN": true, "PATH_CHANGED": true
+            "UNIT": true, "LISTEN": true, "PATH_CHANGED": true
         }
     })
 }
@@ -173,6 +213,12 @@ pub struct OscQueryServer {
     path_changed: bool,
     /// The show's clips the published tree holds.
     shown: Vec<usize>,
+    /// The preset names the tree offers.
+    presets: Vec<String>,
+    /// The tempo last sent to listeners (it is no parameter, so [`ParamChanges`] misses it).
+    ///
+    /// [`ParamChanges`]: super::feedback::ParamChanges
+    bpm: Option<f64>,
     server: HttpServer,
     /// Kept for its lifetime: dropping it withdraws the advertisement.
     _advertisement: Option<Advertisement>,
@@ -183,25 +229,39 @@ impl OscQueryServer {
     /// over mDNS unless `addr` is loopback. The server has hard limits (see [`super::http`]):
     /// no request can exhaust memory or hold up the others. mDNS that cannot start is logged.
     pub fn start(addr: &str, osc_port: u16) -> Result<Self, String> {
+        Self::start_with(addr, osc_port, None)
+    }
+
+    /// [`OscQueryServer::start`], serving the browser control surface too when `surface` is
+    /// given: its page, and OSC from the WebSocket sessions it admits into the inlet.
+    pub fn start_with(addr: &str, osc_port: u16, surface: Option<(WebOptions, OscInlet)>) -> Result<Self, String> {
         let snapshot: Arc<RwLock<Option<Value>>> = Arc::default();
         let tree = snapshot.clone();
-        let handler = Arc::new(move |target: &str| {
-            let (path, query) = target.split_once('?').unwrap_or((target, ""));
-            if query.contains("HOST_INFO") {
-                return (200, host_info(osc_port).to_string());
+        let web = surface.as_ref().map(|(options, _)| options.clone());
+        let handler = Arc::new(move |request: &Request<'_>| {
+            if let Some(reply) = web.as_ref().and_then(|web| web.reply(request)) {
+                return reply;
             }
-            let Ok(tree) = tree.read() else { return (503, "{}".to_string()) };
+            if request.query().contains("HOST_INFO") {
+                return Reply::json(200, host_info(osc_port).to_string());
+            }
+            let Ok(tree) = tree.read() else { return Reply::status(503) };
             // Until the show has built its scene there is no tree: a controller connecting at
             // start-up is told to come back, not shown an empty show.
-            match tree.as_ref().map(|t| subtree(t, path)) {
-                None => (503, "{}".to_string()),
-                Some(Some(v)) => (200, v.to_string()),
-                Some(None) => (404, "{}".to_string()),
+            match tree.as_ref().map(|t| subtree(t, request.path())) {
+                None => Reply::status(503),
+                Some(Some(v)) => Reply::json(200, v.to_string()),
+                Some(None) => Reply::status(404),
             }
         });
         let listeners = Arc::new(Listeners::default());
         let sessions = listeners.clone();
-        let routes = Routes { get: handler, socket: Some(Arc::new(move |socket| sessions.serve(socket))) };
+        let max_sockets = surface.as_ref().map_or(super::http::MAX_SOCKETS, |(web, _)| web.sessions);
+        let socket = Arc::new(move |request: &Request<'_>, socket| {
+            let control = surface.as_ref().filter(|(web, _)| web.controls(request)).map(|(_, inlet)| inlet);
+            sessions.serve(socket, control);
+        });
+        let routes = Routes { get: handler, socket: Some(socket), max_sockets };
         let server = HttpServer::start(addr, "oscquery", routes)?;
         let local = server.local_addr();
         log::info!("OSCQuery on http://{local}/");
@@ -216,7 +276,16 @@ impl OscQueryServer {
                 None
             }
         };
-        Ok(Self { snapshot, listeners, path_changed: false, shown: Vec::new(), server, _advertisement: advertisement })
+        Ok(Self {
+            snapshot,
+            listeners,
+            path_changed: false,
+            shown: Vec::new(),
+            presets: Vec::new(),
+            bpm: None,
+            server,
+            _advertisement: advertisement,
+        })
     }
 
     /// The bound address.
@@ -226,7 +295,7 @@ impl OscQueryServer {
 
     /// Publishes the current tree.
     pub fn publish(&self, instance: SceneView<'_>) {
-        let t = tree(instance);
+        let t = tree(instance, &self.presets);
         if let Ok(mut s) = self.snapshot.write() {
             *s = Some(t);
         }
@@ -248,13 +317,29 @@ impl OscQueryServer {
             self.shown = shown;
             self.path_changed = true;
         }
+        let mut changes = std::borrow::Cow::Borrowed(changes);
+        let bpm = instance.tempo.bpm;
+        if self.bpm.is_none_or(|last| (last - bpm).abs() > 1e-3) {
+            self.bpm = Some(bpm);
+            let args = vec![rosc::OscType::Float(bpm as f32)];
+            changes.to_mut().push(OscMessage { addr: "/indra/tempo/bpm".into(), args });
+        }
         if publish || self.path_changed {
             self.publish(instance);
         }
         if std::mem::take(&mut self.path_changed) {
             self.listeners.path_changed("/indra");
         }
-        if changes.is_empty() { 0 } else { self.listeners.send(changes) }
+        if changes.is_empty() { 0 } else { self.listeners.send(&changes) }
+    }
+
+    /// The preset names the tree offers; a change is published and announced after the next
+    /// frame.
+    pub fn set_presets(&mut self, names: &[String]) {
+        if names != self.presets {
+            self.presets = names.to_vec();
+            self.path_changed = true;
+        }
     }
 
     /// A new scene: the namespace change is announced after the next frame, once the new tree is

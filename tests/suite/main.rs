@@ -5,6 +5,7 @@
 
 mod architecture;
 mod audio;
+mod browser;
 mod cloth;
 #[path = "../common/mod.rs"]
 mod common;

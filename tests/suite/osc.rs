@@ -765,3 +765,89 @@ fn the_osc_queue_is_bounded_in_bytes_under_a_flood_of_large_datagrams() {
     assert!(!drained.is_empty());
     assert_eq!(rx.pending_bytes(), 0, "a drain gives the bytes back");
 }
+
+/// A server with the browser surface: OSC from the sessions it admits goes into `rx`.
+fn surface(read_only: bool, rx: &OscReceiver) -> OscQueryServer {
+    use indra::control::web::{AccessToken, WebOptions};
+    let token = AccessToken::chosen("socket-test-token").unwrap();
+    let web = WebOptions { addr: "127.0.0.1:0".into(), read_only, token, sessions: 4 };
+    OscQueryServer::start_with("127.0.0.1:0", 0, Some((web, rx.inlet()))).unwrap()
+}
+
+/// Whether the session was closed by the server within a few seconds.
+fn closed(socket: &mut Socket) -> bool {
+    let started = Instant::now();
+    while started.elapsed() < Duration::from_secs(5) {
+        match next_message(socket, Duration::from_millis(200)) {
+            Some(tungstenite::Message::Close(_)) => return true,
+            Some(_) => {}
+            None if socket.can_read() => {}
+            None => return true,
+        }
+    }
+    false
+}
+
+#[test]
+fn websocket_osc_is_taken_only_with_the_token_and_within_the_limits_of_udp() {
+    use tungstenite::Message;
+    let mut rx = OscReceiver::without_socket();
+    let server = surface(false, &rx);
+    let at = server.local_addr();
+    let write = packet("/indra/glow/intensity", vec![OscType::Float(0.5)]);
+
+    // With the token (in the URL, or the cookie the page sets), packets are OSC like UDP's.
+    let (mut socket, _) = tungstenite::connect(format!("ws://{at}/?token=socket-test-token")).unwrap();
+    socket.send(Message::binary(write.clone())).unwrap();
+    socket.send(Message::binary(b"garbage, not OSC".to_vec())).unwrap();
+    let batches = receive(&mut rx, 2);
+    assert_eq!(batches.len(), 1);
+    assert_eq!(batches[0].messages[0].addr, "/indra/glow/intensity");
+    let [packets, _, malformed, ..] = rx.counters().snapshot();
+    assert_eq!((packets, malformed), (2, 1), "garbage is counted as UDP's is, and the session goes on");
+    socket.send(Message::binary(write.clone())).unwrap();
+    assert_eq!(receive(&mut rx, 3).len(), 1, "the session survived the garbage");
+    let mut request = tungstenite::client::IntoClientRequest::into_client_request(format!("ws://{at}/")).unwrap();
+    request.headers_mut().insert("Cookie", "indra_token=socket-test-token".parse().unwrap());
+    let (mut cookie, _) = tungstenite::connect(request).unwrap();
+    cookie.send(Message::binary(write.clone())).unwrap();
+    assert_eq!(receive(&mut rx, 4).len(), 1);
+
+    // Without it a session may LISTEN, but OSC closes it unapplied.
+    let (mut stranger, _) = tungstenite::connect(format!("ws://{at}/?token=guess-guess-guess")).unwrap();
+    stranger.send(Message::text(r#"{"COMMAND":"LISTEN","DATA":"/indra/glow/intensity"}"#)).unwrap();
+    stranger.send(Message::binary(write.clone())).unwrap();
+    assert!(closed(&mut stranger), "a session without the token kept writing");
+    std::thread::sleep(Duration::from_millis(200));
+    assert_eq!(rx.counters().snapshot()[0], 4, "its packet reached the show");
+
+    // A huge frame and a flood end that session only.
+    let _ = socket.send(Message::binary(vec![0u8; indra::control::http::MAX_SOCKET_MESSAGE + 1]));
+    assert!(closed(&mut socket), "a huge frame did not end the session");
+    let (mut flood, _) = tungstenite::connect(format!("ws://{at}/?token=socket-test-token")).unwrap();
+    let sent = (0..5 * indra::control::listen::MAX_PACKET_RATE)
+        .take_while(|_| flood.send(Message::binary(write.clone())).is_ok())
+        .count();
+    assert!(closed(&mut flood), "a flood of {sent} packets did not end the session");
+    let taken = rx.counters().snapshot()[0];
+    assert!(
+        taken <= 4 + u64::from(indra::control::listen::MAX_PACKET_RATE) + 1,
+        "{taken} packets taken from the flood"
+    );
+    cookie.send(Message::binary(write.clone())).unwrap();
+    let started = Instant::now();
+    while rx.counters().snapshot()[0] == taken {
+        assert!(started.elapsed() < Duration::from_secs(5), "another session was hurt by the flood");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert_eq!(http_get(at, "/?HOST_INFO").0, 200, "the server still answers");
+
+    // A read-only surface takes OSC from nobody, token or not.
+    let mut rx = OscReceiver::without_socket();
+    let server = surface(true, &rx);
+    let (mut viewer, _) =
+        tungstenite::connect(format!("ws://{}/?token=socket-test-token", server.local_addr())).unwrap();
+    viewer.send(Message::binary(write)).unwrap();
+    assert!(closed(&mut viewer));
+    assert!(rx.drain(SystemTime::now()).is_empty());
+}

@@ -1,0 +1,320 @@
+//! The browser control surface in a real browser: Debian's headless Chromium, driven over the
+//! DevTools protocol (a WebSocket, through the tungstenite indra already uses — no WebDriver
+//! server or async runtime needed), against `indra run --web` in a virtual display. Mouse
+//! events are real input events: a click on a slider's track moves it as a finger would.
+
+use std::io::{Read, Write};
+use std::net::{SocketAddr, TcpStream};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use serde_json::{Value, json};
+
+use crate::osc::http_get;
+use crate::window::{Show, VirtualDisplay, scratch_dir};
+
+/// A headless Chromium with its own profile, killed when dropped.
+struct Chromium {
+    child: Child,
+    port: u16,
+}
+
+impl Chromium {
+    fn start(profile: &Path) -> Self {
+        let child = Command::new("chromium")
+            .args(["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--remote-debugging-port=0"])
+            .arg(format!("--user-data-dir={}", profile.display()))
+            .arg("about:blank")
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("chromium runs (tools/setup-system test installs it)");
+        // Chromium writes the port it picked into the profile.
+        let deadline = Instant::now() + Duration::from_secs(60);
+        let port = loop {
+            if let Some(port) = std::fs::read_to_string(profile.join("DevToolsActivePort"))
+                .ok()
+                .and_then(|t| t.lines().next().and_then(|l| l.parse().ok()))
+            {
+                break port;
+            }
+            assert!(Instant::now() < deadline, "Chromium did not start its DevTools server");
+            std::thread::sleep(Duration::from_millis(100));
+        };
+        Self { child, port }
+    }
+
+    /// A new tab showing `url`.
+    fn open(&self, url: &str) -> Page {
+        let mut s = TcpStream::connect(("127.0.0.1", self.port)).unwrap();
+        // The Host header names the port DevTools puts in the page's WebSocket URL.
+        write!(s, "PUT /json/new?{url} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\n\r\n", self.port).unwrap();
+        // DevTools' server may keep the connection open: read the head, then its Content-Length.
+        s.set_read_timeout(Some(Duration::from_secs(30))).unwrap();
+        let mut bytes = Vec::new();
+        let mut buf = [0u8; 4096];
+        let reply = loop {
+            let n = s.read(&mut buf).unwrap();
+            bytes.extend_from_slice(&buf[..n]);
+            let text = String::from_utf8_lossy(&bytes).to_string();
+            if let Some((head, body)) = text.split_once("\r\n\r\n") {
+                let length = head
+                    .lines()
+                    .find_map(|l| l.to_ascii_lowercase().strip_prefix("content-length:").map(|v| v.trim().to_string()))
+                    .and_then(|v| v.parse::<usize>().ok());
+                if n == 0 || length.is_some_and(|l| body.len() >= l) {
+                    break text;
+                }
+            }
+            assert!(n > 0, "DevTools closed the connection: {text}");
+        };
+        let body = reply.split("\r\n\r\n").nth(1).unwrap_or_default();
+        let target: Value = serde_json::from_str(body).unwrap_or_else(|e| panic!("{e}: {reply}"));
+        let ws = target["webSocketDebuggerUrl"].as_str().unwrap().to_string();
+        let (socket, _) = tungstenite::connect(ws).unwrap();
+        Page { socket, next: 1 }
+    }
+}
+
+impl Drop for Chromium {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// One tab, driven over its DevTools WebSocket.
+struct Page {
+    socket: crate::osc::Socket,
+    next: u64,
+}
+
+impl Page {
+    /// Calls a DevTools method and returns its result (events on the way are skipped).
+    fn call(&mut self, method: &str, params: Value) -> Value {
+        let id = self.next;
+        self.next += 1;
+        let request = json!({ "id": id, "method": method, "params": params }).to_string();
+        self.socket.send(tungstenite::Message::Text(request.into())).unwrap();
+        loop {
+            let message = self.socket.read().unwrap();
+            let Ok(text) = message.to_text() else { continue };
+            let reply: Value = serde_json::from_str(text).unwrap_or_default();
+            if reply["id"] == id {
+                assert!(reply["error"].is_null(), "{method}: {reply}");
+                return reply["result"].clone();
+            }
+        }
+    }
+
+    /// The value of a JavaScript expression (awaited if a promise).
+    fn eval(&mut self, expression: &str) -> Value {
+        let result = self
+            .call("Runtime.evaluate", json!({ "expression": expression, "returnByValue": true, "awaitPromise": true }));
+        assert!(result["exceptionDetails"].is_null(), "{expression}: {result}");
+        result["result"]["value"].clone()
+    }
+
+    /// Waits (at most 60 s) until `condition` is true in the page.
+    fn wait_until(&mut self, condition: &str) {
+        let deadline = Instant::now() + Duration::from_secs(60);
+        while self.eval(condition) != Value::Bool(true) {
+            assert!(Instant::now() < deadline, "never true in the page: {condition}");
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    }
+
+    /// A left click at `fraction` (0–1) across the element `selector`, scrolled into view.
+    fn click(&mut self, selector: &str, fraction: f64) {
+        let rect = self.eval(&format!(
+            "(() => {{ const e = document.querySelector({selector:?}); e.scrollIntoView({{ block: 'center' }});
+               const r = e.getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; }})()"
+        ));
+        let [left, top, width, height] = [0, 1, 2, 3].map(|i| rect[i].as_f64().unwrap());
+        let (x, y) = (left + width * fraction, top + height / 2.0);
+        for kind in ["mousePressed", "mouseReleased"] {
+            let event = json!({ "type": kind, "x": x, "y": y, "button": "left", "clickCount": 1 });
+            self.call("Input.dispatchMouseEvent", event);
+        }
+    }
+}
+
+/// The address of every value and trigger a client may reach in an OSCQuery tree.
+fn leaves(tree: &Value, out: &mut Vec<(String, Value)>) {
+    if let Some(path) = tree["FULL_PATH"].as_str()
+        && tree["TYPE"].is_string()
+    {
+        out.push((path.to_string(), tree.clone()));
+    }
+    if let Some(contents) = tree["CONTENTS"].as_object() {
+        for child in contents.values() {
+            leaves(child, out);
+        }
+    }
+}
+
+/// A parameter's value as the show publishes it (the tree is republished every few frames).
+fn published(query: SocketAddr, path: &str) -> Option<f64> {
+    let (status, leaf) = http_get(query, path);
+    (status == 200).then(|| leaf["VALUE"][0].as_f64()).flatten()
+}
+
+fn wait_for_published(query: SocketAddr, path: &str, want: f64, tolerance: f64) {
+    let deadline = Instant::now() + Duration::from_secs(60);
+    loop {
+        let got = published(query, path);
+        if got.is_some_and(|v| (v - want).abs() <= tolerance) {
+            return;
+        }
+        assert!(Instant::now() < deadline, "{path} is {got:?}, not {want}");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+const SHOW: &str = r#"(
+    name: "browser show",
+    size: (64, 36),
+    layers: [(name: "main", clips: [
+        (scene: "kleinian_classic", id: "red", params: { "limit_set.hit_color": (0.9, 0.1, 0.1, 1.0) }),
+        (scene: "kleinian_classic", id: "blue", params: { "limit_set.hit_color": (0.1, 0.2, 0.9, 1.0) }),
+    ])],
+    cues: [(name: "red", clips: [(1, 1)]), (name: "blue", clips: [(1, 2)]), (name: "red again", clips: [(1, 1)])],
+)"#;
+
+const TOKEN: &str = "browser-test-token";
+
+/// Where the phone-sized screenshot goes (the README's comes from here).
+fn screenshot_path() -> PathBuf {
+    Path::new(env!("CARGO_TARGET_TMPDIR")).join("web-phone.png")
+}
+
+#[test]
+fn a_browser_controls_the_show_and_follows_every_other_source() {
+    let display = VirtualDisplay::start();
+    let dir = scratch_dir("browser");
+    let file = dir.join("show.ron");
+    std::fs::write(&file, SHOW).unwrap();
+    let query = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap();
+    let recording = dir.join("controls.ron");
+    let args: Vec<std::ffi::OsString> = vec![
+        "--web".into(),
+        query.to_string().into(),
+        "--web-token".into(),
+        TOKEN.into(),
+        "--record-controls".into(),
+        recording.clone().into(),
+    ];
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+    let (mut show, osc_port) = Show::start(&display, &dir, file.to_str().unwrap(), &args);
+    show.wait_for("control surface on");
+    show.wait_for("plays clip 'red'");
+
+    // Without the token there is no page (its WebSocket is tested in osc.rs).
+    let raw = |head: &str| {
+        let mut s = TcpStream::connect(query).unwrap();
+        s.write_all(head.as_bytes()).unwrap();
+        let mut reply = String::new();
+        let _ = s.read_to_string(&mut reply);
+        reply
+    };
+    assert!(raw("GET / HTTP/1.1\r\nAccept: text/html\r\n\r\n").starts_with("HTTP/1.1 401"));
+    assert!(raw("GET /?token=guess-guess-guess HTTP/1.1\r\nAccept: text/html\r\n\r\n").starts_with("HTTP/1.1 401"));
+
+    let url = format!("http://{query}/?token={TOKEN}");
+    let browser = Chromium::start(&dir.join("profile-a"));
+    let other_browser = Chromium::start(&dir.join("profile-b"));
+    let mut page = browser.open(&url);
+    let mut other = other_browser.open(&url);
+    for p in [&mut page, &mut other] {
+        p.wait_until("document.body.dataset.state === 'live' && document.querySelectorAll('[data-path]').length > 10");
+    }
+
+    // The page holds a control for every value and trigger of the tree.
+    let (_, tree) = http_get(query, "/");
+    let mut all = Vec::new();
+    leaves(&tree, &mut all);
+    let shown: Vec<String> =
+        serde_json::from_value(page.eval("[...document.querySelectorAll('[data-path]')].map(e => e.dataset.path)"))
+            .unwrap();
+    let missing: Vec<&String> = all.iter().map(|(p, _)| p).filter(|p| !shown.contains(p)).collect();
+    assert!(missing.is_empty(), "no control for {missing:?}");
+    assert!(all.len() > 20, "{} leaves", all.len());
+
+    // A click on a slider's track moves the parameter in the show.
+    let (path, leaf) = all
+        .iter()
+        .find(|(p, l)| p.starts_with("/indra/red/") && l["TYPE"] == "f" && l["RANGE"][0]["MAX"].is_number())
+        .expect("a bounded float of the playing clip")
+        .clone();
+    let (lo, hi) = (leaf["RANGE"][0]["MIN"].as_f64().unwrap(), leaf["RANGE"][0]["MAX"].as_f64().unwrap());
+    let slider = format!("[data-path=\"{path}\"] input");
+    let value_of =
+        |p: &mut Page| p.eval(&format!("Number(document.querySelector({slider:?}).value)")).as_f64().unwrap();
+    page.click(&slider, 0.8);
+    let moved = value_of(&mut page);
+    assert!((moved - (lo + 0.8 * (hi - lo))).abs() < 0.05 * (hi - lo), "{path}: clicked to {moved} in {lo}..{hi}");
+    wait_for_published(query, &path, moved, 1e-3 * (hi - lo));
+    // … and the second browser follows.
+    other.wait_until(&format!("Math.abs(Number(document.querySelector({slider:?}).value) - {moved}) < 1e-6"));
+
+    // An OSC message from another program moves the slider in both browsers.
+    let target = lo + 0.25 * (hi - lo);
+    let sent = Command::new("oscsend")
+        .args(["127.0.0.1", &osc_port.to_string(), &path, "f", &target.to_string()])
+        .status()
+        .expect("oscsend runs (liblo-tools)");
+    assert!(sent.success());
+    for p in [&mut page, &mut other] {
+        p.wait_until(&format!("Math.abs(Number(document.querySelector({slider:?}).value) - {target}) < 1e-3"));
+    }
+
+    // GO fires once: the show moves one cue on, to blue, and stays there.
+    page.click("button[data-path=\"/indra/cue/go\"]", 0.5);
+    show.wait_for("plays clip 'blue'");
+    std::thread::sleep(Duration::from_secs(2));
+    let log = show.wait_for("plays clip 'blue'");
+    assert_eq!(log.matches("plays clip 'red'").count(), 1, "GO fired more than once:\n{log}");
+    // The browser's writes are ordinary control events: in the recording, once each.
+    // (While the show runs, its recording is written beside the target, renamed when it ends.)
+    let taking = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .find(|e| e.file_name().to_string_lossy().starts_with(".controls.ron."))
+        .expect("the recording in progress");
+    let recorded = std::fs::read_to_string(taking.path()).unwrap();
+    assert_eq!(recorded.matches("CueGo").count(), 1, "{recorded}");
+    assert!(recorded.contains(&path.rsplit('/').next().unwrap().to_string()), "{recorded}");
+
+    // The page fits a phone: 375 px wide with nothing to scroll sideways.
+    page.call(
+        "Emulation.setDeviceMetricsOverride",
+        json!({ "width": 375, "height": 812, "deviceScaleFactor": 2, "mobile": true }),
+    );
+    page.eval("window.scrollTo(0, 0)");
+    page.wait_until("document.documentElement.scrollWidth <= 375");
+    let shot = page.call("Page.captureScreenshot", json!({ "format": "png" }));
+    let png = base64_decode(shot["data"].as_str().unwrap());
+    let image = image::load_from_memory(&png).unwrap();
+    assert_eq!(image.width(), 750, "a 375-px screen at 2×");
+    std::fs::write(screenshot_path(), png).unwrap();
+}
+
+/// Standard base64 (DevTools sends screenshots so); ten lines rather than a dependency.
+fn base64_decode(text: &str) -> Vec<u8> {
+    let value = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        _ => 63,
+    };
+    let digits: Vec<u8> = text.bytes().filter(|&c| c != b'=').map(value).collect();
+    digits
+        .chunks(4)
+        .flat_map(|c| {
+            let n = c.iter().enumerate().fold(0u32, |n, (i, &d)| n | u32::from(d) << (18 - 6 * i));
+            n.to_be_bytes()[1..c.len()].to_vec()
+        })
+        .collect()
+}
