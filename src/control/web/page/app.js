@@ -302,7 +302,6 @@ function controlFor(name, leaf) {
 function adopt(leaf, control) {
   control.listens = (leaf.ACCESS & 1) === 1;
   if (Array.isArray(leaf.VALUE) && leaf.VALUE.length) control.set(leaf.VALUE);
-  if (readOnly && control.input) control.input.disabled = true;
   controls.set(leaf.FULL_PATH, control);
   return control.el;
 }
@@ -346,7 +345,6 @@ function showGroup(root) {
     const goto = cue.goto && el("select", { "data-path": cue.goto.FULL_PATH, "aria-label": "go to cue" },
       el("option", { value: "" }, "go to cue…"), ...(rangeOf(cue.goto, 0).VALS || []).map((v) => el("option", { value: v }, v)));
     if (goto) goto.addEventListener("change", () => { if (goto.value) sendNow(cue.goto.FULL_PATH, [["s", goto.value]]); goto.value = ""; });
-    if (goto && readOnly) goto.disabled = true;
     cues = el("div", { class: "row" },
       cue.back ? triggerButton("◀ back", cue.back.FULL_PATH) : null,
       cue.go ? triggerButton("GO", cue.go.FULL_PATH, "go") : null, goto);
@@ -381,7 +379,6 @@ function engineGroup(root) {
     save.addEventListener("click", () => { if (name.value.trim()) sendNow(preset.save.FULL_PATH, [["s", name.value.trim()]]); });
     parts.push(el("div", { class: "row" }, name, save));
   }
-  if (readOnly) for (const p of parts) p.querySelectorAll("input, select, button").forEach((c) => { c.disabled = true; });
   return parts.length ? group("Tempo & presets", null, "engine", ...parts) : null;
 }
 
@@ -426,7 +423,10 @@ function build(tree) {
   const rest = Object.fromEntries(Object.entries(root).filter(([name]) => !["layer", "column", "cue", "preset", "tempo"].includes(name)));
   const out = { groups: [], tree: containers(rest, "", {}) };
   nodeGroups(rest, "", out);
-  document.getElementById("surface").replaceChildren(...groups, ...out.groups);
+  const surface = document.getElementById("surface");
+  surface.replaceChildren(...groups, ...out.groups);
+  // A read-only surface shows every control, none of them usable.
+  if (readOnly) surface.querySelectorAll("input, select, button").forEach((c) => { c.disabled = true; });
 }
 
 /** Fetches the tree and rebuilds; LISTENs to every value once connected. */
