@@ -110,17 +110,25 @@ impl Page {
 
     /// The value of a JavaScript expression (awaited if a promise).
     fn eval(&mut self, expression: &str) -> Value {
+        self.try_eval(expression).unwrap_or_else(|e| panic!("{expression}: {e}"))
+    }
+
+    /// The value of a JavaScript expression, or the exception it threw.
+    fn try_eval(&mut self, expression: &str) -> Result<Value, Value> {
         let result = self
             .call("Runtime.evaluate", json!({ "expression": expression, "returnByValue": true, "awaitPromise": true }));
-        assert!(result["exceptionDetails"].is_null(), "{expression}: {result}");
-        result["result"]["value"].clone()
+        if result["exceptionDetails"].is_null() { Ok(result["result"]["value"].clone()) } else { Err(result) }
     }
 
     /// Waits (at most 60 s) until `condition` is true in the page.
     fn wait_until(&mut self, condition: &str) {
         let deadline = Instant::now() + Duration::from_secs(60);
-        while self.eval(condition) != Value::Bool(true) {
-            assert!(Instant::now() < deadline, "never true in the page: {condition}");
+        // Until the page has loaded, its elements may not exist yet: an exception is "not yet".
+        while self.try_eval(condition) != Ok(Value::Bool(true)) {
+            if Instant::now() > deadline {
+                let state = self.eval("[document.body.dataset.state, document.querySelectorAll('[data-path]').length]");
+                panic!("never true in the page (state, controls: {state}): {condition}");
+            }
             std::thread::sleep(Duration::from_millis(100));
         }
     }

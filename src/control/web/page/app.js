@@ -79,6 +79,8 @@ const socketUrl = `${location.protocol === "https:" ? "wss" : "ws"}://${location
 let socket = null;
 /** Controls by address: each has `set(values)` and `el`. */
 let controls = new Map();
+/** The newest value heard for each address: a tree fetched while changes arrive may be older. */
+const heard = new Map();
 /** The values waiting to be sent, by address, flushed once per animation frame. */
 const pending = new Map();
 
@@ -124,7 +126,9 @@ function connect() {
       return;
     }
     const message = decodeMessage(event.data);
-    const control = message && controls.get(message.address);
+    if (!message) return;
+    heard.set(message.address, message.args);
+    const control = controls.get(message.address);
     if (control && !control.held()) control.set(message.args);
   };
   socket.onclose = () => {
@@ -301,7 +305,8 @@ function controlFor(name, leaf) {
 /** Registers `control` for `leaf` and returns its element. */
 function adopt(leaf, control) {
   control.listens = (leaf.ACCESS & 1) === 1;
-  if (Array.isArray(leaf.VALUE) && leaf.VALUE.length) control.set(leaf.VALUE);
+  const value = heard.get(leaf.FULL_PATH) || leaf.VALUE;
+  if (Array.isArray(value) && value.length) control.set(value);
   controls.set(leaf.FULL_PATH, control);
   return control.el;
 }
