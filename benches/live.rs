@@ -77,6 +77,9 @@ fn copy_assets(root: &Path) {
             std::fs::copy(e.path(), root.join(dir).join(e.file_name())).unwrap();
         }
     }
+    // The technique's own shader, as a performer's copy in shaders/ that the bench edits.
+    let kleinian = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/techniques/kleinian/kleinian.wgsl");
+    std::fs::copy(kleinian, root.join("shaders/kleinian.wgsl")).unwrap();
 }
 
 fn reload_latency(c: &mut Criterion) {

@@ -1,5 +1,7 @@
 //! Where shaders and scenes come from: files on disk win, the copies embedded at build time are
-//! the fallback, so a release binary copied anywhere still runs every scene.
+//! the fallback, so a release binary copied anywhere still runs every scene. A technique's own
+//! shaders live in its folder (`src/techniques/<name>/`); a file of the same name in `shaders/`
+//! overrides it, and under a source checkout the folder's file on disk is read (and watched).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -40,7 +42,8 @@ impl AssetKind {
         }
     }
 
-    fn embedded(self) -> &'static [(&'static str, &'static str)] {
+    /// The built-in copies: (file name, path in the source tree, text).
+    fn embedded(self) -> &'static [(&'static str, &'static str, &'static str)] {
         match self {
             AssetKind::Shader => embedded::SHADERS,
             AssetKind::Scene => embedded::SCENES,
@@ -164,27 +167,25 @@ impl Assets {
         self.root.as_ref().map(|r| r.join(kind.dir()))
     }
 
-    /// Loads `name` (with or without extension): the file on disk if present, else the embedded
-    /// copy. The error says where it looked.
+    /// Loads `name` (with or without extension): the file on disk if present — in the kind's
+    /// folder, or for a technique's shader in its folder of a source checkout — else the
+    /// embedded copy. The error says where it looked.
     pub fn load(&self, kind: AssetKind, name: &str) -> Result<Asset, String> {
         let file = with_ext(name, kind);
         if let Some(asset) = self.pinned.get(&file).filter(|_| kind == AssetKind::Shader) {
             return Ok(asset.clone());
         }
-        if let Some(dir) = self.dir(kind) {
-            let path = dir.join(&file);
-            if path.is_file() {
-                return std::fs::read_to_string(&path)
-                    .map(|source| Asset { name: file.clone(), origin: path.display().to_string(), source })
-                    .map_err(|e| format!("cannot read {}: {e}", path.display()));
-            }
+        let built_in = kind.embedded().iter().find(|(n, _, _)| *n == file);
+        let on_disk = [self.dir(kind).map(|d| d.join(&file)), built_in.and_then(|(_, path, _)| self.in_root(path))];
+        if let Some(path) = on_disk.into_iter().flatten().find(|p| p.is_file()) {
+            return std::fs::read_to_string(&path)
+                .map(|source| Asset { name: file.clone(), origin: path.display().to_string(), source })
+                .map_err(|e| format!("cannot read {}: {e}", path.display()));
         }
-        kind.embedded()
-            .iter()
-            .find(|(n, _)| *n == file)
-            .map(|(n, s)| Asset {
+        built_in
+            .map(|(n, path, s)| Asset {
                 name: n.to_string(),
-                origin: format!("<embedded>/{}/{n}", kind.dir()),
+                origin: format!("<embedded>/{path}"),
                 source: s.to_string(),
             })
             .ok_or_else(|| {
@@ -197,9 +198,30 @@ impl Assets {
             })
     }
 
+    /// `path` (from the source tree's root) under the root on disk, if there is a root.
+    fn in_root(&self, path: &str) -> Option<PathBuf> {
+        self.root.as_ref().map(|r| r.join(path))
+    }
+
+    /// The folders a live show watches for edits: `shaders/`, `scenes/`, `shows/`, and under a
+    /// source checkout each technique folder that holds shaders. Only those that exist.
+    pub fn watched_dirs(&self) -> Vec<PathBuf> {
+        let kinds = [AssetKind::Shader, AssetKind::Scene, AssetKind::Show];
+        let mut dirs: Vec<PathBuf> = kinds.iter().filter_map(|k| self.dir(*k)).collect();
+        for (_, path, _) in AssetKind::Shader.embedded() {
+            if let Some(dir) = self.in_root(path).and_then(|p| p.parent().map(Path::to_path_buf))
+                && !dirs.contains(&dir)
+            {
+                dirs.push(dir);
+            }
+        }
+        dirs.retain(|d| d.is_dir());
+        dirs
+    }
+
     /// Every asset name of `kind`: those on disk and the embedded ones, sorted, without duplicates.
     pub fn names(&self, kind: AssetKind) -> Vec<String> {
-        let mut names: Vec<String> = kind.embedded().iter().map(|(n, _)| n.to_string()).collect();
+        let mut names: Vec<String> = kind.embedded().iter().map(|(n, _, _)| n.to_string()).collect();
         if let Some(Ok(entries)) = self.dir(kind).map(std::fs::read_dir) {
             for entry in entries.flatten() {
                 let n = entry.file_name().to_string_lossy().into_owned();
@@ -233,6 +255,27 @@ mod tests {
         assert!(scene.origin.starts_with("<embedded>"), "{}", scene.origin);
         let err = assets.load(AssetKind::Scene, "no_such_scene").unwrap_err();
         assert!(err.contains("no_such_scene.ron"), "{err}");
+        std::fs::remove_dir_all(tmp).unwrap();
+    }
+
+    #[test]
+    fn a_technique_shader_is_read_from_its_folder_of_a_checkout_unless_shaders_overrides_it() {
+        let tmp = std::env::temp_dir().join(format!("indra-assets-tree-{}", std::process::id()));
+        let folder = tmp.join("src/techniques/star_glow");
+        std::fs::create_dir_all(&folder).unwrap();
+        std::fs::write(folder.join("star_glow.wgsl"), "// in its folder").unwrap();
+        let assets = Assets::new(Some(tmp.clone()));
+        let loaded = assets.load(AssetKind::Shader, "star_glow").unwrap();
+        assert_eq!(
+            (loaded.source.as_str(), loaded.origin.contains("src/techniques/star_glow")),
+            ("// in its folder", true)
+        );
+        assert!(assets.watched_dirs().contains(&folder), "{:?}", assets.watched_dirs());
+        std::fs::create_dir_all(tmp.join("shaders")).unwrap();
+        std::fs::write(tmp.join("shaders/star_glow.wgsl"), "// the performer's").unwrap();
+        assert_eq!(assets.load(AssetKind::Shader, "star_glow").unwrap().source, "// the performer's");
+        let built_in = Assets::new(None).load(AssetKind::Shader, "star_glow").unwrap();
+        assert_eq!(built_in.origin, "<embedded>/src/techniques/star_glow/star_glow.wgsl");
         std::fs::remove_dir_all(tmp).unwrap();
     }
 

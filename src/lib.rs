@@ -22,3 +22,12 @@ pub mod params;
 pub mod scene;
 pub mod techniques;
 pub mod time;
+
+// A technique's golden renders live in its folder (`techniques/<name>/render_tests.rs`) and run
+// as this crate's tests, written as the integration tests are: against `indra::` and with the
+// helpers of `tests/common`.
+#[cfg(test)]
+extern crate self as indra;
+#[cfg(test)]
+#[path = "../tests/common/mod.rs"]
+mod common;

@@ -50,11 +50,11 @@ struct AppliedShader {
 }
 
 impl LiveReload {
-    /// Watches `assets`' `shaders/`, `scenes/` and `shows/` folders (if it has a root on disk).
+    /// Watches `assets`' `shaders/`, `scenes/` and `shows/` folders and, under a source
+    /// checkout, the technique folders' shaders (see [`Assets::watched_dirs`]).
     pub fn new(assets: &Assets) -> Result<Self, String> {
-        let kinds = [AssetKind::Shader, AssetKind::Scene, AssetKind::Show];
-        let dirs: Vec<PathBuf> = kinds.iter().filter_map(|k| assets.dir(*k)).collect();
-        let watcher = if dirs.iter().any(|d| d.is_dir()) { Some(Watcher::watch(&dirs)?) } else { None };
+        let dirs = assets.watched_dirs();
+        let watcher = if dirs.is_empty() { None } else { Some(Watcher::watch(&dirs)?) };
         let running = assets.with_shaders_pinned();
         Ok(Self { watcher, running, broken: BTreeMap::new(), newest: None, stalled: BTreeMap::new() })
     }

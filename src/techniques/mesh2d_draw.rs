@@ -1,6 +1,6 @@
 //! Drawing a triangulated 2-D mesh, shared by chapter 5's two techniques (`polygon_draw` and
 //! `text_mesh`): the textured fill, the wireframe (line list over the same vertices) and the
-//! open loop being drawn (line strip), with `shaders/polygon_draw.wgsl`.
+//! open loop being drawn (line strip), with `polygon_draw/polygon_draw.wgsl`.
 
 use crate::geometry::triangulate::Mesh2D;
 use crate::gpu::{GrowableBuffer, RasterDesc, ShaderError, UniformBlock};
@@ -205,7 +205,7 @@ mod tests {
 
     #[test]
     fn uniform_layout_matches_the_wgsl_struct() {
-        let source = include_str!("../../shaders/polygon_draw.wgsl");
+        let source = include_str!("polygon_draw/polygon_draw.wgsl");
         assert_eq!(crate::gpu::wgsl_struct_size(source, "PolygonUniforms"), Some(size_of::<PolygonUniforms>() as u32));
     }
 }

@@ -2,8 +2,13 @@
 //! pipelines once, steps its simulation on the fixed clock and adds passes to the frame graph.
 //! It never owns the frame: no encoders, no submits, no windows, no files beyond its shader.
 //!
-//! To add a technique: write `src/techniques/<name>/`, `shaders/<name>.wgsl` and
-//! `scenes/<name>.ron`, then add its `INFO` to [`REGISTRY`]. Nothing else.
+//! A technique is one folder, `src/techniques/<name>/`: its Rust (`mod.rs` with its `INFO`), its
+//! shaders (`*.wgsl`, embedded by `build.rs` and loaded by file name, so a performer's file of
+//! that name in `shaders/` overrides one), its render tests (`render_tests.rs`, golden renders
+//! and invariants through the whole engine, `#[cfg(test)] mod render_tests;`) and their
+//! references (`golden/`). Its demo scenes are `scenes/<name>*.ron`. To add one, write the folder
+//! and register it here — `pub mod <name>;` and its `INFO` in [`REGISTRY`]. Nothing else (a test
+//! checks that every folder is registered and its shaders are built in).
 
 pub mod blend;
 pub mod cloth;

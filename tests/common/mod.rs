@@ -40,7 +40,19 @@ pub fn render_text(ron: &str, size: (u32, u32)) -> RenderedFrame {
 /// states its own bounds where it checks (0.01 and 0.3 tolerate rasterisation noise across
 /// drivers but not a changed picture).
 pub fn golden(max_mean: f32, max_p99: f32) -> GoldenCheck {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/golden");
+    golden_in(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/golden"), max_mean, max_p99)
+}
+
+/// The golden checker for the `golden/` folder beside `file` (a test's `file!()`: a technique's
+/// references sit in its own folder), with the bounds of [`golden`].
+pub fn golden_beside(file: &str, max_mean: f32, max_p99: f32) -> GoldenCheck {
+    let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+    let dir = folder.parent().expect("a test file is in a folder").join("golden");
+    golden_in(dir, max_mean, max_p99)
+}
+
+/// The golden checker for the references in `dir`, with the bounds of [`golden`].
+pub fn golden_in(dir: impl Into<std::path::PathBuf>, max_mean: f32, max_p99: f32) -> GoldenCheck {
     GoldenCheck { max_mean, max_percentile: max_p99, percentile: 0.99, ..GoldenCheck::new(dir) }
 }
 
@@ -52,15 +64,24 @@ pub fn bright(frame: &RenderedFrame, x: u32, y: u32) -> bool {
 }
 
 /// A private copy of the project's scenes/ and shaders/ (in the temporary folder, named after
-/// `name` and this process) for a test to edit.
+/// `name` and this process) for a test to edit; the techniques' own shaders are copied into its
+/// shaders/ too, as a performer's overrides of them would be.
 pub fn sandbox(name: &str) -> std::path::PathBuf {
     let root = std::env::temp_dir().join(format!("indra-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&root);
-    for dir in ["scenes", "shaders"] {
-        std::fs::create_dir_all(root.join(dir)).unwrap();
-        for entry in std::fs::read_dir(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(dir)).unwrap() {
-            let entry = entry.unwrap();
-            std::fs::copy(entry.path(), root.join(dir).join(entry.file_name())).unwrap();
+    let project = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let techniques = std::fs::read_dir(project.join("src/techniques")).unwrap().map(|e| e.unwrap().path());
+    let copies = [(project.join("scenes"), "scenes"), (project.join("shaders"), "shaders")]
+        .into_iter()
+        .chain(techniques.filter(|p| p.is_dir()).map(|p| (p, "shaders")));
+    for (from, to) in copies {
+        std::fs::create_dir_all(root.join(to)).unwrap();
+        for entry in std::fs::read_dir(&from).unwrap() {
+            let path = entry.unwrap().path();
+            let wanted = to == "scenes" || path.extension().is_some_and(|e| e == "wgsl");
+            if path.is_file() && wanted {
+                std::fs::copy(&path, root.join(to).join(path.file_name().unwrap())).unwrap();
+            }
         }
     }
     root
@@ -91,8 +112,12 @@ pub fn read_float_texture(gpu: &Gpu, texture: &wgpu::Texture) -> Vec<[f32; 4]> {
 }
 
 /// Runs the `indra` binary with `args` on Vulkan, against this checkout's scenes and shaders.
+/// (Cargo names the binary to integration tests only, not to the crate's own tests.)
 pub fn indra(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_indra"))
+    let Some(binary) = option_env!("CARGO_BIN_EXE_indra") else {
+        panic!("the binary is built for integration tests only");
+    };
+    std::process::Command::new(binary)
         .args(args)
         .args(["--backend", "vulkan"])
         .env("INDRA_ROOT", env!("CARGO_MANIFEST_DIR"))

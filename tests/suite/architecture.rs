@@ -79,7 +79,9 @@ fn every_import_goes_to_a_lower_layer() {
         let path = if dir.is_dir() { dir } else { dir.with_extension("rs") };
         let mut files = Vec::new();
         rust_files(&path, &mut files);
-        for file in files {
+        // A technique's render tests sit in its folder but test it through the whole engine,
+        // as the integration tests do (see lib.rs): they are exempt, as those are.
+        for file in files.into_iter().filter(|f| !f.ends_with("render_tests.rs")) {
             let source = std::fs::read_to_string(&file).unwrap();
             for used in imports(&source).into_iter().filter(|u| u != module) {
                 match layers.get(&used) {
@@ -99,4 +101,30 @@ fn every_import_goes_to_a_lower_layer() {
 fn the_import_scan_sees_what_it_must() {
     let source = "use crate::gpu::Gpu; $crate::no; my_crate::no; crate::a_macro! {} crate::params::ParamSet::new();";
     assert_eq!(imports(source), ["gpu", "params"]);
+}
+
+#[test]
+fn every_technique_folder_is_registered_once_and_its_shaders_are_built_in() {
+    let dir = Path::new(ROOT).join("src/techniques");
+    let registry = std::fs::read_to_string(dir.join("mod.rs")).unwrap();
+    let built_in = indra::assets::Assets::new(None);
+    let mut folders: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    folders.sort();
+    for name in &folders {
+        assert!(registry.contains(&format!("pub mod {name};")), "src/techniques/{name}/ is not declared");
+        assert_eq!(registry.matches(&format!("    {name}::INFO,")).count(), 1, "{name} is not in REGISTRY once");
+        for shader in std::fs::read_dir(dir.join(name)).unwrap().map(|e| e.unwrap().path()) {
+            if shader.extension().is_some_and(|e| e == "wgsl") {
+                let file = shader.file_name().unwrap().to_string_lossy().into_owned();
+                let asset = built_in.load(indra::assets::AssetKind::Shader, &file).unwrap();
+                assert_eq!(asset.source, std::fs::read_to_string(&shader).unwrap(), "{file} is not the built-in copy");
+            }
+        }
+    }
+    assert_eq!(indra::techniques::REGISTRY.len(), folders.len(), "REGISTRY has entries without a folder");
 }

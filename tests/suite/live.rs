@@ -55,7 +55,7 @@ pub(crate) fn edit(path: &Path, from: &str, to: &str) {
 fn a_broken_shader_keeps_the_last_good_image_and_the_fix_applies() {
     let root = sandbox("shader");
     let (mut r, mut live) = renderer(&root);
-    let golden = common::golden(0.01, 0.3);
+    let golden = common::golden_in(concat!(env!("CARGO_MANIFEST_DIR"), "/src/techniques/kleinian/golden"), 0.01, 0.3);
     golden.check("kleinian_classic_f0000", (256, 256), &shown(&mut r).rgba).unwrap();
 
     let shader = root.join("shaders/kleinian.wgsl");

@@ -6,27 +6,17 @@
 mod architecture;
 mod audio;
 mod browser;
-mod cloth;
 #[path = "../common/mod.rs"]
 mod common;
 mod control;
 mod errors;
 mod graph_gpu;
-mod grid_fluid;
-mod kleinian;
 mod live;
 mod msaa;
 mod osc;
-mod poisson;
-mod polygon_draw;
 mod recovery;
 mod seek;
 mod show;
-mod space_colonization;
-mod star_glow;
-mod tessellation;
-mod text_mesh;
 mod triangulate;
 mod video;
-mod warp;
 mod window;

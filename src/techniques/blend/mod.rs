@@ -2,7 +2,7 @@
 //! Multiply, Difference and Lighten, in linear HDR, at an opacity. A show composites its layers
 //! with one `blend` node each (`layer/<n>`); a scene may use it to mix any two nodes.
 //!
-//! Shader: `shaders/blend.wgsl`. Tests: `tests/suite/show.rs` (each mode against a CPU reference).
+//! Shader: `blend.wgsl`. Tests: `tests/suite/show.rs` (each mode against a CPU reference).
 
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, TextureHandle};
@@ -99,7 +99,7 @@ mod tests {
 
     #[test]
     fn uniform_layout_matches_the_wgsl_struct() {
-        let source = include_str!("../../../shaders/blend.wgsl");
+        let source = include_str!("blend.wgsl");
         assert_eq!(crate::gpu::wgsl_struct_size(source, "BlendUniforms"), Some(size_of::<BlendUniforms>() as u32));
     }
 }

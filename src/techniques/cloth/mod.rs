@@ -4,8 +4,8 @@
 //! `step` queues fixed steps and `add_passes` records them, so all GPU work is timed by the graph.
 //!
 //! Book: [UGP4 ch.3] "GPU-Based Cloth Simulation" (oishi); [Macklin 2019] "Small Steps in Physics
-//! Simulation". Shaders: `shaders/cloth.wgsl`, `shaders/cloth_render.wgsl`.
-//! Goldens: `tests/golden/cloth*.png`.
+//! Simulation". Shaders: `cloth.wgsl`, `cloth_render.wgsl`.
+//! Goldens: `golden/`, made by `render_tests.rs`.
 
 mod params;
 pub mod reference;
@@ -238,3 +238,6 @@ impl Technique for Cloth {
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod render_tests;

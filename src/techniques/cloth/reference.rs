@@ -1,4 +1,4 @@
-//! A CPU version of one Verlet substep of `shaders/cloth.wgsl`, for checking the GPU on small
+//! A CPU version of one Verlet substep of `cloth.wgsl`, for checking the GPU on small
 //! grids.
 
 use super::ClothUniforms;

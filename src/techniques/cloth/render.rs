@@ -89,7 +89,7 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    /// Builds the four pipelines from `shaders/cloth_render.wgsl`.
+    /// Builds the four pipelines from `cloth_render.wgsl`.
     pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
         let device = &setup.gpu.device;
         let (origin, source) =

@@ -3,9 +3,9 @@ use super::*;
 
 #[test]
 fn uniform_layouts_match_the_wgsl_structs() {
-    let sim = include_str!("../../../shaders/cloth.wgsl");
+    let sim = include_str!("cloth.wgsl");
     assert_eq!(crate::gpu::wgsl_struct_size(sim, "ClothUniforms"), Some(size_of::<ClothUniforms>() as u32));
-    let draw = include_str!("../../../shaders/cloth_render.wgsl");
+    let draw = include_str!("cloth_render.wgsl");
     assert_eq!(crate::gpu::wgsl_struct_size(draw, "ClothView"), Some(size_of::<render::ClothViewUniforms>() as u32));
 }
 

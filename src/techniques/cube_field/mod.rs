@@ -4,7 +4,7 @@
 //!
 //! Book: [UGP4 ch.4] sample scene (a Unity particle system; seed-reference §4). Here the particles
 //! are a pure function of time and seed (no simulation state), so any frame renders alone and
-//! identically. Shader: `shaders/cube_field.wgsl`.
+//! identically. Shader: `cube_field.wgsl`.
 
 mod particles;
 
@@ -196,7 +196,7 @@ mod tests {
 
     #[test]
     fn uniform_layout_matches_the_wgsl_struct() {
-        let source = include_str!("../../../shaders/cube_field.wgsl");
+        let source = include_str!("cube_field.wgsl");
         assert_eq!(
             crate::gpu::wgsl_struct_size(source, "CubeFieldUniforms"),
             Some(size_of::<CubeFieldUniforms>() as u32)

@@ -1,7 +1,7 @@
 //! A fader to black: the image's colour times a level. A show's master (`master`) is one, so the
 //! whole composition can be taken down to black from the panel, OSC or a MIDI fader.
 //!
-//! Shader: `shaders/fader.wgsl`.
+//! Shader: `fader.wgsl`.
 
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, TextureHandle};
@@ -73,7 +73,7 @@ mod tests {
 
     #[test]
     fn uniform_layout_matches_the_wgsl_struct() {
-        let source = include_str!("../../../shaders/fader.wgsl");
+        let source = include_str!("fader.wgsl");
         assert_eq!(crate::gpu::wgsl_struct_size(source, "FaderUniforms"), Some(size_of::<FaderUniforms>() as u32));
     }
 }

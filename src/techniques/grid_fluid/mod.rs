@@ -13,7 +13,7 @@
 //! (the sample's a = dt·ν·N² made diffusion pure neighbour averaging).
 //!
 //! Book: [UGP4 ch.6] (sakota), the displacement source; [UGP1] grid fluid. Shader:
-//! `shaders/grid_fluid.wgsl`.
+//! `grid_fluid.wgsl`.
 
 mod plan;
 
@@ -349,3 +349,6 @@ impl GridFluid {
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod render_tests;

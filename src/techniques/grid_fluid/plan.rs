@@ -35,7 +35,7 @@ impl Field {
     pub const COUNT: usize = 10;
 }
 
-/// The kernels of `shaders/grid_fluid.wgsl`.
+/// The kernels of `grid_fluid.wgsl`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kernel {
     /// Adds the cursor's splat.

@@ -4,7 +4,7 @@ use crate::params::ParamSet;
 
 #[test]
 fn the_dispatch_block_matches_the_wgsl_struct() {
-    let source = include_str!("../../../shaders/grid_fluid.wgsl");
+    let source = include_str!("grid_fluid.wgsl");
     assert_eq!(crate::gpu::wgsl_struct_size(source, "Dispatch"), Some(size_of::<FluidDispatch>() as u32));
     assert!(size_of::<FluidDispatch>() as u64 <= BLOCK);
 }

@@ -3,7 +3,7 @@
 //!
 //! Book: [UGP4 ch.2] "Limit sets of Kleinian groups" (fuqunaga). Reference: [Leys] J. Leys,
 //! "A fast algorithm for limit sets of Kleinian groups with the Maskit parametrisation".
-//! Shader: `shaders/kleinian.wgsl`. Goldens: `tests/golden/kleinian*.png`.
+//! Shader: `kleinian.wgsl`. Goldens: `golden/`, made by `render_tests.rs`.
 
 pub mod reference;
 
@@ -126,7 +126,7 @@ pub struct Kleinian {
     bind_groups: BindGroupCache<u64>,
 }
 
-/// Bindings of `shaders/kleinian.wgsl` (checked against the WGSL by name at creation).
+/// Bindings of `kleinian.wgsl` (checked against the WGSL by name at creation).
 const PARAMS_BINDING: u32 = 0;
 const OUTPUT_BINDING: u32 = 1;
 
@@ -194,3 +194,6 @@ impl Technique for Kleinian {
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod render_tests;

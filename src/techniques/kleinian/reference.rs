@@ -7,7 +7,7 @@ fn wrap(x: f32, width: f32, left: f32) -> f32 {
     shifted - width * (shifted / width).floor() + left
 }
 
-/// The escape-time test of `shaders/kleinian.wgsl::in_limit_set`.
+/// The escape-time test of `kleinian.wgsl::in_limit_set`.
 pub fn in_limit_set(start: [f32; 2], t: [f32; 2], iterations: u32) -> bool {
     classify(start, t, iterations).0
 }

@@ -2,7 +2,7 @@ use super::*;
 
 #[test]
 fn uniform_layout_matches_the_wgsl_struct() {
-    let source = include_str!("../../../shaders/kleinian.wgsl");
+    let source = include_str!("kleinian.wgsl");
     assert_eq!(crate::gpu::wgsl_struct_size(source, "KleinianUniforms"), Some(size_of::<KleinianUniforms>() as u32));
 }
 

@@ -3,7 +3,7 @@
 //! (first samples deep blue, through magenta, newest yellow). Sampling is [`crate::geometry::poisson`] on the CPU;
 //! each fixed step runs `steps_per_step` sampler steps and only new samples are uploaded.
 //! Changing dimensions, radius, attempts, extent or seed restarts the run (so does `restart`).
-//! Shader: `shaders/poisson.wgsl` (instanced quads: discs, or sphere impostors).
+//! Shader: `poisson.wgsl` (instanced quads: discs, or sphere impostors).
 
 use crate::geometry::poisson::{PoissonDisk, PoissonSettings, Step};
 use crate::gpu::ShaderError;
@@ -477,9 +477,10 @@ mod tests {
 
     #[test]
     fn uniform_layout_matches_the_wgsl_struct() {
-        let source =
-            [include_str!("../../../shaders/msaa_samples.wgsl"), include_str!("../../../shaders/poisson.wgsl")]
-                .join("\n");
+        let source = [include_str!("../../../shaders/msaa_samples.wgsl"), include_str!("poisson.wgsl")].join("\n");
         assert_eq!(crate::gpu::wgsl_struct_size(&source, "PoissonUniforms"), Some(size_of::<PoissonUniforms>() as u32));
     }
 }
+
+#[cfg(test)]
+mod render_tests;

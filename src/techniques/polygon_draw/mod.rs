@@ -7,7 +7,7 @@
 //! `cursor` (view position, 0–1, y up) then the `add` trigger appends a vertex, `close` ends the
 //! polygon, `undo` removes the last polygon, `clear` removes all. In the window a left click
 //! sets `cursor` and fires `add`, a right click fires `close`, U and C fire `undo` and `clear`.
-//! Shader: `shaders/polygon_draw.wgsl`.
+//! Shader: `polygon_draw.wgsl`.
 
 use super::mesh2d_draw::{self as gpu, DrawStyle};
 use crate::geometry::triangulate::{Mesh2D, Triangulator};
@@ -218,3 +218,6 @@ impl Technique for PolygonDraw {
         self.gpu.add_pass(graph, "polygon_draw", &settings.style(), time)
     }
 }
+
+#[cfg(test)]
+mod render_tests;

@@ -1,6 +1,6 @@
 //! Chapter 1: space colonization (Runions, Lane & Prusinkiewicz 2007) grown on the GPU. Branches
 //! grow from seeds towards a cloud of attractions; each growth step is Search → Attract → Connect
-//! → Remove → Grow (see `shaders/space_colonization.wgsl`), entirely on the GPU with indirect
+//! → Remove → Grow (see `space_colonization.wgsl`), entirely on the GPU with indirect
 //! dispatches and draws — no count is read back.
 //!
 //! Changes from the book's sample (seed-reference §1, §9 items 1–7), and why:
@@ -30,7 +30,7 @@
 //! (the sample's append/consume buffer, without the order a consume buffer would randomise).
 //!
 //! Book: [UGP4 ch.1] "GPU-Based Space Colonization Algorithm" (nakamura). Shaders:
-//! `shaders/space_colonization.wgsl`, `shaders/space_colonization_draw.wgsl`,
+//! `space_colonization.wgsl`, `space_colonization_draw.wgsl`,
 //! `shaders/prefix_sum.wgsl`.
 
 mod cloud;
@@ -502,3 +502,6 @@ impl Technique for SpaceColonization {
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod render_tests;

@@ -122,7 +122,7 @@ pub fn params() -> Vec<ParamDecl> {
     Settings::decls()
 }
 
-/// The growth shader's uniform block (`Growth` in `shaders/space_colonization.wgsl`).
+/// The growth shader's uniform block (`Growth` in `space_colonization.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GrowthUniforms {
@@ -208,7 +208,7 @@ pub fn growth_uniforms(p: &Settings, unit: f32, dt: f32) -> GrowthUniforms {
     }
 }
 
-/// The draw shader's uniform block (`View` in `shaders/space_colonization_draw.wgsl`).
+/// The draw shader's uniform block (`View` in `space_colonization_draw.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct ViewUniforms {

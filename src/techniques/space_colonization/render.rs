@@ -69,7 +69,7 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    /// Builds the pipelines from `shaders/space_colonization_draw.wgsl` for `format`.
+    /// Builds the pipelines from `space_colonization_draw.wgsl` for `format`.
     pub fn new(setup: &NodeSetup<'_>, format: wgpu::TextureFormat) -> Result<Self, ShaderError> {
         let device = &setup.gpu.device;
         let (origin, source) = setup.shader_source("space_colonization_draw.wgsl", &DRAW_BINDINGS)?;

@@ -3,7 +3,7 @@
 //! scene.
 //!
 //! Book: [UGP4 ch.4] "StarGlow" (xjine); [Kawase 2003] "Frame Buffer Postprocessing Effects in
-//! DOUBLE-S.T.E.A.L", GDC. Shader: `shaders/star_glow.wgsl`. Goldens: `tests/golden/star_glow*.png`.
+//! DOUBLE-S.T.E.A.L", GDC. Shader: `star_glow.wgsl`. Goldens: `golden/`, made by `render_tests.rs`.
 //!
 //! Differences from the sample (seed-reference §9 item 17), on purpose: the accumulation target
 //! starts black every frame; nothing is clamped to 1 (HDR stays HDR until the display encode);
@@ -199,7 +199,7 @@ struct Kernels {
     level_last: Kernel,
 }
 
-/// The texture bindings of `shaders/star_glow.wgsl` besides the uniform (0) and sampler (1).
+/// The texture bindings of `star_glow.wgsl` besides the uniform (0) and sampler (1).
 #[derive(Clone, Copy)]
 enum Binding {
     TexA = 2,
@@ -300,3 +300,6 @@ impl Technique for StarGlow {
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod render_tests;

@@ -2,7 +2,7 @@ use super::*;
 
 #[test]
 fn uniform_layout_matches_the_wgsl_struct() {
-    let source = include_str!("../../../shaders/star_glow.wgsl");
+    let source = include_str!("star_glow.wgsl");
     assert_eq!(crate::gpu::wgsl_struct_size(source, "StarGlowUniforms"), Some(size_of::<StarGlowUniforms>() as u32));
 }
 

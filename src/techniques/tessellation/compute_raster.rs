@@ -1,4 +1,4 @@
-//! The surface drawn in compute (`shaders/tessellation_raster.wgsl`): a visibility buffer of
+//! The surface drawn in compute (`tessellation_raster.wgsl`): a visibility buffer of
 //! one 64-bit word per sample (inverted depth, triangle), filled by one thread per refined
 //! triangle with `atomicMax` and shaded once per pixel and triangle. On GPUs whose raster path is
 //! narrow (the H100/H200, where clearing and resolving a 4× multisampled 4K target alone takes
@@ -298,8 +298,8 @@ mod tests {
     fn the_uniform_block_matches_the_wgsl_struct() {
         let source = [
             include_str!("../../../shaders/msaa_samples.wgsl"),
-            include_str!("../../../shaders/tessellation.wgsl"),
-            include_str!("../../../shaders/tessellation_raster.wgsl"),
+            include_str!("tessellation.wgsl"),
+            include_str!("tessellation_raster.wgsl"),
         ]
         .join("\n");
         assert_eq!(crate::gpu::wgsl_struct_size(&source, "Raster"), Some(size_of::<super::RasterUniforms>() as u32));

@@ -15,7 +15,7 @@
 //! `compute_raster`; the `rasterizer` parameter), else by the raster pipeline (`draw_indirect`).
 //! Both give the same image within multisampling's differences (a test compares them).
 //!
-//! Book: [UGP4 ch.6] "Tessellation & Displacement" (sakota). Shader: `shaders/tessellation.wgsl`.
+//! Book: [UGP4 ch.6] "Tessellation & Displacement" (sakota). Shader: `tessellation.wgsl`.
 
 mod compute_raster;
 mod params;
@@ -527,7 +527,7 @@ mod tests {
 
     #[test]
     fn the_uniform_block_matches_the_wgsl_struct() {
-        let source = include_str!("../../../shaders/tessellation.wgsl");
+        let source = include_str!("tessellation.wgsl");
         assert_eq!(crate::gpu::wgsl_struct_size(source, "Tess"), Some(size_of::<TessUniforms>() as u32));
     }
 
@@ -550,3 +550,6 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod render_tests;

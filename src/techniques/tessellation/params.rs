@@ -94,7 +94,7 @@ pub fn params() -> Vec<ParamDecl> {
     Settings::decls()
 }
 
-/// `Tess` in `shaders/tessellation.wgsl`.
+/// `Tess` in `tessellation.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct TessUniforms {

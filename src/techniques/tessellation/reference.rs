@@ -1,5 +1,5 @@
 //! The book's tessellation factors and culling on the CPU, mirroring the compute passes of
-//! `shaders/tessellation.wgsl` (same mesh numbering), for tests.
+//! `tessellation.wgsl` (same mesh numbering), for tests.
 
 use glam::{Mat4, Vec3, Vec4};
 
@@ -89,7 +89,7 @@ pub fn patch_level(u: &TessUniforms, factors: &[f32], p: u32) -> u32 {
 }
 
 /// Where point `m` of `level` equal parts lies (0–1) when the factor is `phi` (0–1) into that
-/// level — the geomorph of `shaders/tessellation.wgsl`'s `morphed`: at `phi` = 1 the even
+/// level — the geomorph of `tessellation.wgsl`'s `morphed`: at `phi` = 1 the even
 /// subdivision, at 0 the points of `level` − 1 parts (up to the middle they keep their number,
 /// past it they take the one before: the two middle points start as one).
 pub fn morphed(m: u32, level: u32, phi: f32) -> f32 {

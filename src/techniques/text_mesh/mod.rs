@@ -202,3 +202,6 @@ mod tests {
         assert!(text_rings(&face, "\u{E000}", 1.0, 0.01).is_empty());
     }
 }
+
+#[cfg(test)]
+mod render_tests;

@@ -582,7 +582,7 @@ mod tests {
 
     #[test]
     fn uniform_layout_matches_the_wgsl_struct() {
-        let source = include_str!("../../../shaders/warp.wgsl");
+        let source = include_str!("warp.wgsl");
         assert_eq!(crate::gpu::wgsl_struct_size(source, "WarpUniforms"), Some(size_of::<WarpUniforms>() as u32));
     }
 
@@ -613,3 +613,6 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod render_tests;

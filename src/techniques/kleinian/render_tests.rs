@@ -1,14 +1,16 @@
 //! Chapter 2, Kleinian limit sets: golden renders of every scene at two times, determinism,
 //! the limit set's own symmetries, and agreement with the CPU version of the algorithm.
 
-use crate::common::{bright, golden, render_named, render_text};
+use crate::common::{bright, render_named, render_text};
 use indra::techniques::kleinian::reference::{in_limit_set, pixel_to_plane};
 
 const SIZE: (u32, u32) = (256, 256);
 
 fn check_golden(scene: &str, frame: u64) {
     let rendered = render_named(scene, SIZE, frame);
-    golden(0.01, 0.3).check(&format!("{scene}_f{frame:04}"), SIZE, &rendered.rgba).unwrap_or_else(|e| panic!("{e}"));
+    crate::common::golden_beside(file!(), 0.01, 0.3)
+        .check(&format!("{scene}_f{frame:04}"), SIZE, &rendered.rgba)
+        .unwrap_or_else(|e| panic!("{e}"));
 }
 
 #[test]

@@ -211,7 +211,7 @@ fn the_same_scene_gives_the_same_bytes() {
 
 fn golden(scene: &str, frames: &[u64], sets: &[&str]) {
     for (image, f) in render(scene, (256, 256), frames, sets).iter().zip(frames) {
-        common::golden(0.01, 0.3)
+        common::golden_beside(file!(), 0.01, 0.3)
             .check(&format!("{scene}_f{f:04}"), (256, 256), image)
             .unwrap_or_else(|e| panic!("{e}"));
     }

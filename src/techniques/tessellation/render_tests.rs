@@ -172,7 +172,7 @@ fn check_golden(scene: &str, frames: &[u64]) {
     for &f in frames {
         r.seek(f).unwrap();
         let rendered = r.render_next().unwrap();
-        common::golden(0.01, 0.3)
+        common::golden_beside(file!(), 0.01, 0.3)
             .check(&format!("{scene}_f{f:04}"), SIZE, &rendered.rgba)
             .unwrap_or_else(|e| panic!("{e}"));
     }

@@ -4,7 +4,7 @@
 
 use crate::common;
 
-use crate::common::{assets, golden, gpu, render_named};
+use crate::common::{assets, gpu, render_named};
 use indra::assets::Assets;
 use indra::geometry::warp::{Corners, MeshWarp, WarpFile};
 use indra::gpu::Gpu;
@@ -246,11 +246,11 @@ fn a_broken_warp_file_keeps_the_last_good_warp_and_save_writes_what_is_live() {
 #[test]
 fn projection_mapping_matches_its_golden_with_and_without_the_grid() {
     let frame = render_named("projection_mapping", (192, 108), 30);
-    golden(0.01, 0.3).check("projection_mapping", frame.size, &frame.rgba).unwrap();
+    crate::common::golden_beside(file!(), 0.01, 0.3).check("projection_mapping", frame.size, &frame.rgba).unwrap();
     let mut scene = indra::scene::load_scene(&assets(), "projection_mapping").unwrap();
     scene.set_from_str("wall.grid=true").unwrap();
     let frame = common::render_scene(scene, (192, 108), 30);
-    golden(0.01, 0.3).check("projection_mapping_grid", frame.size, &frame.rgba).unwrap();
+    crate::common::golden_beside(file!(), 0.01, 0.3).check("projection_mapping_grid", frame.size, &frame.rgba).unwrap();
 }
 
 #[test]
@@ -287,7 +287,9 @@ fn each_projector_output_matches_its_golden() {
         r.show_output(n).unwrap();
         r.seek(30).unwrap();
         let frame = r.render_next().unwrap();
-        golden(0.01, 0.3).check(&format!("two_projectors_output{n}"), frame.size, &frame.rgba).unwrap();
+        crate::common::golden_beside(file!(), 0.01, 0.3)
+            .check(&format!("two_projectors_output{n}"), frame.size, &frame.rgba)
+            .unwrap();
     }
 }
 

@@ -37,7 +37,9 @@ fn lit(frame: &RenderedFrame, x: f32, y: f32) -> bool {
 #[test]
 fn golden_book_nested_shapes() {
     let frame = common::render_scene(scene(), SIZE, 0);
-    common::golden(0.01, 0.3).check("polygon_draw_book", SIZE, &frame.rgba).unwrap_or_else(|e| panic!("{e}"));
+    common::golden_beside(file!(), 0.01, 0.3)
+        .check("polygon_draw_book", SIZE, &frame.rgba)
+        .unwrap_or_else(|e| panic!("{e}"));
 }
 
 #[test]
@@ -71,7 +73,9 @@ fn drawing_over_osc_makes_holes_and_islands() {
     }
     let frames: Vec<RenderedFrame> = (0..=undo_frame).map(|_| r.render_next().unwrap()).collect();
     let drawn = &frames[undo_frame as usize - 1];
-    common::golden(0.01, 0.3).check("polygon_draw_osc", SIZE, &drawn.rgba).unwrap_or_else(|e| panic!("{e}"));
+    common::golden_beside(file!(), 0.01, 0.3)
+        .check("polygon_draw_osc", SIZE, &drawn.rgba)
+        .unwrap_or_else(|e| panic!("{e}"));
     assert!(lit(drawn, 0.27, 0.5), "outer fill");
     assert!(!lit(drawn, 0.4, 0.62), "inside the hole");
     assert!(lit(drawn, 0.5, 0.47), "island");

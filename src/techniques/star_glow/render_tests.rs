@@ -3,7 +3,7 @@
 
 use crate::common;
 
-use crate::common::{assets, golden, gpu, render_scene};
+use crate::common::{assets, gpu, render_scene};
 use indra::gpu::Gpu;
 use indra::graph::{FrameGraph, GraphRuntime};
 use indra::params::ParamSet;
@@ -216,7 +216,7 @@ fn zero_intensity_adds_no_passes() {
 fn golden_star_glow_at_two_times() {
     for frame in [0, 90] {
         let f = render_star_glow(&[], frame);
-        golden(0.01, 0.3)
+        crate::common::golden_beside(file!(), 0.01, 0.3)
             .check(&format!("star_glow_f{frame:04}"), (256, 256), &f.rgba)
             .unwrap_or_else(|e| panic!("{e}"));
     }
@@ -226,7 +226,7 @@ fn golden_star_glow_at_two_times() {
 fn golden_kleinian_star_glow_at_two_times() {
     for frame in [0, 240] {
         let f = common::render_named("kleinian_star_glow", (256, 256), frame);
-        golden(0.01, 0.3)
+        crate::common::golden_beside(file!(), 0.01, 0.3)
             .check(&format!("kleinian_star_glow_f{frame:04}"), (256, 256), &f.rgba)
             .unwrap_or_else(|e| panic!("{e}"));
     }

@@ -22,7 +22,11 @@ fn golden_text_and_a_new_text_over_osc() {
     r.schedule(1, vec![event]);
     let before = r.render_next().unwrap();
     let after = r.render_next().unwrap();
-    common::golden(0.01, 0.3).check("text_mesh_default", SIZE, &before.rgba).unwrap_or_else(|e| panic!("{e}"));
-    common::golden(0.01, 0.3).check("text_mesh_osc", SIZE, &after.rgba).unwrap_or_else(|e| panic!("{e}"));
+    common::golden_beside(file!(), 0.01, 0.3)
+        .check("text_mesh_default", SIZE, &before.rgba)
+        .unwrap_or_else(|e| panic!("{e}"));
+    common::golden_beside(file!(), 0.01, 0.3)
+        .check("text_mesh_osc", SIZE, &after.rgba)
+        .unwrap_or_else(|e| panic!("{e}"));
     assert!(before.rgba != after.rgba);
 }

@@ -171,7 +171,7 @@ fn golden_frames(scene: &str, frames: &[u64], sets: &[&str]) {
     for f in 0..=last {
         let frame = r.render_next().unwrap();
         if frames.contains(&f) {
-            common::golden(0.01, 0.3)
+            common::golden_beside(file!(), 0.01, 0.3)
                 .check(&format!("{scene}_f{f:04}"), (256, 256), &frame.rgba)
                 .unwrap_or_else(|e| panic!("{e}"));
         }

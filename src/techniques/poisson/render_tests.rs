@@ -28,7 +28,7 @@ fn golden_poisson_2d_growing_and_complete() {
     let mut r = renderer("poisson_2d", &[]);
     for (frames, name) in [(120, "poisson_2d_f0119"), (880, "poisson_2d_f0999")] {
         let rgba = play(&mut r, frames);
-        common::golden(0.01, 0.3).check(name, SIZE, &rgba).unwrap_or_else(|e| panic!("{e}"));
+        common::golden_beside(file!(), 0.01, 0.3).check(name, SIZE, &rgba).unwrap_or_else(|e| panic!("{e}"));
     }
 }
 
@@ -36,7 +36,7 @@ fn golden_poisson_2d_growing_and_complete() {
 fn golden_poisson_3d_growing() {
     let mut r = renderer("poisson_3d", &[]);
     let rgba = play(&mut r, 400);
-    common::golden(0.01, 0.3).check("poisson_3d_f0399", SIZE, &rgba).unwrap_or_else(|e| panic!("{e}"));
+    common::golden_beside(file!(), 0.01, 0.3).check("poisson_3d_f0399", SIZE, &rgba).unwrap_or_else(|e| panic!("{e}"));
 }
 
 #[test]
