@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::params::{ControlEvent, ParamWrite, RawValue, ShowCommand, Source, raw_from_value, value_from_raw};
+use crate::params::{Addressing, ControlEvent, ParamWrite, RawValue, Source, raw_from_value, value_from_raw};
 use crate::scene::Scene;
 
 /// One line of a control-stream file.
@@ -18,51 +18,39 @@ use crate::scene::Scene;
 pub struct Recorded {
     /// The fixed-step frame the event applied before.
     pub frame: u64,
-    /// What happened.
-    pub event: RecordedEvent,
+    /// What happened, by names.
+    pub event: ControlEvent<Named>,
 }
 
-/// An event by names, so recordings survive node reordering.
+/// Control events by names and raw values, so recordings survive node reordering and edits of a
+/// parameter's type: the same [`ControlEvent`], addressed as a file needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Named;
+
+impl Addressing for Named {
+    type Write = NamedWrite;
+    type Values = Vec<(String, String, RawValue)>;
+}
+
+/// A parameter write by names.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum RecordedEvent {
-    /// A parameter write.
-    Write {
-        /// Node id.
-        node: String,
-        /// Parameter name.
-        param: String,
-        /// Component index, if one.
-        component: Option<usize>,
-        /// The value.
-        value: RawValue,
-        /// Who wrote it.
-        source: Source,
-    },
-    /// A preset recall: (node, param, value) over seconds.
-    Morph {
-        /// The values.
-        values: Vec<(String, String, RawValue)>,
-        /// Duration.
-        seconds: f64,
-    },
-    /// Tracks resumed.
-    ResumeTracks,
-    /// The tempo set (tap, OSC, MIDI clock).
-    Tempo {
-        /// Beats per minute.
-        bpm: f64,
-        /// Whether the beat snapped to this step.
-        resync: bool,
-    },
-    /// The beat moved to a phase of the bar (Ableton Link).
-    Phase {
-        /// The beat within the bar.
-        phase: f64,
-        /// Beats per bar.
-        quantum: f64,
-    },
-    /// A show command (clip, column or cue), numbered from 0.
-    Show(ShowCommand),
+pub struct NamedWrite {
+    /// Node id.
+    pub node: String,
+    /// Parameter name.
+    pub param: String,
+    /// Component index, if one.
+    pub component: Option<usize>,
+    /// The value.
+    pub value: RawValue,
+    /// Who wrote it.
+    pub source: Source,
+}
+
+/// RON as recordings are written: a write's fields directly inside `Write(…)`, as they were when
+/// the event had a type of its own.
+fn ron_options() -> ron::Options {
+    ron::Options::default().with_default_extension(ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES)
 }
 
 /// Writes events as they are applied — into a temporary file beside the target, renamed over it
@@ -106,7 +94,7 @@ impl Recorder {
                 log::warn!("not recorded (no such parameter in '{}'): {event:?}", scene.name);
                 continue;
             };
-            let text = ron::to_string(&Recorded { frame, event }).map_err(|e| e.to_string())?;
+            let text = ron_options().to_string(&Recorded { frame, event }).map_err(|e| e.to_string())?;
             writeln!(self.out, "{text}").map_err(|e| e.to_string())?;
             self.count += 1;
         }
@@ -132,7 +120,7 @@ fn named(scene: &Scene, node: usize, param: usize) -> Option<(String, String, &c
     Some((n.id.clone(), decl.name.clone(), decl))
 }
 
-fn to_recorded(event: &ControlEvent, scene: &Scene) -> Option<RecordedEvent> {
+fn to_recorded(event: &ControlEvent, scene: &Scene) -> Option<ControlEvent<Named>> {
     Some(match event {
         ControlEvent::Write(w) => {
             let (node, param, decl) = named(scene, w.node, w.param)?;
@@ -140,19 +128,19 @@ fn to_recorded(event: &ControlEvent, scene: &Scene) -> Option<RecordedEvent> {
                 Some(_) => RawValue::Number(f64::from(w.value.components()[0])),
                 None => raw_from_value(&w.value, decl),
             };
-            RecordedEvent::Write { node, param, component: w.component, value, source: w.source }
+            ControlEvent::Write(NamedWrite { node, param, component: w.component, value, source: w.source })
         }
-        ControlEvent::Morph { values, seconds } => RecordedEvent::Morph {
+        ControlEvent::Morph { values, seconds } => ControlEvent::Morph {
             values: values
                 .iter()
                 .map(|(n, p, v)| named(scene, *n, *p).map(|(node, param, decl)| (node, param, raw_from_value(v, decl))))
                 .collect::<Option<_>>()?,
             seconds: *seconds,
         },
-        ControlEvent::ResumeTracks => RecordedEvent::ResumeTracks,
-        ControlEvent::Tempo { bpm, resync } => RecordedEvent::Tempo { bpm: *bpm, resync: *resync },
-        ControlEvent::Phase { phase, quantum } => RecordedEvent::Phase { phase: *phase, quantum: *quantum },
-        ControlEvent::Show(command) => RecordedEvent::Show(*command),
+        ControlEvent::ResumeTracks => ControlEvent::ResumeTracks,
+        ControlEvent::Tempo { bpm, resync } => ControlEvent::Tempo { bpm: *bpm, resync: *resync },
+        ControlEvent::Phase { phase, quantum } => ControlEvent::Phase { phase: *phase, quantum: *quantum },
+        ControlEvent::Show(command) => ControlEvent::Show(*command),
     })
 }
 
@@ -170,7 +158,7 @@ pub fn read_replay(path: &Path, scene: &Scene) -> Result<BTreeMap<u64, Vec<Contr
     let mut out: BTreeMap<u64, Vec<ControlEvent>> = BTreeMap::new();
     for (i, line) in lines.iter().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
         let at = |msg: String| format!("{}:{}: {msg}", path.display(), i + 1);
-        let rec: Recorded = match ron::from_str(line) {
+        let rec: Recorded = match ron_options().from_str(line) {
             Ok(rec) => rec,
             Err(_) if cut_short && i + 1 == lines.len() => {
                 log::warn!("{}:{}: the last line is cut short; replaying up to the line before", path.display(), i + 1);
@@ -195,9 +183,9 @@ fn resolve(scene: &Scene, node: &str, param: &str) -> Result<(usize, usize), Str
     Ok((n, p))
 }
 
-fn from_recorded(event: &RecordedEvent, scene: &Scene) -> Result<ControlEvent, String> {
+fn from_recorded(event: &ControlEvent<Named>, scene: &Scene) -> Result<ControlEvent, String> {
     Ok(match event {
-        RecordedEvent::Write { node, param, component, value, source } => {
+        ControlEvent::Write(NamedWrite { node, param, component, value, source }) => {
             let (n, p) = resolve(scene, node, param)?;
             let decl = &scene.nodes[n].params.decls()[p];
             let typed = match component {
@@ -212,7 +200,7 @@ fn from_recorded(event: &RecordedEvent, scene: &Scene) -> Result<ControlEvent, S
             };
             ControlEvent::Write(ParamWrite { node: n, param: p, component: *component, value: typed, source: *source })
         }
-        RecordedEvent::Morph { values, seconds } => ControlEvent::Morph {
+        ControlEvent::Morph { values, seconds } => ControlEvent::Morph {
             values: values
                 .iter()
                 .map(|(node, param, raw)| {
@@ -224,12 +212,37 @@ fn from_recorded(event: &RecordedEvent, scene: &Scene) -> Result<ControlEvent, S
             seconds: finite("morph seconds", *seconds)
                 .and_then(|s| if s >= 0.0 { Ok(s) } else { Err(format!("morph seconds {s} is negative")) })?,
         },
-        RecordedEvent::ResumeTracks => ControlEvent::ResumeTracks,
-        RecordedEvent::Tempo { bpm, resync } => ControlEvent::Tempo { bpm: finite("bpm", *bpm)?, resync: *resync },
-        RecordedEvent::Phase { phase, quantum } => {
+        ControlEvent::ResumeTracks => ControlEvent::ResumeTracks,
+        ControlEvent::Tempo { bpm, resync } => ControlEvent::Tempo { bpm: finite("bpm", *bpm)?, resync: *resync },
+        ControlEvent::Phase { phase, quantum } => {
             ControlEvent::Phase { phase: finite("phase", *phase)?, quantum: finite("quantum", *quantum)? }
         }
         // Numbers past the show's layers, clips or cues are refused where the show applies them.
-        RecordedEvent::Show(command) => ControlEvent::Show(*command),
+        ControlEvent::Show(command) => ControlEvent::Show(*command),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_recorded_write_reads_as_recordings_always_have() {
+        let event = ControlEvent::Write(NamedWrite {
+            node: "glow".into(),
+            param: "intensity".into(),
+            component: None,
+            value: RawValue::Number(0.5),
+            source: Source::Osc,
+        });
+        let line = ron_options().to_string(&Recorded { frame: 3, event: event.clone() }).unwrap();
+        assert_eq!(
+            line,
+            r#"(frame:3,event:Write(node:"glow",param:"intensity",component:None,value:0.5,source:Osc))"#
+        );
+        let back: Recorded = ron_options().from_str(&line).unwrap();
+        assert_eq!(back, Recorded { frame: 3, event });
+        let show: Recorded = ron_options().from_str("(frame: 1, event: Show(CueGo))").unwrap();
+        assert_eq!(show.event, ControlEvent::Show(crate::params::ShowCommand::CueGo));
+    }
 }

@@ -20,15 +20,38 @@ pub struct Target {
 /// Values for (node, param) pairs: a preset, or a morph's destination.
 pub type NodeValues = Vec<(usize, usize, ParamValue)>;
 
+/// How a [`ControlEvent`] names parameters and values: by index and typed, as the running scene
+/// applies them ([`Indexed`], the default), or by name and raw, as a recording stores them so it
+/// survives edits of the scene (`control::record::Named`). One event type, two addressings.
+pub trait Addressing {
+    /// A parameter write.
+    type Write: Clone + std::fmt::Debug + PartialEq;
+    /// A morph's destination values.
+    type Values: Clone + std::fmt::Debug + PartialEq;
+}
+
+/// Parameters by node and parameter index, values typed: what the running scene applies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Indexed;
+
+impl Addressing for Indexed {
+    type Write = ParamWrite;
+    type Values = NodeValues;
+}
+
 /// Something a controller, the UI or a replay asks of the running scene.
-#[derive(Clone, Debug, PartialEq)]
-pub enum ControlEvent {
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(bound(
+    serialize = "A::Write: serde::Serialize, A::Values: serde::Serialize",
+    deserialize = "A::Write: serde::Deserialize<'de>, A::Values: serde::Deserialize<'de>"
+))]
+pub enum ControlEvent<A: Addressing = Indexed> {
     /// Set one parameter (or component).
-    Write(ParamWrite),
+    Write(A::Write),
     /// Move to these values over `seconds` (0: at once) — a preset recall.
     Morph {
         /// (node, param, value).
-        values: NodeValues,
+        values: A::Values,
         /// Morph duration.
         seconds: f64,
     },
