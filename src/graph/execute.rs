@@ -52,13 +52,29 @@ pub struct GraphRuntime {
     pool: TexturePool,
     buffers: Vec<PooledBuffer>,
     timer: Option<GpuTimer>,
+    /// Whether each pass is recorded inside a debug group of its name.
+    debug_groups: bool,
 }
 
 impl GraphRuntime {
-    /// A runtime that times passes when the device has `TIMESTAMP_QUERY_INSIDE_ENCODERS`.
+    /// A runtime that times passes when the device has `TIMESTAMP_QUERY_INSIDE_ENCODERS`, and
+    /// encloses each pass in a debug group named like it (so a RenderDoc or Nsight capture reads
+    /// like the frame graph) except on a CPU adapter: lavapipe (Mesa 22.3) crashes when a debug
+    /// group encloses a render pass.
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
         let timed = device.features().contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
-        Self { pool: TexturePool::new(), buffers: Vec::new(), timer: timed.then(|| GpuTimer::new(device, queue)) }
+        let debug_groups = device.adapter_info().device_type != wgpu::DeviceType::Cpu;
+        Self {
+            pool: TexturePool::new(),
+            buffers: Vec::new(),
+            timer: timed.then(|| GpuTimer::new(device, queue)),
+            debug_groups,
+        }
+    }
+
+    /// Whether passes are recorded inside debug groups of their names (see [`GraphRuntime::new`]).
+    pub fn debug_groups(&self) -> bool {
+        self.debug_groups
     }
 
     /// The transient texture pool.
@@ -162,8 +178,9 @@ impl GraphRuntime {
             if timing && let Some(t) = self.timer.as_mut() {
                 t.begin_pass(encoder, position, &pass.name);
             }
-            // No encoder debug group around the pass: lavapipe (Mesa 22.3) crashes when one
-            // encloses a render pass. Passes label their own wgpu passes instead.
+            if self.debug_groups {
+                encoder.push_debug_group(&pass.name);
+            }
             if let Some(record) = pass.record.take() {
                 let mut ctx = PassContext {
                     device,
@@ -174,6 +191,9 @@ impl GraphRuntime {
                     pass_name: &pass.name,
                 };
                 record(&mut ctx);
+            }
+            if self.debug_groups {
+                encoder.pop_debug_group();
             }
             if timing && let Some(t) = self.timer.as_mut() {
                 t.end_pass(encoder, position);
