@@ -236,10 +236,7 @@ mod tests {
             source: Source::Osc,
         });
         let line = ron_options().to_string(&Recorded { frame: 3, event: event.clone() }).unwrap();
-        assert_eq!(
-            line,
-            r#"(frame:3,event:Write(node:"glow",param:"intensity",component:None,value:0.5,source:Osc))"#
-        );
+        assert_eq!(line, r#"(frame:3,event:Write(node:"glow",param:"intensity",component:None,value:0.5,source:Osc))"#);
         let back: Recorded = ron_options().from_str(&line).unwrap();
         assert_eq!(back, Recorded { frame: 3, event });
         let show: Recorded = ron_options().from_str("(frame: 1, event: Show(CueGo))").unwrap();
