@@ -76,7 +76,7 @@ impl<'a> Request<'a> {
 
     /// The value of query parameter `name` (`?token=abc&x` → `abc` for `token`), undecoded.
     pub fn query_param(&self, name: &str) -> Option<&'a str> {
-        self.query().split('&').filter_map(|pair| pair.split_once('=')).find(|(n, _)| *n == name).map(|(_, v)| v)
+        value_of(self.query(), '&', name)
     }
 
     /// The first header called `name` (any case), trimmed.
@@ -90,12 +90,13 @@ impl<'a> Request<'a> {
 
     /// The value of cookie `name`, if the request carries it.
     pub fn cookie(&self, name: &str) -> Option<&'a str> {
-        self.header("cookie")?
-            .split(';')
-            .filter_map(|c| c.trim().split_once('='))
-            .find(|(n, _)| *n == name)
-            .map(|(_, v)| v)
+        value_of(self.header("cookie")?, ';', name)
     }
+}
+
+/// The value of `name` in a list of `name=value` pairs split by `separator`.
+fn value_of<'a>(list: &'a str, separator: char, name: &str) -> Option<&'a str> {
+    list.split(separator).filter_map(|pair| pair.trim().split_once('=')).find(|(n, _)| *n == name).map(|(_, v)| v)
 }
 
 /// What a handler answers: a status, a body and its type, and extra headers.
@@ -112,9 +113,14 @@ pub struct Reply {
 }
 
 impl Reply {
+    /// `body` of `content_type` with `status`, no extra headers.
+    pub fn text(status: u16, content_type: &'static str, body: String) -> Self {
+        Self { status, content_type, body: body.into_bytes().into(), headers: Vec::new() }
+    }
+
     /// A JSON body with `status`.
     pub fn json(status: u16, body: String) -> Self {
-        Self { status, content_type: "application/json", body: body.into_bytes().into(), headers: Vec::new() }
+        Self::text(status, "application/json", body)
     }
 
     /// An empty JSON object with `status` (errors say it by status alone).
@@ -240,20 +246,25 @@ fn serve(mut stream: TcpStream, routes: &Routes, sockets: &AtomicUsize) {
     let _ = stream.set_nonblocking(false);
     let _ = stream.set_read_timeout(Some(TIMEOUT));
     let _ = stream.set_write_timeout(Some(TIMEOUT));
-    let reply = match read_head(&mut stream) {
-        Ok(head) => match (&routes.socket, websocket_key(&head)) {
-            (Some(handler), Some(key)) => {
-                if sockets.fetch_add(1, Ordering::Relaxed) < routes.max_sockets {
-                    upgrade(stream, &head, &key, handler);
-                    sockets.fetch_sub(1, Ordering::Relaxed);
-                    return;
-                }
+    let head = match read_head(&mut stream) {
+        Ok(head) => head,
+        Err(status) => {
+            let _ = write_reply(&mut stream, &Reply::status(status));
+            return;
+        }
+    };
+    let (method, request) = parse(&head);
+    let reply = match (&routes.socket, websocket_key(method, &request)) {
+        (Some(handler), Some(key)) => {
+            if sockets.fetch_add(1, Ordering::Relaxed) < routes.max_sockets {
+                upgrade(stream, &request, key, handler);
                 sockets.fetch_sub(1, Ordering::Relaxed);
-                Reply::status(503)
+                return;
             }
-            _ => answer(&head, &routes.get),
-        },
-        Err(status) => Reply::status(status),
+            sockets.fetch_sub(1, Ordering::Relaxed);
+            Reply::status(503)
+        }
+        _ => answer(method, &request, &routes.get),
     };
     let _ = write_reply(&mut stream, &reply);
 }
@@ -287,15 +298,10 @@ fn write_reply(stream: &mut TcpStream, reply: &Reply) -> std::io::Result<()> {
 }
 
 /// The `Sec-WebSocket-Key` of a GET that asks for a WebSocket (version 13), if it does.
-fn websocket_key(head: &str) -> Option<String> {
-    if !head.starts_with("GET ") {
-        return None;
-    }
-    let request = parse(head).1;
-    let header = |wanted: &str| request.header(wanted);
-    let upgrade = header("upgrade").is_some_and(|v| v.eq_ignore_ascii_case("websocket"));
-    (upgrade && header("sec-websocket-version") == Some("13"))
-        .then(|| header("sec-websocket-key").map(str::to_string))?
+fn websocket_key<'a>(method: &str, request: &Request<'a>) -> Option<&'a str> {
+    let upgrade = request.header("upgrade").is_some_and(|v| v.eq_ignore_ascii_case("websocket"));
+    (method == "GET" && upgrade && request.header("sec-websocket-version") == Some("13"))
+        .then(|| request.header("sec-websocket-key"))?
 }
 
 /// The method of a request head and the request it makes.
@@ -307,7 +313,7 @@ fn parse(head: &str) -> (&str, Request<'_>) {
 }
 
 /// Completes the handshake and hands the session to `handler`.
-fn upgrade(mut stream: TcpStream, head: &str, key: &str, handler: &Arc<SocketHandler>) {
+fn upgrade(mut stream: TcpStream, request: &Request<'_>, key: &str, handler: &Arc<SocketHandler>) {
     let accept = tungstenite::handshake::derive_accept_key(key.as_bytes());
     let answered = write!(
         stream,
@@ -318,7 +324,7 @@ fn upgrade(mut stream: TcpStream, head: &str, key: &str, handler: &Arc<SocketHan
     }
     let config =
         WebSocketConfig::default().max_message_size(Some(MAX_SOCKET_MESSAGE)).max_frame_size(Some(MAX_SOCKET_MESSAGE));
-    handler(&parse(head).1, WebSocket::from_raw_socket(stream, Role::Server, Some(config)));
+    handler(request, WebSocket::from_raw_socket(stream, Role::Server, Some(config)));
 }
 
 /// The request head (up to the blank line), or the status to answer with: `408` when it has
@@ -352,9 +358,8 @@ fn read_head(stream: &mut TcpStream) -> Result<String, u16> {
     }
 }
 
-/// The reply to a request head.
-fn answer(head: &str, handler: &Arc<Handler>) -> Reply {
-    let (method, request) = parse(head);
+/// The reply to a request made with `method`.
+fn answer(method: &str, request: &Request<'_>, handler: &Arc<Handler>) -> Reply {
     if method != "GET" {
         return Reply::status(405);
     }
@@ -363,7 +368,7 @@ fn answer(head: &str, handler: &Arc<Handler>) -> Reply {
     if declares_body {
         return Reply::status(413);
     }
-    handler(&request)
+    handler(request)
 }
 
 #[cfg(test)]
@@ -376,12 +381,16 @@ mod tests {
 
     #[test]
     fn gets_are_answered_and_everything_else_is_refused_by_status() {
-        let h = echo();
-        assert_eq!(answer("GET /a?b HTTP/1.1\r\nHost: x", &h), Reply::json(200, "{\"target\":\"/a?b\"}".into()));
-        assert_eq!(answer("POST / HTTP/1.1", &h).status, 405);
-        assert_eq!(answer("GET / HTTP/1.1\r\nContent-Length: 99999999999", &h).status, 413);
-        assert_eq!(answer("GET / HTTP/1.1\r\ntransfer-encoding: chunked", &h).status, 413);
-        assert_eq!(answer("GET / HTTP/1.1\r\nContent-Length: 0", &h).status, 200);
+        let handler = echo();
+        let answer = |head: &str| {
+            let (method, request) = parse(head);
+            super::answer(method, &request, &handler)
+        };
+        assert_eq!(answer("GET /a?b HTTP/1.1\r\nHost: x"), Reply::json(200, "{\"target\":\"/a?b\"}".into()));
+        assert_eq!(answer("POST / HTTP/1.1").status, 405);
+        assert_eq!(answer("GET / HTTP/1.1\r\nContent-Length: 99999999999").status, 413);
+        assert_eq!(answer("GET / HTTP/1.1\r\ntransfer-encoding: chunked").status, 413);
+        assert_eq!(answer("GET / HTTP/1.1\r\nContent-Length: 0").status, 200);
     }
 
     #[test]
@@ -398,7 +407,10 @@ mod tests {
 
     #[test]
     fn only_a_get_asking_for_websocket_version_13_upgrades() {
-        let ask = |head: &str| websocket_key(head);
+        let ask = |head: &str| {
+            let (method, request) = parse(head);
+            websocket_key(method, &request).map(str::to_string)
+        };
         let good = "GET / HTTP/1.1\r\nUpgrade: WebSocket\r\nConnection: Upgrade\r\nSec-WebSocket-Version: 13\r\nSec-WebSocket-Key: abc==";
         assert_eq!(ask(good).as_deref(), Some("abc=="));
         assert_eq!(ask(&good.replace("GET", "POST")), None);

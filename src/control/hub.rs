@@ -139,10 +139,13 @@ impl ControlHub {
         let oscquery =
             query_addr.and_then(|a| OscQueryServer::start_with(a, osc_port, surface).map_err(|e| report(Err(e))).ok());
         let web_urls = match (&options.web, &oscquery) {
-            (Some(web), Some(server)) => super::web::urls(server.local_addr(), &web.token),
+            (Some(web), Some(server)) => {
+                let urls = super::web::urls(server.local_addr(), &web.token);
+                announce_surface(&urls, web.read_only, !server.local_addr().ip().is_loopback());
+                urls
+            }
             _ => Vec::new(),
         };
-        announce_surface(&web_urls, options.web.as_ref().is_some_and(|w| w.read_only));
         let midi = if options.midi {
             MidiInput::open(options.midi_filter.as_deref()).map_err(|e| log::info!("{e}")).ok()
         } else {
@@ -339,7 +342,15 @@ impl ControlHub {
             Ok(path) => log::info!("saved preset {}", path.display()),
             Err(e) => self.notice(e),
         }
+        self.rescan_presets();
+    }
+
+    /// Re-reads the preset folder's names, and offers them in the OSCQuery tree.
+    fn rescan_presets(&mut self) {
         self.preset_names = self.presets.names();
+        if let Some(q) = self.oscquery.as_mut() {
+            q.set_presets(&self.preset_names);
+        }
     }
 
     /// Preset names in recall order (1–9 keys, MIDI program numbers).
@@ -392,10 +403,9 @@ impl ControlHub {
             f.send(&changes);
         }
         if self.frame_count.is_multiple_of(PRESET_RESCAN_FRAMES) {
-            self.preset_names = self.presets.names();
+            self.rescan_presets();
         }
         if let Some(q) = self.oscquery.as_mut() {
-            q.set_presets(&self.preset_names);
             q.after_frame(instance, self.frame_count.is_multiple_of(6), &changes);
         }
         self.frame_count += 1;
@@ -436,15 +446,13 @@ impl ControlHub {
 }
 
 /// Tells the performer where the browser surface is: each URL, and a QR code of the first for a
-/// phone's camera when it is open to the network.
-fn announce_surface(urls: &[String], read_only: bool) {
+/// phone's camera when the surface is `networked` (not on loopback).
+fn announce_surface(urls: &[String], read_only: bool, networked: bool) {
     let mode = if read_only { " (read-only)" } else { "" };
     for url in urls {
         log::info!("control surface{mode} on {url}");
     }
-    let Some(first) = urls.first().filter(|u| !u.starts_with("http://127.") && !u.starts_with("http://[::1]")) else {
-        return;
-    };
+    let Some(first) = urls.first().filter(|_| networked) else { return };
     if let Some(code) = super::web::qr::terminal(first) {
         log::info!("scan to open the control surface:\n{code}");
     }

@@ -17,10 +17,10 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use rosc::{OscMessage, OscPacket};
-
-use super::osc::{Intake, OscInlet};
 use serde_json::{Value, json};
 use tungstenite::{Message, WebSocket};
+
+use super::osc::{Intake, OscInlet};
 
 /// Messages a session may have waiting.
 pub const QUEUE: usize = 1024;

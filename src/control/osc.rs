@@ -155,16 +155,14 @@ const RECEIVE_BUFFER_BYTES: usize = 4 << 20;
 pub struct OscReceiver {
     local: SocketAddr,
     queue: Receiver<(Batch, usize)>,
-    /// Bytes of the batches in `queue` (the receiver thread adds, `drain` subtracts).
-    queued_bytes: Arc<AtomicUsize>,
-    counters: Arc<OscCounters>,
     /// Future batches with their bytes.
     scheduled: Vec<(Batch, usize)>,
     /// Bytes of the batches in `scheduled`.
     scheduled_bytes: usize,
     stop: Arc<AtomicBool>,
     thread: Option<JoinHandle<()>>,
-    logged: Arc<Mutex<HashSet<String>>>,
+    /// The sending end of `queue` with its byte count, the counters and the log of problems,
+    /// shared with every transport.
     inlet: OscInlet,
 }
 
@@ -196,24 +194,15 @@ impl OscReceiver {
 
     fn queue_only(local: SocketAddr) -> Self {
         let (tx, queue) = sync_channel(MAX_QUEUED);
-        let queued_bytes = Arc::new(AtomicUsize::new(0));
-        let counters = Arc::new(OscCounters::default());
-        let logged = Arc::new(Mutex::new(HashSet::new()));
-        let inlet = OscInlet {
-            queue: Queue { tx, bytes: queued_bytes.clone() },
-            counters: counters.clone(),
-            logged: logged.clone(),
-        };
+        let inlet =
+            OscInlet { queue: Queue { tx, bytes: Arc::default() }, counters: Arc::default(), logged: Arc::default() };
         Self {
             local,
             queue,
-            queued_bytes,
-            counters,
             scheduled: Vec::new(),
             scheduled_bytes: 0,
             stop: Arc::new(AtomicBool::new(false)),
             thread: None,
-            logged,
             inlet,
         }
     }
@@ -231,7 +220,7 @@ impl OscReceiver {
 
     /// The shared counters.
     pub fn counters(&self) -> &Arc<OscCounters> {
-        &self.counters
+        &self.inlet.counters
     }
 
     /// Every batch that is due at `now`, in arrival order; later ones wait (at most
@@ -239,14 +228,14 @@ impl OscReceiver {
     pub fn drain(&mut self, now: SystemTime) -> Vec<Batch> {
         let horizon = now + MAX_AHEAD;
         for (batch, bytes) in self.queue.try_iter() {
-            self.queued_bytes.fetch_sub(bytes, Ordering::Relaxed);
+            self.inlet.queue.bytes.fetch_sub(bytes, Ordering::Relaxed);
             let too_late = batch.due.is_some_and(|t| t > horizon);
             let full = batch.due.is_some_and(|t| t > now)
                 && (self.scheduled.len() >= MAX_SCHEDULED || self.scheduled_bytes + bytes > MAX_SCHEDULED_BYTES);
             if too_late || full {
-                self.counters.dropped.fetch_add(1, Ordering::Relaxed);
+                self.inlet.counters.dropped.fetch_add(1, Ordering::Relaxed);
                 let why = if too_late { "a time tag more than an hour ahead" } else { "too many future bundles" };
-                log_once(&self.logged, why, &format!("bundle dropped: {why}"));
+                log_once(&self.inlet.logged, why, &format!("bundle dropped: {why}"));
                 continue;
             }
             self.scheduled_bytes += bytes;
@@ -261,12 +250,12 @@ impl OscReceiver {
 
     /// Bytes waiting: queued by the receiver thread and scheduled for later.
     pub fn pending_bytes(&self) -> usize {
-        self.queued_bytes.load(Ordering::Relaxed) + self.scheduled_bytes
+        self.inlet.queue.bytes.load(Ordering::Relaxed) + self.scheduled_bytes
     }
 
     /// Logs `message` the first time its `kind` is seen.
     pub fn log_once(&self, kind: &str, message: &str) {
-        log_once(&self.logged, kind, message);
+        log_once(&self.inlet.logged, kind, message);
     }
 }
 

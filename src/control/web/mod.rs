@@ -81,7 +81,7 @@ impl WebOptions {
 
 /// An HTML reply.
 fn html(status: u16, body: String) -> Reply {
-    Reply { status, content_type: "text/html; charset=utf-8", body: body.into_bytes().into(), headers: Vec::new() }
+    Reply::text(status, "text/html; charset=utf-8", body)
 }
 
 /// A browser asking for a page (not a client asking for the root of the tree as JSON): HTML
