@@ -177,8 +177,8 @@ pub struct RenderArgs {
     /// 422 HQ; .webm: VP9), through ffmpeg, at 1/dt frames per second.
     #[arg(long, value_name = "FILE")]
     pub video: Option<PathBuf>,
-    /// Video codec: h264, h265, prores, vp9, av1, ffv1, or an ffmpeg encoder name (default:
-    /// the container's).
+    /// Video codec: h264, h265, prores, vp9, av1, ffv1, hap, hap_alpha, hap_q (in .mov; clips
+    /// indra and VJ tools play frame-exact), or an ffmpeg encoder name (default: the container's).
     #[arg(long, requires = "video")]
     pub codec: Option<String>,
     /// Video quality: the CRF for h264/h265/vp9/av1 (lower is better; default 18, 20, 30, 30),
@@ -749,6 +749,20 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
             s.transient_bytes_allocated / 1024,
             s.compile_time.as_secs_f64() * 1e6
         );
+    }
+    Ok(())
+}
+
+/// `indra --list-cameras`: the V4L2 devices a `camera` node can name.
+pub fn list_cameras() -> Result<(), String> {
+    let cameras = indra::media::camera::list_cameras();
+    if cameras.is_empty() {
+        println!(
+            "no cameras found (no V4L2 devices under /sys/class/video4linux); `device: \"test\"` plays a test pattern"
+        );
+    }
+    for camera in cameras {
+        println!("{}  {}", camera.device.display(), camera.name);
     }
     Ok(())
 }

@@ -17,6 +17,7 @@ pub mod geometry;
 pub mod gpu;
 pub mod graph;
 pub mod live;
+pub mod media;
 pub mod offscreen;
 pub mod params;
 pub mod scene;

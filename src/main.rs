@@ -25,6 +25,9 @@ struct Cli {
     /// and the scene's own folder; repeatable. `/` opens every file the process can read.
     #[arg(long = "allow-path", value_name = "FOLDER", global = true)]
     allow_paths: Vec<PathBuf>,
+    /// List this machine's cameras (V4L2 devices) for a `camera` node's `device`, and exit.
+    #[arg(long)]
+    list_cameras: bool,
 }
 
 /// Options that pick the GPU.
@@ -69,6 +72,7 @@ fn main() -> ExitCode {
     }
     let gpu = indra::gpu::GpuOptions { backend: cli.gpu.backend, adapter: cli.gpu.adapter };
     let result = match cli.command {
+        _ if cli.list_cameras => commands::list_cameras(),
         None => commands::run(&assets, &gpu, &commands::RunArgs::default()),
         Some(Command::Run(args)) => commands::run(&assets, &gpu, &args),
         Some(Command::Render(args)) => commands::render(&assets, &gpu, &args),

@@ -156,14 +156,8 @@ pub struct NamedBytes {
 /// and checked after opening, so a FIFO or device swapped in after a look-up is still refused.
 pub fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, FileError> {
     let refused = |why: String| FileError::Refused(format!("{}: {why}", path.display()));
-    let file = open_nonblocking(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => FileError::NotFound(format!("{}: no such file", path.display())),
-        _ => refused(e.to_string()),
-    })?;
+    let file = open_regular(path)?;
     let meta = file.metadata().map_err(|e| refused(e.to_string()))?;
-    if !meta.is_file() {
-        return Err(refused("not a regular file (a pipe, device or folder is never read)".into()));
-    }
     if meta.len() > limit {
         return Err(refused(format!("{} bytes, more than the {} allowed", meta.len(), limit)));
     }
@@ -173,6 +167,22 @@ pub fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, FileError> {
         return Err(refused(format!("grew past the {limit} bytes allowed while being read")));
     }
     Ok(bytes)
+}
+
+/// `path` opened for reading if it is a regular file (checked after opening, without blocking:
+/// a FIFO or device swapped in after a look-up is refused). For files read in parts, such as
+/// video clips; [`read_limited`] reads a whole one.
+pub fn open_regular(path: &Path) -> Result<std::fs::File, FileError> {
+    let refused = |why: String| FileError::Refused(format!("{}: {why}", path.display()));
+    let file = open_nonblocking(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => FileError::NotFound(format!("{}: no such file", path.display())),
+        _ => refused(e.to_string()),
+    })?;
+    let meta = file.metadata().map_err(|e| refused(e.to_string()))?;
+    if !meta.is_file() {
+        return Err(refused("not a regular file (a pipe, device or folder is never read)".into()));
+    }
+    Ok(file)
 }
 
 #[cfg(unix)]

@@ -94,6 +94,8 @@ impl Gpu {
         let wanted = wgpu::Features::TIMESTAMP_QUERY
             | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
             | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+            // HAP clips upload their BC blocks as they are (a CPU decode where this is missing).
+            | wgpu::Features::TEXTURE_COMPRESSION_BC
             | wgpu::Features::SHADER_INT64
             | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX;
         let required_features = adapter.features() & wanted;

@@ -11,8 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdin, Command, Stdio};
 use std::thread::JoinHandle;
 
-/// The environment variable that names the `ffmpeg` to run (default: `ffmpeg` on the PATH).
-pub const FFMPEG_ENV: &str = "INDRA_FFMPEG";
+pub use crate::media::ffmpeg::FFMPEG_ENV;
 
 /// What to encode and how.
 #[derive(Clone, Debug)]
@@ -99,6 +98,12 @@ fn codec_args(codec: &str, quality: Option<u32>) -> Result<Vec<String>, VideoErr
             Ok(["-c:v", "prores_ks", "-profile:v", &profile.to_string(), "-pix_fmt", pix].map(String::from).to_vec())
         }
         "ffv1" => Ok(["-c:v", "ffv1", "-level", "3", "-pix_fmt", "bgr0"].map(String::from).to_vec()),
+        // HAP, the VJ codec (every frame a keyframe, decoded on the GPU): indra plays it back
+        // frame-exact, so a scene can be rendered to a clip for a show. Sides must be multiples
+        // of 4 (ffmpeg's encoder refuses others).
+        "hap" | "hap_alpha" | "hap_q" => {
+            Ok(["-c:v", "hap", "-format", codec, "-pix_fmt", "rgba"].map(String::from).to_vec())
+        }
         other => {
             let mut args = vec!["-c:v".into(), other.into(), "-pix_fmt".into(), "yuv420p".into()];
             if let Some(q) = quality {
@@ -203,11 +208,12 @@ impl VideoSettings {
             // The video decides the length; the sound stops with the last frame.
             args.push("-shortest".into());
         }
-        // Pad odd sides (4:2:0 needs even ones) and convert with the BT.709 matrix players assume
-        // for HD, instead of swscale's BT.601 default.
+        // Pad odd sides (4:2:0 needs even ones; HAP's 4×4 blocks, multiples of 4) and convert
+        // with the BT.709 matrix players assume for HD, instead of swscale's BT.601 default.
+        let side = if codec.starts_with("hap") { 4 } else { 2 };
         args.extend([
             "-vf".into(),
-            "pad=ceil(iw/2)*2:ceil(ih/2)*2,scale=out_color_matrix=bt709:out_range=tv".into(),
+            format!("pad=ceil(iw/{side})*{side}:ceil(ih/{side})*{side},scale=out_color_matrix=bt709:out_range=tv"),
             "-colorspace".into(),
             "bt709".into(),
             "-color_primaries".into(),
@@ -225,11 +231,7 @@ impl VideoSettings {
     }
 }
 
-/// `path` as ffmpeg must read it to take it as a file: with the `file:` protocol, so that
-/// `-y.mp4` is no option and `mix:final.wav` no protocol.
-fn ffmpeg_file(path: &Path) -> String {
-    format!("file:{}", path.display())
-}
+use crate::media::ffmpeg::file_arg as ffmpeg_file;
 
 impl VideoWriter {
     /// Starts ffmpeg writing `settings.path` (its folder is created). A missing ffmpeg, or one

@@ -11,14 +11,16 @@
 //! checks that every folder is registered and its shaders are built in).
 
 pub mod blend;
+pub mod camera;
 pub mod cloth;
 pub mod cube_field;
 pub mod fader;
 pub mod grid_fluid;
-pub mod height_image;
+pub mod image;
 pub mod image_pass;
 pub mod kleinian;
 pub mod mesh2d_draw;
+pub mod picture_pass;
 pub mod poisson;
 pub mod polygon_draw;
 pub mod runner;
@@ -26,6 +28,7 @@ pub mod space_colonization;
 pub mod star_glow;
 pub mod tessellation;
 pub mod text_mesh;
+pub mod video;
 pub mod warp;
 
 use crate::assets::{AssetKind, Assets};
@@ -45,11 +48,13 @@ pub const REGISTRY: &[TechniqueInfo] = &[
     text_mesh::INFO,
     grid_fluid::INFO,
     tessellation::INFO,
-    height_image::INFO,
+    image::INFO,
     space_colonization::INFO,
     warp::INFO,
     blend::INFO,
     fader::INFO,
+    video::INFO,
+    camera::INFO,
 ];
 
 /// Finds a technique by the name scenes use.

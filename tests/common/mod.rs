@@ -2,6 +2,8 @@
 //! pixel classification.
 #![allow(dead_code)]
 
+pub mod clips;
+
 use indra::assets::Assets;
 use indra::gpu::{BackendChoice, Gpu, GpuOptions};
 use indra::offscreen::{GoldenCheck, OffscreenRenderer, RenderedFrame};

@@ -12,6 +12,7 @@ mod control;
 mod errors;
 mod graph_gpu;
 mod live;
+mod media;
 mod msaa;
 mod osc;
 mod recovery;

@@ -1,17 +1,19 @@
-//! A PNG (or any image the `image` crate reads) as a texture in the frame graph: the height map
-//! of a tessellated surface, or any node's input. A path that cannot be read is one message, and
-//! the last good image (or a flat black one) stays, so the show goes on; fixing the path (a
-//! `--set`, OSC, a scene edit) loads it.
+//! A still image (PNG, JPEG) as a node: as a picture (sRGB to linear light, alpha premultiplied,
+//! fitted into the node's size like a clip's frame — any node's input), or as data (the values
+//! as stored, at the image's own size — the height map of a tessellated surface). A path that
+//! cannot be read is one message, and the last good image (or a flat black one) stays, so the
+//! show goes on; fixing the path (a `--set`, OSC, a scene edit) loads it. Numbered sequences
+//! play as clips in the `video` node (`frames/shot_%04d.png`).
 //!
 //! Relative paths are looked up beside `scenes/` and `shaders/` (the asset root), then in the
 //! current folder, under the file rules of [`crate::files`]; the bundled height maps are built
 //! into the binary as a fallback. An image is read and decoded off the render thread, and its
 //! size is checked against the device and a memory budget before it is decoded.
 
-use std::io::Cursor;
+#[cfg(test)]
+mod render_tests;
 
 use crate::assets::Assets;
-use image::ImageDecoder;
 
 use crate::files::Loader;
 use crate::gpu::ShaderError;
@@ -19,16 +21,18 @@ use crate::graph::{FrameGraph, PersistentTexture, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, Text};
 use crate::time::FrameTime;
 
+use super::picture_pass::{Fit, PicturePass};
 use super::{NodeSetup, Technique, TechniqueInfo};
+use crate::media::clip::Picture;
 
 /// The registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
-    name: "height_image",
-    chapter: "6: Tessellation & Displacement (height map)",
-    summary: "an image file as a texture (a height map for the tessellated surface)",
+    name: "image",
+    chapter: "media: stills (and ch. 6's height maps)",
+    summary: "a PNG or JPEG: a picture fitted into the image, or its values as data (a height map)",
     params,
     inputs: &[],
-    shaders: &[],
+    shaders: &["picture.wgsl"],
     create,
     check: None,
     stage: None,
@@ -44,11 +48,25 @@ const IMAGE_FILE_LIMIT: u64 = 64 << 20;
 /// The most memory one decoded image may take (RGBA8): 8192 × 8192.
 const DECODED_LIMIT: u64 = 256 << 20;
 
+crate::param_enum! {
+    /// What the image's values are.
+    pub enum Values {
+        /// Colours: sRGB to linear light, alpha premultiplied, fitted into the node's size.
+        Picture = "picture",
+        /// Numbers, as stored, at the image's own size (a height map).
+        Data = "data",
+    }
+}
+
 crate::technique_params! {
     /// What an image node reads each step.
     pub struct Settings {
-        /// image file (PNG); relative to the folder holding scenes/, or the current folder
+        /// image file (PNG, JPEG); relative to the folder holding scenes/, or the current folder
         path: Text = |n, doc| ParamDecl::text(n, "assets/heightmaps/ridges.png", doc),
+        /// colours (a picture) or numbers as stored (data, e.g. heights)
+        values: Values = |n, doc| ParamDecl::choice(n, Values::OPTIONS, 0, doc),
+        /// how a picture of another shape fills the image
+        fit: Fit = |n, doc| ParamDecl::choice(n, Fit::OPTIONS, 0, doc),
     }
 }
 
@@ -58,7 +76,9 @@ pub fn params() -> Vec<ParamDecl> {
 }
 
 /// An image node.
-pub struct HeightImage {
+pub struct Image {
+    /// The image as a picture.
+    picture: PicturePass,
     device: wgpu::Device,
     queue: wgpu::Queue,
     assets: Assets,
@@ -71,22 +91,25 @@ pub struct HeightImage {
 }
 
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
-    Ok(Box::new(HeightImage::new(setup)))
+    Ok(Box::new(Image::new(setup)?))
 }
 
-impl HeightImage {
+impl Image {
     /// A node showing its path's image, read and decoded now (a show prepares clips on a worker
     /// thread, so a triggered clip has its image before its first frame); a 1×1 black image and
     /// a message when it cannot be read. Later paths load in the background.
-    pub fn new(setup: &NodeSetup<'_>) -> Self {
+    pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
         let device = &setup.gpu.device;
         let path = Settings::read(setup.params).path.as_str().trim().to_string();
         let max_side = device.limits().max_texture_dimension_2d;
-        let (image, messages) = match read_image(setup.assets, &path, max_side) {
+        let (image, mut messages) = match read_image(setup.assets, &path, max_side) {
             Ok(image) => (image, Vec::new()),
             Err(e) => (image::RgbaImage::new(1, 1), vec![e]),
         };
-        Self {
+        let mut picture = PicturePass::new(setup, true)?;
+        show(&mut picture, &image, &mut messages);
+        Ok(Self {
+            picture,
             texture: upload(device, &setup.gpu.queue, &image),
             device: device.clone(),
             queue: setup.gpu.queue.clone(),
@@ -94,7 +117,7 @@ impl HeightImage {
             loader: Loader::new(setup.assets.load_wait()),
             requested: Some(path),
             messages,
-        }
+        })
     }
 
     /// The loaded image's size.
@@ -111,36 +134,23 @@ fn read_image(assets: &Assets, name: &str, max_side: u32) -> Result<image::RgbaI
     decode_bounded(&read.bytes, &read.origin, max_side)
 }
 
-/// Decodes `bytes` if the image's header says it fits a texture of at most `max_side` a side and
-/// the memory budget: a tiny file claiming a huge image is refused before it is decoded.
+/// Decodes `bytes` within the device's side and this node's memory budget (see
+/// [`crate::media::still::decode_bounded`]).
 pub fn decode_bounded(bytes: &[u8], name: &str, max_side: u32) -> Result<image::RgbaImage, String> {
-    let failed = |e: image::ImageError| format!("cannot read {name}: {e}");
-    let mut reader = image::ImageReader::new(Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| format!("cannot read {name}: {e}"))?;
-    // A backstop: the checks below refuse first, with a sentence that says why.
-    let mut limits = image::Limits::default();
-    limits.max_alloc = Some(2 * DECODED_LIMIT);
-    reader.limits(limits);
-    let decoder = reader.into_decoder().map_err(failed)?;
-    let (width, height) = decoder.dimensions();
-    if width > max_side || height > max_side {
-        return Err(format!("{name} is {width}×{height} pixels; this GPU takes at most {max_side} on a side"));
+    crate::media::still::decode_bounded(bytes, name, max_side, DECODED_LIMIT)
+}
+
+/// Makes `image` the picture shown.
+fn show(picture: &mut PicturePass, image: &image::RgbaImage, messages: &mut Vec<String>) {
+    let size = (image.width().max(1), image.height().max(1));
+    if let Err(e) = picture.upload(&Picture::Rgba(image.as_raw().clone()), size) {
+        messages.push(e);
     }
-    let decoded_bytes = u64::from(width) * u64::from(height) * 4;
-    if decoded_bytes > DECODED_LIMIT {
-        return Err(format!(
-            "{name} is {width}×{height} pixels ({} MiB decoded), more than the {} MiB an image may take",
-            decoded_bytes >> 20,
-            DECODED_LIMIT >> 20
-        ));
-    }
-    Ok(image::DynamicImage::from_decoder(decoder).map_err(failed)?.to_rgba8())
 }
 
 fn upload(device: &wgpu::Device, queue: &wgpu::Queue, image: &image::RgbaImage) -> PersistentTexture {
     let size = (image.width().max(1), image.height().max(1));
-    let texture = PersistentTexture::new(device, "height_image", size, wgpu::TextureFormat::Rgba8Unorm);
+    let texture = PersistentTexture::new(device, "image", size, wgpu::TextureFormat::Rgba8Unorm);
     queue.write_texture(
         texture.texture.as_image_copy(),
         image.as_raw(),
@@ -150,7 +160,7 @@ fn upload(device: &wgpu::Device, queue: &wgpu::Queue, image: &image::RgbaImage) 
     texture
 }
 
-impl Technique for HeightImage {
+impl Technique for Image {
     fn step(&mut self, params: &ParamSet, _time: &FrameTime) {
         let path = Settings::read(params).path.as_str().trim().to_string();
         if self.requested.as_deref() != Some(path.as_str()) {
@@ -160,7 +170,10 @@ impl Technique for HeightImage {
             self.requested = Some(path);
         }
         match self.loader.poll() {
-            Some((_, Ok(image))) => self.texture = upload(&self.device, &self.queue, &image),
+            Some((_, Ok(image))) => {
+                self.texture = upload(&self.device, &self.queue, &image);
+                show(&mut self.picture, &image, &mut self.messages);
+            }
             Some((_, Err(e))) => self.messages.push(format!("{e}; keeping the last image")),
             None => {}
         }
@@ -173,11 +186,15 @@ impl Technique for HeightImage {
     fn add_passes<'r>(
         &'r mut self,
         graph: &mut FrameGraph<'r>,
-        _params: &ParamSet,
+        params: &ParamSet,
         _time: &FrameTime,
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
-        graph.import_texture("height_image/image", &self.texture)
+        let settings = Settings::read(params);
+        match settings.values {
+            Values::Data => graph.import_texture("image/data", &self.texture),
+            Values::Picture => self.picture.declare(graph, "image", settings.fit),
+        }
     }
 }
 
