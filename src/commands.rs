@@ -240,6 +240,11 @@ pub struct BenchArgs {
     /// the worst frame at a switch against the median frame.
     #[arg(long, value_name = "SECONDS")]
     pub cue_every: Option<f64>,
+    /// Every frame waits for its files and clip frames, as `render` does (default: as live, a
+    /// frame whose clip frame is not decoded yet shows an older one): the frame time then
+    /// includes decoding that does not keep up.
+    #[arg(long)]
+    pub wait_for_media: bool,
 }
 
 fn parse_msaa(text: &str) -> Result<u32, String> {
@@ -653,8 +658,11 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         }
         Some(_) => return Err("--cue-every takes a positive number of seconds and a show with a cue list".into()),
     };
-    // Measured as it plays live: clips prepare on worker threads, files load in the background.
-    let assets = &assets.with_load_wait(indra::files::LoadWait::Background);
+    // Measured as it plays live: clips prepare on worker threads, files load in the background —
+    // or, with --wait-for-media, each frame waiting for its files and clip frames as a render
+    // does, so the wall time includes any decoding that does not keep up.
+    let wait = if args.wait_for_media { indra::files::LoadWait::Finish } else { indra::files::LoadWait::Background };
+    let assets = &assets.with_load_wait(wait);
     let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
     let adapter = device.adapter_label();
     let timestamps = device.has_timestamps();

@@ -253,6 +253,9 @@ fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub
         }
         let header = format!("{} ({})", instance.scene().nodes[node].id, instance.scene().nodes[node].technique.name);
         egui::CollapsingHeader::new(header).default_open(true).show(ui, |ui| {
+            if let Some(status) = instance.status(node) {
+                ui.label(egui::RichText::new(status).small());
+            }
             for (p, decl) in instance.params(node).decls().iter().enumerate() {
                 let animated = instance.is_animated(node, p);
                 let mut value = instance.params(node).target_at(p);

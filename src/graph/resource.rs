@@ -111,6 +111,25 @@ impl PersistentTexture {
     }
 }
 
+impl PersistentTexture {
+    /// A texture only written by the queue and sampled — what block-compressed formats allow
+    /// (a clip's uploaded frame).
+    pub fn sampled(device: &wgpu::Device, label: &str, size: (u32, u32), format: wgpu::TextureFormat) -> Self {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        Self { texture, view, id: next_resource_id() }
+    }
+}
+
 /// Two persistent textures that swap roles each step: one holds the last state (read), the other
 /// receives the next (write).
 pub struct PingPong {

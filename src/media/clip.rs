@@ -152,7 +152,7 @@ impl HapClip {
         if !HAP_CODECS.iter().any(|(code, _)| **code == track.codec) {
             return Ok(None);
         }
-        super::check_size(track.width, track.height, max_side, max_bytes)?;
+        super::check_size("the video", (track.width, track.height), max_side, max_bytes)?;
         if track.samples.is_empty() {
             return Err(format!("{}: the clip has no frames", path.display()));
         }

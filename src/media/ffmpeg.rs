@@ -177,7 +177,7 @@ impl FfmpegClip {
     /// Probes `path` and checks its frames fit `max_side` and `max_bytes`.
     pub fn open(path: &Path, max_side: u32, max_bytes: u64) -> Result<Self, String> {
         let probe = probe(path)?;
-        super::check_size(probe.width, probe.height, max_side, max_bytes)?;
+        super::check_size("the video", (probe.width, probe.height), max_side, max_bytes)?;
         Ok(Self { path: path.to_path_buf(), probe, pipe: None })
     }
 

@@ -18,18 +18,19 @@ pub mod still;
 /// The most memory one decoded frame may take (RGBA8): 8192 × 8192.
 pub const DECODED_LIMIT: u64 = 256 << 20;
 
-/// Refuses a `width` × `height` frame larger than `max_side` on a side or `max_bytes` as RGBA8.
-pub fn check_size(width: u32, height: u32, max_side: u32, max_bytes: u64) -> Result<(), String> {
+/// Refuses a `width` × `height` picture (called `what` in the message: "the video", a file
+/// name) larger than `max_side` on a side or `max_bytes` as RGBA8.
+pub fn check_size(what: &str, (width, height): (u32, u32), max_side: u32, max_bytes: u64) -> Result<(), String> {
     if width == 0 || height == 0 {
-        return Err("the video has no frame size".into());
+        return Err(format!("{what} has no size"));
     }
     if width > max_side || height > max_side {
-        return Err(format!("the video is {width}×{height} pixels; this GPU takes at most {max_side} on a side"));
+        return Err(format!("{what} is {width}×{height} pixels; this GPU takes at most {max_side} on a side"));
     }
     let bytes = u64::from(width) * u64::from(height) * 4;
     if bytes > max_bytes {
         return Err(format!(
-            "the video is {width}×{height} pixels ({} MiB a frame), more than the {} MiB a frame may take",
+            "{what} is {width}×{height} pixels ({} MiB decoded), more than the {} MiB a picture may take",
             bytes >> 20,
             max_bytes >> 20
         ));

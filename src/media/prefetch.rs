@@ -16,6 +16,9 @@ pub const CACHE_BYTES: usize = 256 << 20;
 /// How many frames ahead a clip is decoded at most.
 pub const MAX_AHEAD: usize = 8;
 
+/// How many decode times [`Prefetcher::decode_median_ms`] looks at.
+const DECODE_TIMES_KEPT: usize = 240;
+
 /// A clip decoding on its own thread.
 pub struct Prefetcher {
     shared: Arc<Shared>,
@@ -34,6 +37,10 @@ struct State {
     wanted: Vec<usize>,
     ready: BTreeMap<usize, Arc<Picture>>,
     failed: BTreeMap<usize, String>,
+    /// The frame decoded last, kept when no longer wanted: what a late live frame shows.
+    newest: Option<(usize, Arc<Picture>)>,
+    /// How long the last frames took to decode, seconds (for `indra bench`).
+    decode_seconds: std::collections::VecDeque<f64>,
     quit: bool,
 }
 
@@ -48,11 +55,19 @@ impl Prefetcher {
             .name(format!("clip {label}"))
             .spawn(move || {
                 while let Some(index) = next_job(&worker_shared, random_access) {
+                    let started = std::time::Instant::now();
                     let result = clip.read(index);
+                    let took = started.elapsed().as_secs_f64();
                     let mut state = worker_shared.state.lock().unwrap_or_else(|e| e.into_inner());
+                    if state.decode_seconds.len() == DECODE_TIMES_KEPT {
+                        state.decode_seconds.pop_front();
+                    }
+                    state.decode_seconds.push_back(took);
                     match result {
                         Ok(picture) => {
-                            state.ready.insert(index, Arc::new(picture));
+                            let picture = Arc::new(picture);
+                            state.newest = Some((index, Arc::clone(&picture)));
+                            state.ready.insert(index, picture);
                         }
                         Err(e) => {
                             state.failed.insert(index, e);
@@ -94,6 +109,19 @@ impl Prefetcher {
     pub fn get(&self, index: usize) -> Option<Result<Arc<Picture>, String>> {
         let state = self.shared.state.lock().unwrap_or_else(|e| e.into_inner());
         lookup(&state, index)
+    }
+
+    /// The median time one frame took to decode (read, Snappy or ffmpeg) over the last 240, ms.
+    pub fn decode_median_ms(&self) -> Option<f64> {
+        let state = self.shared.state.lock().unwrap_or_else(|e| e.into_inner());
+        let mut times: Vec<f64> = state.decode_seconds.iter().copied().collect();
+        times.sort_by(f64::total_cmp);
+        times.get(times.len() / 2).map(|s| s * 1000.0)
+    }
+
+    /// The frame decoded last, wanted or not (a late live frame shows it rather than none).
+    pub fn newest(&self) -> Option<(usize, Arc<Picture>)> {
+        self.shared.state.lock().unwrap_or_else(|e| e.into_inner()).newest.clone()
     }
 
     /// Frame `index`, waiting for it (at most `limit`). It must have been asked for.

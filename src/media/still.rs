@@ -17,17 +17,6 @@ pub fn decode_bounded(bytes: &[u8], name: &str, max_side: u32, max_bytes: u64) -
     limits.max_alloc = Some(2 * max_bytes);
     reader.limits(limits);
     let decoder = reader.into_decoder().map_err(failed)?;
-    let (width, height) = decoder.dimensions();
-    if width > max_side || height > max_side {
-        return Err(format!("{name} is {width}×{height} pixels; this GPU takes at most {max_side} on a side"));
-    }
-    let decoded_bytes = u64::from(width) * u64::from(height) * 4;
-    if decoded_bytes > max_bytes {
-        return Err(format!(
-            "{name} is {width}×{height} pixels ({} MiB decoded), more than the {} MiB an image may take",
-            decoded_bytes >> 20,
-            max_bytes >> 20
-        ));
-    }
+    super::check_size(name, decoder.dimensions(), max_side, max_bytes)?;
     Ok(image::DynamicImage::from_decoder(decoder).map_err(failed)?.to_rgba8())
 }

@@ -380,6 +380,11 @@ impl SceneInstance {
         Ok(remap)
     }
 
+    /// Node `node`'s status line for the panel (see [`Technique::status`]).
+    pub fn status(&self, node: usize) -> Option<String> {
+        self.nodes.get(node).and_then(|n| n.status())
+    }
+
     /// Every node's figures for `indra bench`, prefixed by node id.
     pub fn bench_reports(&mut self) -> Vec<String> {
         let ids = self.scene.nodes.iter().map(|n| n.id.as_str());

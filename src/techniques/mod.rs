@@ -223,6 +223,12 @@ pub trait Technique: Send {
         Vec::new()
     }
 
+    /// A line the panel shows under the node's name while it runs (a clip's codec, frame and
+    /// late frames), or `None`.
+    fn status(&self) -> Option<String> {
+        None
+    }
+
     /// Things to tell the performer since the last call (e.g. "the cloth blew up and was reset").
     fn take_messages(&mut self) -> Vec<String> {
         Vec::new()

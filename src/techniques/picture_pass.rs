@@ -8,7 +8,7 @@
 use super::NodeSetup;
 use super::image_pass::{self, ImageKernel, ImagePass};
 use crate::gpu::ShaderError;
-use crate::graph::{FrameGraph, PersistentTexture, TextureHandle, next_resource_id};
+use crate::graph::{FrameGraph, PersistentTexture, TextureHandle};
 use crate::media::clip::Picture;
 use crate::media::hap::{self, BlockFormat, Channels, HapTexture};
 
@@ -121,7 +121,7 @@ struct FrameTextures {
 impl FrameTextures {
     /// Empty textures; BC uploads when `device` has `TEXTURE_COMPRESSION_BC` and `allow_blocks`.
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, allow_blocks: bool) -> Self {
-        let white = sampled_texture(device, "video/white", (1, 1), wgpu::TextureFormat::Rgba8Unorm);
+        let white = PersistentTexture::sampled(device, "video/white", (1, 1), wgpu::TextureFormat::Rgba8Unorm);
         queue.write_texture(
             white.texture.as_image_copy(),
             &[255; 4],
@@ -245,30 +245,9 @@ fn reuse<'a>(
     let fits =
         slot.as_ref().is_some_and(|t| t.texture.format() == format && (t.texture.width(), t.texture.height()) == size);
     if !fits {
-        *slot = Some(sampled_texture(device, "video/frame", size, format));
+        *slot = Some(PersistentTexture::sampled(device, "video/frame", size, format));
     }
     slot.as_ref().expect("made above")
-}
-
-/// A texture that is only written by the queue and sampled (block formats allow nothing else).
-fn sampled_texture(
-    device: &wgpu::Device,
-    label: &str,
-    size: (u32, u32),
-    format: wgpu::TextureFormat,
-) -> PersistentTexture {
-    let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    let view = texture.create_view(&Default::default());
-    PersistentTexture { texture, view, id: next_resource_id() }
 }
 
 #[cfg(test)]

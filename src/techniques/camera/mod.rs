@@ -123,6 +123,14 @@ impl Technique for Camera {
         }
     }
 
+    fn status(&self) -> Option<String> {
+        let (w, h) = self.key.size;
+        Some(match self.shown {
+            0 => format!("{} {w}×{h} · waiting for frames", self.key.device),
+            n => format!("{} {w}×{h} · frame {n}", self.key.device),
+        })
+    }
+
     fn take_messages(&mut self) -> Vec<String> {
         std::mem::take(&mut self.messages)
     }

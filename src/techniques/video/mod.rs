@@ -242,7 +242,15 @@ impl Video {
         };
         let result = match got {
             None => {
+                // Late: the newest frame decoded stands in (if it is not already shown), so a
+                // clip that decodes slower than the show still moves, at its decode rate.
                 self.late += 1;
+                if let Some((index, picture)) = playing.frames.newest()
+                    && playing.shown != Some(index)
+                    && self.picture.upload(&picture, (info.width, info.height)).is_ok()
+                {
+                    playing.shown = Some(index);
+                }
                 return;
             }
             Some(Ok(picture)) => self.picture.upload(&picture, (info.width, info.height)),
@@ -298,6 +306,16 @@ impl Technique for Video {
         }
     }
 
+    fn status(&self) -> Option<String> {
+        let Some(playing) = &self.clip else { return Some("no clip".into()) };
+        let info = playing.frames.info();
+        let frame = playing.shown.map_or("–".to_string(), |f| (f + 1).to_string());
+        Some(format!(
+            "{} {}×{} · frame {frame}/{} · {} late",
+            info.codec, info.width, info.height, info.frames, self.late
+        ))
+    }
+
     fn take_messages(&mut self) -> Vec<String> {
         std::mem::take(&mut self.messages)
     }
@@ -306,8 +324,9 @@ impl Technique for Video {
         let Some(playing) = &self.clip else { return vec!["no clip".into()] };
         let info = playing.frames.info();
         let path = if self.picture.uploads_blocks() { "BC textures" } else { "decoded on the CPU" };
+        let decode = playing.frames.decode_median_ms().map_or("–".into(), |ms| format!("{ms:.2} ms"));
         vec![format!(
-            "{} {}×{} at {:.3} fps, {} frames ({path}); {} live frames late",
+            "{} {}×{} at {:.3} fps, {} frames ({path}); decode median {decode} a frame on its thread; {} live frames late",
             info.codec, info.width, info.height, info.fps, info.frames, self.late
         )]
     }
