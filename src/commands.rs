@@ -467,6 +467,11 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     for _ in 0..args.frames {
         let frame = renderer.render_next().map_err(|e| e.to_string())?;
         sink.write(&frame)?;
+        // What a node tells the performer (a clip that cannot play, a bad image path) is said
+        // once, as the window's overlay says it; the render goes on.
+        for message in renderer.instance_mut().take_messages() {
+            bar.suspend(|| eprintln!("warning: {message}"));
+        }
         bar.inc(1);
     }
     bar.finish_and_clear();

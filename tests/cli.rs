@@ -449,3 +449,34 @@ fn check_and_list_take_shows_and_locate_a_bad_clip() {
     let expected = format!("broken-show.ron:{line}:21: clip 'kleinain'");
     assert!(text(&o).contains(&expected), "expected «{expected}» in:\n{}", text(&o));
 }
+
+#[test]
+fn a_clip_without_ffmpeg_is_one_sentence_and_the_render_goes_on() {
+    let dir = temp_dir("no-ffmpeg");
+    let clip = dir.join("clip.mp4");
+    let made = Command::new("ffmpeg")
+        .args(["-v", "error", "-y", "-f", "lavfi", "-i", "testsrc=size=64x32:rate=25:duration=0.2", "-c:v", "libx264"])
+        .arg(&clip)
+        .output()
+        .expect("ffmpeg runs");
+    assert!(made.status.success());
+    let scene = dir.join("clip.ron");
+    let ron = format!(
+        r#"(name: "clip", size: (64, 32), seed: 1, dt: 0.04,
+            nodes: [(id: "clip", technique: "video", params: {{ "file": "{}" }})], output: "clip")"#,
+        clip.display()
+    );
+    std::fs::write(&scene, ron).unwrap();
+    let out_dir = dir.join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_indra"))
+        .args(["render", scene.to_str().unwrap(), "--frames", "2", "--backend", "vulkan", "--out"])
+        .arg(&out_dir)
+        .env("INDRA_FFPROBE", dir.join("no-such-ffprobe"))
+        .output()
+        .unwrap();
+    let said = text(&o);
+    assert!(o.status.success(), "the render goes on: {said}");
+    assert!(said.contains("no-such-ffprobe was not found") && said.contains("apt-get install ffmpeg"), "{said}");
+    assert_eq!(said.matches("was not found").count(), 1, "said once: {said}");
+    assert_eq!(std::fs::read_dir(&out_dir).unwrap().count(), 2, "both frames written (black)");
+}

@@ -286,6 +286,24 @@ mod tests {
     }
 
     #[test]
+    fn hap_q_alpha_is_two_images_in_one_section() {
+        // Hap Q Alpha (HapM): scaled YCoCg in BC3 and alpha in BC4, in a multiple-image section.
+        let color: Vec<u8> = (0..BlockFormat::Bc3.image_bytes(8, 4)).map(|i| i as u8).collect();
+        let alpha: Vec<u8> = (0..BlockFormat::Bc4.image_bytes(8, 4)).map(|i| 200 - i as u8).collect();
+        let mut images = header(alpha.len(), 0xA1);
+        images.extend(&alpha);
+        let packed = snap::raw::Encoder::new().compress_vec(&color).unwrap();
+        images.extend(header(packed.len(), 0xBF));
+        images.extend(&packed);
+        let mut frame = header(images.len(), MULTIPLE_IMAGES);
+        frame.extend(images);
+        let decoded = decode_frame(&frame, 8, 4).unwrap();
+        assert_eq!((decoded.color.channels, decoded.color.blocks.clone()), (Channels::ScaledYCoCg, color));
+        let a = decoded.alpha.expect("the alpha image");
+        assert_eq!((a.format, a.channels, a.blocks), (BlockFormat::Bc4, Channels::Alpha, alpha));
+    }
+
+    #[test]
     fn a_frame_whose_sizes_lie_is_an_error() {
         // Snappy data claiming 4 GiB for an 8×8 frame: refused before anything is allocated.
         let mut claim = vec![0xff, 0xff, 0xff, 0xff, 0x0f];
