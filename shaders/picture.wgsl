@@ -9,7 +9,8 @@ struct PictureUniforms {
     fit: u32,
     // 1 when src1's red channel is the alpha (HAP Q Alpha)
     separate_alpha: u32,
-    _pad: u32,
+    // 1 when the values are linear already (OpenEXR: HDR kept), 0 sRGB-encoded
+    linear_values: u32,
     // The frame's size in pixels.
     size: vec2<f32>,
     // The frame's share of its texture (block-compressed textures are padded to 4 × 4).
@@ -77,6 +78,9 @@ fn picture(@builtin(global_invocation_id) id: vec3<u32>) {
         alpha = textureSampleLevel(src1, linear_clamp, uv * u.uv_scale, 0.0).r;
     }
     alpha = clamp(alpha, 0.0, 1.0);
-    let linear = srgb_to_linear(clamp(rgb, vec3<f32>(0.0), vec3<f32>(1.0)));
-    textureStore(dst, vec2<i32>(id.xy), vec4<f32>(linear * alpha, alpha));
+    var colour = max(rgb, vec3<f32>(0.0));
+    if u.linear_values == 0u {
+        colour = srgb_to_linear(min(colour, vec3<f32>(1.0)));
+    }
+    textureStore(dst, vec2<i32>(id.xy), vec4<f32>(colour * alpha, alpha));
 }

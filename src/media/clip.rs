@@ -15,8 +15,10 @@ use super::sequence::ImageSequence;
 pub enum Picture {
     /// HAP's texture blocks, for the GPU to sample (or the CPU to decode).
     Hap(HapFrame),
-    /// RGBA8 pixels, straight alpha, top row first.
+    /// RGBA8 pixels, sRGB-encoded, straight alpha, top row first.
     Rgba(Vec<u8>),
+    /// Linear RGBA half floats (bits), straight alpha, top row first (OpenEXR).
+    LinearHalf(Vec<u16>),
 }
 
 impl Picture {
@@ -25,6 +27,7 @@ impl Picture {
         match self {
             Picture::Hap(f) => f.color.blocks.len() + f.alpha.as_ref().map_or(0, |a| a.blocks.len()),
             Picture::Rgba(p) => p.len(),
+            Picture::LinearHalf(p) => p.len() * 2,
         }
     }
 }
@@ -123,7 +126,7 @@ impl Clip {
         match self {
             Clip::Hap(c) => c.read(index).map(Picture::Hap),
             Clip::Ffmpeg(c) => c.read(index).map(Picture::Rgba),
-            Clip::Sequence(s, _) => s.read(index).map(Picture::Rgba),
+            Clip::Sequence(s, _) => s.read(index),
         }
     }
 }

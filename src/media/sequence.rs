@@ -1,11 +1,12 @@
 //! A numbered image sequence as a clip: `shots/take_%04d.png` names every file of that folder
 //! whose name is the prefix, a number and the suffix, in the order of their numbers (gaps are
-//! skipped, not shown black), played at a frame rate the node gives. Frames are read and decoded
+//! skipped, not shown black), played at a frame rate the node gives (PNG, JPEG or OpenEXR). Frames are read and decoded
 //! like stills, each under the file rules and size bounds, and must all be the first one's size.
 
 use std::path::{Path, PathBuf};
 
-use super::still::decode_bounded;
+use super::clip::Picture;
+use super::still::{Still, decode};
 
 /// The largest file one frame may be.
 pub const FRAME_FILE_LIMIT: u64 = 256 << 20;
@@ -53,10 +54,13 @@ impl ImageSequence {
         let frames: Vec<PathBuf> = numbered.into_iter().map(|(_, p)| p).collect();
         let first = frames.first().ok_or_else(|| format!("no files match {pattern} in {}", folder.display()))?;
         let mut sequence = Self { frames: frames.clone(), width: 0, height: 0, alpha: false, max_side, max_bytes };
-        let image = sequence.decode(first)?;
-        sequence.width = image.width();
-        sequence.height = image.height();
-        sequence.alpha = image.pixels().any(|p| p[3] < 255);
+        let first = sequence.decode(first)?;
+        (sequence.width, sequence.height) = first.size;
+        sequence.alpha = match &first.picture {
+            Picture::Rgba(p) => p.chunks_exact(4).any(|p| p[3] < 255),
+            Picture::LinearHalf(p) => p.chunks_exact(4).any(|p| half::f16::from_bits(p[3]).to_f32() < 1.0),
+            Picture::Hap(_) => false,
+        };
         Ok(sequence)
     }
 
@@ -80,27 +84,21 @@ impl ImageSequence {
         self.alpha
     }
 
-    fn decode(&self, path: &Path) -> Result<image::RgbaImage, String> {
+    fn decode(&self, path: &Path) -> Result<Still, String> {
         let bytes = crate::files::read_limited(path, FRAME_FILE_LIMIT).map_err(|e| e.to_string())?;
         let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
-        decode_bounded(&bytes, &name, self.max_side, self.max_bytes)
+        decode(&bytes, &name, self.max_side, self.max_bytes)
     }
 
-    /// Frame `index`'s RGBA pixels.
-    pub fn read(&self, index: usize) -> Result<Vec<u8>, String> {
+    /// Frame `index`'s pixels.
+    pub fn read(&self, index: usize) -> Result<Picture, String> {
         let path = self.frames.get(index).ok_or_else(|| format!("the sequence has no frame {index}"))?;
-        let image = self.decode(path)?;
-        if (image.width(), image.height()) != (self.width, self.height) {
-            return Err(format!(
-                "{} is {}×{}, not the sequence's {}×{}",
-                path.display(),
-                image.width(),
-                image.height(),
-                self.width,
-                self.height
-            ));
+        let still = self.decode(path)?;
+        if still.size != (self.width, self.height) {
+            let (w, h) = still.size;
+            return Err(format!("{} is {w}×{h}, not the sequence's {}×{}", path.display(), self.width, self.height));
         }
-        Ok(image.into_raw())
+        Ok(still.picture)
     }
 }
 

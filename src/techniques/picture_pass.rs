@@ -34,8 +34,8 @@ pub struct PictureUniforms {
     pub fit: u32,
     /// 1 when the second texture holds the alpha.
     pub separate_alpha: u32,
-    /// Padding.
-    pub pad: u32,
+    /// 0 sRGB-encoded (to be linearised, within 0–1), 1 linear already (OpenEXR, HDR kept).
+    pub linear_values: u32,
     /// The picture's size in pixels.
     pub size: [f32; 2],
     /// The picture's share of its texture.
@@ -82,7 +82,7 @@ impl PicturePass {
             channels: layout.channels,
             fit: fit.index(),
             separate_alpha: u32::from(layout.separate_alpha),
-            pad: 0,
+            linear_values: u32::from(layout.linear),
             size: [layout.size.0 as f32, layout.size.1 as f32],
             uv_scale: layout.uv_scale,
         };
@@ -105,6 +105,8 @@ struct Layout {
     pub size: (u32, u32),
     /// The picture's share of its texture (BC textures are padded to whole blocks).
     pub uv_scale: [f32; 2],
+    /// Whether the values are linear already.
+    pub linear: bool,
 }
 
 /// The textures a video node samples.
@@ -156,7 +158,14 @@ impl FrameTextures {
         match picture {
             Picture::Rgba(pixels) => {
                 write_pixels(device, queue, &mut self.color, wgpu::TextureFormat::Rgba8Unorm, size, pixels)?;
-                self.layout = Some(Layout { channels: 1, separate_alpha: false, size, uv_scale: [1.0, 1.0] });
+                self.layout =
+                    Some(Layout { channels: 1, separate_alpha: false, size, uv_scale: [1.0, 1.0], linear: false });
+            }
+            Picture::LinearHalf(texels) => {
+                let bytes: &[u8] = bytemuck::cast_slice(texels);
+                write_pixels(device, queue, &mut self.color, wgpu::TextureFormat::Rgba16Float, size, bytes)?;
+                self.layout =
+                    Some(Layout { channels: 1, separate_alpha: false, size, uv_scale: [1.0, 1.0], linear: true });
             }
             Picture::Hap(frame) => {
                 let uv_scale = self.write_hap(device, queue, &frame.color, size, false)?;
@@ -170,7 +179,7 @@ impl FrameTextures {
                     Channels::Alpha => 3,
                 };
                 let separate_alpha = frame.alpha.is_some();
-                self.layout = Some(Layout { channels, separate_alpha, size: (w, h), uv_scale });
+                self.layout = Some(Layout { channels, separate_alpha, size: (w, h), uv_scale, linear: false });
             }
         }
         Ok(())
@@ -213,7 +222,7 @@ impl FrameTextures {
     }
 }
 
-/// Writes 4-byte pixels into `slot` (made or remade at `size` and `format`).
+/// Writes pixels (of `format`'s texel size) into `slot` (made or remade at `size` and `format`).
 fn write_pixels(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -222,14 +231,15 @@ fn write_pixels(
     size: (u32, u32),
     pixels: &[u8],
 ) -> Result<(), String> {
-    if pixels.len() != size.0 as usize * size.1 as usize * 4 {
+    let texel = format.block_copy_size(None).unwrap_or(4);
+    if pixels.len() != size.0 as usize * size.1 as usize * texel as usize {
         return Err(format!("a frame of {} bytes does not fit {}×{}", pixels.len(), size.0, size.1));
     }
     let target = reuse(device, slot, format, size);
     queue.write_texture(
         target.texture.as_image_copy(),
         pixels,
-        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * size.0), rows_per_image: Some(size.1) },
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(texel * size.0), rows_per_image: Some(size.1) },
         target.texture.size(),
     );
     Ok(())

@@ -103,6 +103,7 @@ fn frames_are_exact_by_index_through_hap_and_ffmpeg_in_any_order() {
             let rgba: Vec<u8> = match &picture {
                 Picture::Rgba(p) => p.clone(),
                 Picture::Hap(_) => cpu_rgba(&picture, COUNTER_SIZE).into_iter().flatten().collect(),
+                Picture::LinearHalf(_) => panic!("a movie decodes to 8-bit RGBA"),
             };
             assert_eq!(read_counter(&rgba, 8), index, "{} frame {index}", path.display());
         }

@@ -24,6 +24,7 @@ use crate::time::FrameTime;
 use super::picture_pass::{Fit, PicturePass};
 use super::{NodeSetup, Technique, TechniqueInfo};
 use crate::media::clip::Picture;
+use crate::media::still::Still;
 
 /// The registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -83,7 +84,7 @@ pub struct Image {
     queue: wgpu::Queue,
     assets: Assets,
     /// Images being read and decoded off the render thread.
-    loader: Loader<image::RgbaImage>,
+    loader: Loader<Still>,
     /// The path last asked for (loaded or not), so a bad path is reported once.
     requested: Option<String>,
     texture: PersistentTexture,
@@ -104,7 +105,7 @@ impl Image {
         let max_side = device.limits().max_texture_dimension_2d;
         let (image, mut messages) = match read_image(setup.assets, &path, max_side) {
             Ok(image) => (image, Vec::new()),
-            Err(e) => (image::RgbaImage::new(1, 1), vec![e]),
+            Err(e) => (Still { size: (1, 1), picture: Picture::Rgba(vec![0; 4]) }, vec![e]),
         };
         let mut picture = PicturePass::new(setup, true)?;
         show(&mut picture, &image, &mut messages);
@@ -126,35 +127,45 @@ impl Image {
     }
 }
 
-/// Reads image `name` as RGBA8 under the file rules, or says why not. The bundled height maps
-/// answer for their paths when no file is there.
-fn read_image(assets: &Assets, name: &str, max_side: u32) -> Result<image::RgbaImage, String> {
+/// Reads image `name` under the file rules, or says why not. The bundled height maps answer
+/// for their paths when no file is there.
+fn read_image(assets: &Assets, name: &str, max_side: u32) -> Result<Still, String> {
     let bundled = BUNDLED.iter().find(|(bundled, _)| *bundled == name).map(|(_, bytes)| *bytes);
     let read = assets.read_file(name, IMAGE_FILE_LIMIT, bundled).map_err(|e| format!("cannot read image: {e}"))?;
     decode_bounded(&read.bytes, &read.origin, max_side)
 }
 
 /// Decodes `bytes` within the device's side and this node's memory budget (see
-/// [`crate::media::still::decode_bounded`]).
-pub fn decode_bounded(bytes: &[u8], name: &str, max_side: u32) -> Result<image::RgbaImage, String> {
-    crate::media::still::decode_bounded(bytes, name, max_side, DECODED_LIMIT)
+/// [`crate::media::still::decode`]).
+pub fn decode_bounded(bytes: &[u8], name: &str, max_side: u32) -> Result<Still, String> {
+    crate::media::still::decode(bytes, name, max_side, DECODED_LIMIT)
 }
 
 /// Makes `image` the picture shown.
-fn show(picture: &mut PicturePass, image: &image::RgbaImage, messages: &mut Vec<String>) {
-    let size = (image.width().max(1), image.height().max(1));
-    if let Err(e) = picture.upload(&Picture::Rgba(image.as_raw().clone()), size) {
+fn show(picture: &mut PicturePass, image: &Still, messages: &mut Vec<String>) {
+    if let Err(e) = picture.upload(&image.picture, image.size) {
         messages.push(e);
     }
 }
 
-fn upload(device: &wgpu::Device, queue: &wgpu::Queue, image: &image::RgbaImage) -> PersistentTexture {
-    let size = (image.width().max(1), image.height().max(1));
-    let texture = PersistentTexture::new(device, "image", size, wgpu::TextureFormat::Rgba8Unorm);
+/// The image's values as stored, for data: RGBA8, or half floats for OpenEXR (heights above 1
+/// stay above 1).
+fn upload(device: &wgpu::Device, queue: &wgpu::Queue, image: &Still) -> PersistentTexture {
+    let mut size = image.size;
+    let (format, bytes, texel): (_, &[u8], u32) = match &image.picture {
+        Picture::LinearHalf(texels) => (wgpu::TextureFormat::Rgba16Float, bytemuck::cast_slice(texels), 8),
+        Picture::Rgba(pixels) => (wgpu::TextureFormat::Rgba8Unorm, pixels, 4),
+        // A still is never HAP (`still::decode` makes the other two): black, not a panic.
+        Picture::Hap(_) => {
+            size = (1, 1);
+            (wgpu::TextureFormat::Rgba8Unorm, &[0u8; 4][..], 4)
+        }
+    };
+    let texture = PersistentTexture::new(device, "image", size, format);
     queue.write_texture(
         texture.texture.as_image_copy(),
-        image.as_raw(),
-        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * size.0), rows_per_image: Some(size.1) },
+        bytes,
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(texel * size.0), rows_per_image: Some(size.1) },
         wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
     );
     texture
@@ -239,6 +250,6 @@ mod tests {
         let e = decode_bounded(b"not an image", "junk.png", 16384).unwrap_err();
         assert!(e.contains("junk.png"), "{e}");
         let bundled = decode_bounded(BUNDLED[0].1, "ridges.png", 16384).unwrap();
-        assert!(bundled.width() > 1, "a real image still decodes");
+        assert!(bundled.size.0 > 1, "a real image still decodes");
     }
 }

@@ -31,4 +31,14 @@ fn a_still_is_a_fitted_linear_picture_or_its_stored_values() {
     let data = render(&scene("data"));
     let value = data.rgba[((16 + 8) * 4) as usize]; // row 1, column 8
     assert!(value.abs_diff(188) <= 2, "data is not colour-converted: {value}");
+
+    // OpenEXR is linear already: 0.25 stays 0.25 (sRGB ≈ 137), not decoded again as sRGB (≈ 64).
+    let exr = dir.join("quarter.exr");
+    image::DynamicImage::ImageRgba32F(image::Rgba32FImage::from_pixel(8, 4, image::Rgba([0.25, 0.25, 0.25, 1.0])))
+        .save(&exr)
+        .unwrap();
+    let ron = scene("picture").replace(path.to_str().unwrap(), exr.to_str().unwrap());
+    let picture = render(&ron);
+    let centre = picture.rgba[((8 * 16 + 8) * 4) as usize];
+    assert!(centre.abs_diff(137) <= 2, "EXR values are linear: {centre}");
 }
