@@ -93,11 +93,12 @@ impl Prefetcher {
 
     /// Asks for `frames`, most urgent first; frames not among them are let go.
     pub fn want(&self, frames: &[usize]) {
+        let wanted: Vec<usize> = frames.iter().copied().filter(|&f| f < self.info.frames).collect();
         let mut state = self.shared.state.lock().unwrap_or_else(|e| e.into_inner());
-        if state.wanted == frames {
+        if state.wanted == wanted {
             return;
         }
-        state.wanted = frames.iter().copied().filter(|&f| f < self.info.frames).collect();
+        state.wanted = wanted;
         let State { wanted, ready, failed, .. } = &mut *state;
         ready.retain(|f, _| wanted.contains(f));
         failed.retain(|f, _| wanted.contains(f));

@@ -52,9 +52,11 @@ impl ImageSequence {
             .collect();
         numbered.sort();
         let frames: Vec<PathBuf> = numbered.into_iter().map(|(_, p)| p).collect();
-        let first = frames.first().ok_or_else(|| format!("no files match {pattern} in {}", folder.display()))?;
-        let mut sequence = Self { frames: frames.clone(), width: 0, height: 0, alpha: false, max_side, max_bytes };
-        let first = sequence.decode(first)?;
+        if frames.is_empty() {
+            return Err(format!("no files match {pattern} in {}", folder.display()));
+        }
+        let mut sequence = Self { frames, width: 0, height: 0, alpha: false, max_side, max_bytes };
+        let first = sequence.decode(&sequence.frames[0])?;
         (sequence.width, sequence.height) = first.size;
         sequence.alpha = match &first.picture {
             Picture::Rgba(p) => p.chunks_exact(4).any(|p| p[3] < 255),

@@ -68,6 +68,12 @@ impl PicturePass {
         self.textures.uploads_blocks()
     }
 
+    /// The picture's texture as uploaded: its values as stored, at its own size (what an
+    /// image node shows as data). `None` before any picture came.
+    pub fn uploaded(&self) -> Option<&PersistentTexture> {
+        self.textures.color.as_ref()
+    }
+
     /// Makes `picture` (of `size` pixels) the one shown.
     pub fn upload(&mut self, picture: &Picture, size: (u32, u32)) -> Result<(), String> {
         self.textures.upload(&self.device, &self.queue, picture, size)

@@ -17,10 +17,11 @@ use crate::assets::Assets;
 
 use crate::files::Loader;
 use crate::gpu::ShaderError;
-use crate::graph::{FrameGraph, PersistentTexture, TextureHandle};
+use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, Text};
 use crate::time::FrameTime;
 
+use super::image_pass;
 use super::picture_pass::{Fit, PicturePass};
 use super::{NodeSetup, Technique, TechniqueInfo};
 use crate::media::clip::Picture;
@@ -45,9 +46,6 @@ const BUNDLED: &[(&str, &[u8])] =
 
 /// The largest image file read.
 const IMAGE_FILE_LIMIT: u64 = 64 << 20;
-
-/// The most memory one decoded image may take (RGBA8): 8192 × 8192.
-const DECODED_LIMIT: u64 = 256 << 20;
 
 crate::param_enum! {
     /// What the image's values are.
@@ -81,13 +79,11 @@ pub struct Image {
     /// The image as a picture.
     picture: PicturePass,
     device: wgpu::Device,
-    queue: wgpu::Queue,
     assets: Assets,
     /// Images being read and decoded off the render thread.
     loader: Loader<Still>,
     /// The path last asked for (loaded or not), so a bad path is reported once.
     requested: Option<String>,
-    texture: PersistentTexture,
     messages: Vec<String>,
 }
 
@@ -111,19 +107,12 @@ impl Image {
         show(&mut picture, &image, &mut messages);
         Ok(Self {
             picture,
-            texture: upload(device, &setup.gpu.queue, &image),
             device: device.clone(),
-            queue: setup.gpu.queue.clone(),
             assets: setup.assets.clone(),
             loader: Loader::new(setup.assets.load_wait()),
             requested: Some(path),
             messages,
         })
-    }
-
-    /// The loaded image's size.
-    pub fn size(&self) -> (u32, u32) {
-        (self.texture.texture.width(), self.texture.texture.height())
     }
 }
 
@@ -138,7 +127,7 @@ fn read_image(assets: &Assets, name: &str, max_side: u32) -> Result<Still, Strin
 /// Decodes `bytes` within the device's side and this node's memory budget (see
 /// [`crate::media::still::decode`]).
 pub fn decode_bounded(bytes: &[u8], name: &str, max_side: u32) -> Result<Still, String> {
-    crate::media::still::decode(bytes, name, max_side, DECODED_LIMIT)
+    crate::media::still::decode(bytes, name, max_side, crate::media::DECODED_LIMIT)
 }
 
 /// Makes `image` the picture shown.
@@ -146,29 +135,6 @@ fn show(picture: &mut PicturePass, image: &Still, messages: &mut Vec<String>) {
     if let Err(e) = picture.upload(&image.picture, image.size) {
         messages.push(e);
     }
-}
-
-/// The image's values as stored, for data: RGBA8, or half floats for OpenEXR (heights above 1
-/// stay above 1).
-fn upload(device: &wgpu::Device, queue: &wgpu::Queue, image: &Still) -> PersistentTexture {
-    let mut size = image.size;
-    let (format, bytes, texel): (_, &[u8], u32) = match &image.picture {
-        Picture::LinearHalf(texels) => (wgpu::TextureFormat::Rgba16Float, bytemuck::cast_slice(texels), 8),
-        Picture::Rgba(pixels) => (wgpu::TextureFormat::Rgba8Unorm, pixels, 4),
-        // A still is never HAP (`still::decode` makes the other two): black, not a panic.
-        Picture::Hap(_) => {
-            size = (1, 1);
-            (wgpu::TextureFormat::Rgba8Unorm, &[0u8; 4][..], 4)
-        }
-    };
-    let texture = PersistentTexture::new(device, "image", size, format);
-    queue.write_texture(
-        texture.texture.as_image_copy(),
-        bytes,
-        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(texel * size.0), rows_per_image: Some(size.1) },
-        wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
-    );
-    texture
 }
 
 impl Technique for Image {
@@ -181,10 +147,7 @@ impl Technique for Image {
             self.requested = Some(path);
         }
         match self.loader.poll() {
-            Some((_, Ok(image))) => {
-                self.texture = upload(&self.device, &self.queue, &image);
-                show(&mut self.picture, &image, &mut self.messages);
-            }
+            Some((_, Ok(image))) => show(&mut self.picture, &image, &mut self.messages),
             Some((_, Err(e))) => self.messages.push(format!("{e}; keeping the last image")),
             None => {}
         }
@@ -203,7 +166,12 @@ impl Technique for Image {
     ) -> TextureHandle {
         let settings = Settings::read(params);
         match settings.values {
-            Values::Data => graph.import_texture("image/data", &self.texture),
+            // The picture's upload is the values as stored, at the image's own size: RGBA8, or
+            // half floats for OpenEXR (heights above 1 stay above 1).
+            Values::Data => match self.picture.uploaded() {
+                Some(texture) => graph.import_texture("image/data", texture),
+                None => image_pass::black(graph),
+            },
             Values::Picture => self.picture.declare(graph, "image", settings.fit),
         }
     }

@@ -228,10 +228,11 @@ impl Video {
     /// Makes the current frame the textures' (waiting for it in off-screen renders).
     fn take_up_frame(&mut self, settings: &Settings, dt: f64) {
         let Some(playing) = &mut self.clip else { return };
-        let info = playing.frames.info().clone();
+        let info = playing.frames.info();
+        let (size, fps, frames) = ((info.width, info.height), info.fps, info.frames);
         let play = settings.play();
-        let current = playing.head.frame(&play, info.fps, info.frames);
-        let upcoming = playing.head.upcoming(&play, dt, info.fps, info.frames, playing.frames.ahead());
+        let current = playing.head.frame(&play, fps, frames);
+        let upcoming = playing.head.upcoming(&play, dt, fps, frames, playing.frames.ahead());
         playing.frames.want(&upcoming);
         if playing.shown == Some(current) {
             return;
@@ -247,13 +248,13 @@ impl Video {
                 self.late += 1;
                 if let Some((index, picture)) = playing.frames.newest()
                     && playing.shown != Some(index)
-                    && self.picture.upload(&picture, (info.width, info.height)).is_ok()
+                    && self.picture.upload(&picture, size).is_ok()
                 {
                     playing.shown = Some(index);
                 }
                 return;
             }
-            Some(Ok(picture)) => self.picture.upload(&picture, (info.width, info.height)),
+            Some(Ok(picture)) => self.picture.upload(&picture, size),
             Some(Err(e)) => Err(e),
         };
         playing.shown = Some(current);
