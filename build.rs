@@ -1,4 +1,4 @@
-//! Embeds every file of `shaders/`, `scenes/` and `shows/`, and every technique's own shaders
+//! Embeds every file of `shaders/` (the ISF shaders of `shaders/isf/` too), `scenes/` and `shows/`, and every technique's own shaders
 //! (`src/techniques/<name>/*.wgsl`), into the binary as a fallback, so that adding a technique
 //! means adding files, not editing a list of `include_str!`s. Shaders are known by file name:
 //! two with one name would be ambiguous, and stop the build.
@@ -55,6 +55,11 @@ fn main() {
         ("SHADERS", "`shaders/*.wgsl` and `src/techniques/*/*.wgsl`", shaders),
         ("SCENES", "`scenes/*.ron`", files(manifest, "scenes", "ron")),
         ("SHOWS", "`shows/*.ron`", files(manifest, "shows", "ron")),
+        (
+            "ISF",
+            "`shaders/isf/*.fs` and `*.vs`",
+            [files(manifest, "shaders/isf", "fs"), files(manifest, "shaders/isf", "vs")].concat(),
+        ),
     ] {
         code.push_str(&format!("/// Every {what} at build time: (file name, path in the source tree, contents).\n"));
         code.push_str(&format!("pub const {konst}: &[(&str, &str, &str)] = &[\n"));

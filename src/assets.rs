@@ -203,11 +203,12 @@ impl Assets {
         self.root.as_ref().map(|r| r.join(path))
     }
 
-    /// The folders a live show watches for edits: `shaders/`, `scenes/`, `shows/`, and under a
+    /// The folders a live show watches for edits: `shaders/` (and `shaders/isf/`), `scenes/`, `shows/`, and under a
     /// source checkout each technique folder that holds shaders. Only those that exist.
     pub fn watched_dirs(&self) -> Vec<PathBuf> {
         let kinds = [AssetKind::Shader, AssetKind::Scene, AssetKind::Show];
         let mut dirs: Vec<PathBuf> = kinds.iter().filter_map(|k| self.dir(*k)).collect();
+        dirs.extend(self.dir(AssetKind::Shader).map(|d| d.join("isf")));
         for (_, path, _) in AssetKind::Shader.embedded() {
             if let Some(dir) = self.in_root(path).and_then(|p| p.parent().map(Path::to_path_buf))
                 && !dirs.contains(&dir)
@@ -234,6 +235,12 @@ impl Assets {
         names.dedup();
         names
     }
+}
+
+/// The ISF shaders built into the binary (`shaders/isf/*.fs` and `*.vs`): (path in the source
+/// tree, text) — what an `isf` node falls back to when the file is not on disk.
+pub fn bundled_isf() -> impl Iterator<Item = (&'static str, &'static str)> {
+    embedded::ISF.iter().map(|(_, path, text)| (*path, *text))
 }
 
 fn with_ext(name: &str, kind: AssetKind) -> String {

@@ -512,13 +512,22 @@ impl FrameSink {
 /// Validates scenes and shaders; prints every located error.
 pub fn check(assets: &Assets, files: &[PathBuf]) -> Result<(), String> {
     let mut targets: Vec<(AssetKind, String)> = Vec::new();
+    // ISF shaders (.fs, with a .vs beside them) are checked as the isf node compiles them.
+    let mut isf_files: Vec<String> = Vec::new();
+    // A file named on the command line may be anywhere.
+    let assets = &if files.is_empty() { assets.clone() } else { assets.allowing("/") };
     if files.is_empty() {
         targets.extend(assets.names(AssetKind::Shader).into_iter().map(|n| (AssetKind::Shader, n)));
         targets.extend(assets.names(AssetKind::Scene).into_iter().map(|n| (AssetKind::Scene, n)));
         targets.extend(assets.names(AssetKind::Show).into_iter().map(|n| (AssetKind::Show, format!("shows/{n}"))));
+        isf_files.extend(indra::techniques::isf::shader_names(assets));
     } else {
         for f in files {
             let name = f.display().to_string();
+            if f.extension().is_some_and(|e| e == "fs") {
+                isf_files.push(name);
+                continue;
+            }
             let kind = if f.extension().is_some_and(|e| e == "wgsl") {
                 AssetKind::Shader
             } else if indra::scene::names_a_show(&name) {
@@ -550,7 +559,17 @@ pub fn check(assets: &Assets, files: &[PathBuf]) -> Result<(), String> {
             }
         }
     }
-    say!("{} checked, {failures} with errors", targets.len());
+    for name in &isf_files {
+        match indra::techniques::isf::IsfFiles::read(assets, name).and_then(|f| f.compile().map_err(|e| e.to_string()))
+        {
+            Ok(_) => say!("ok     {name}"),
+            Err(e) => {
+                failures += 1;
+                say!("error  {e}");
+            }
+        }
+    }
+    say!("{} checked, {failures} with errors", targets.len() + isf_files.len());
     if failures > 0 { Err(format!("{failures} file(s) have errors")) } else { Ok(()) }
 }
 
@@ -592,6 +611,13 @@ pub fn list(assets: &Assets) -> Result<(), String> {
                 }
                 say!();
             }
+        }
+    }
+    say!("ISF shaders (technique \"isf\", params: {{ \"file\": PATH }}; each parameter at /indra/<node>/<name>):");
+    for name in indra::techniques::isf::shader_names(assets) {
+        match indra::techniques::isf::describe(assets, &name) {
+            Ok(line) => say!("  {name} — {line}"),
+            Err(e) => say!("  {name}: INVALID {e}"),
         }
     }
     Ok(())

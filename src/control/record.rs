@@ -141,6 +141,7 @@ fn to_recorded(event: &ControlEvent, scene: &Scene) -> Option<ControlEvent<Named
         ControlEvent::Tempo { bpm, resync } => ControlEvent::Tempo { bpm: *bpm, resync: *resync },
         ControlEvent::Phase { phase, quantum } => ControlEvent::Phase { phase: *phase, quantum: *quantum },
         ControlEvent::Show(command) => ControlEvent::Show(*command),
+        ControlEvent::Audio(snapshot) => ControlEvent::Audio(snapshot.clone()),
     })
 }
 
@@ -219,6 +220,13 @@ fn from_recorded(event: &ControlEvent<Named>, scene: &Scene) -> Result<ControlEv
         }
         // Numbers past the show's layers, clips or cues are refused where the show applies them.
         ControlEvent::Show(command) => ControlEvent::Show(*command),
+        ControlEvent::Audio(snapshot) => {
+            let fits = |v: &[f32]| v.len() <= 4096 && v.iter().all(|x| x.is_finite());
+            if !(fits(&snapshot.wave) && fits(&snapshot.spectrum)) {
+                return Err("an audio snapshot must have at most 4096 finite values of each kind".into());
+            }
+            ControlEvent::Audio(snapshot.clone())
+        }
     })
 }
 

@@ -35,9 +35,20 @@ pub fn validate_wgsl(origin: &str, source: &str) -> Result<naga::Module, ShaderE
         }
         ShaderError { origin: origin.to_string(), line, column, message }
     })?;
+    validate_module(origin, source, &module)?;
+    Ok(module)
+}
+
+/// Validates a parsed module (WGSL or GLSL), an error located in `source` by the narrowest span
+/// naga gives and its cause chain joined into one line.
+pub fn validate_module(
+    origin: &str,
+    source: &str,
+    module: &naga::Module,
+) -> Result<naga::valid::ModuleInfo, ShaderError> {
     let mut validator =
         naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
-    validator.validate(&module).map_err(|e| {
+    validator.validate(module).map_err(|e| {
         // Spans go from the whole function down to the faulty expression: report the narrowest.
         let (line, column) = e
             .spans()
@@ -55,8 +66,7 @@ pub fn validate_wgsl(origin: &str, source: &str) -> Result<naga::Module, ShaderE
             cause = c.source();
         }
         ShaderError { origin: origin.to_string(), line, column, message }
-    })?;
-    Ok(module)
+    })
 }
 
 /// Validates `source` and creates the wgpu shader module inside a validation error scope; the

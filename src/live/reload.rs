@@ -9,7 +9,7 @@ use crate::assets::{Asset, AssetKind, Assets};
 use crate::gpu::{Gpu, JoinedSource};
 use crate::params::Remap;
 use crate::scene::show::parse_show;
-use crate::scene::{Player, SceneInstance, parse_scene};
+use crate::scene::{Player, SceneInstance, load_scene, parse_scene_with};
 
 /// What one poll did.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -114,6 +114,7 @@ impl LiveReload {
             let result = match path.extension().and_then(|e| e.to_str()) {
                 Some("wgsl") => self.reload_shader(path, instance, gpu, size),
                 Some("ron") => self.reload_scene(path, instance, gpu, size, &mut report),
+                Some("fs" | "vs") => self.reload_declared(path, instance, gpu, size, &mut report),
                 _ => continue,
             };
             match result {
@@ -171,6 +172,41 @@ impl LiveReload {
         Ok(used)
     }
 
+    /// For a file nodes declare their parameters from (an ISF shader, `.fs` or its `.vs`):
+    /// Ok(true) if nodes read it and the scene was loaded again with them rebuilt — its inputs
+    /// may have changed, so the scene's parameters are declared anew; an error keeps the last
+    /// good version running.
+    fn reload_declared(
+        &self,
+        path: &Path,
+        instance: &mut SceneInstance,
+        gpu: &Gpu,
+        size: (u32, u32),
+        report: &mut ReloadReport,
+    ) -> Result<bool, String> {
+        let shader = path.with_extension("fs").canonicalize().ok();
+        let reads_it = |n: &crate::scene::SceneNode| {
+            n.technique.declare.is_some_and(|d| {
+                let file = n.params.index(d.file_param).map(|i| n.params.value_at(i));
+                let Some(crate::params::ParamValue::Text(file)) = file else { return false };
+                let located = self.running.locate_file(file.as_str()).ok().and_then(|p| p.canonicalize().ok());
+                located.is_some() && located == shader
+            })
+        };
+        if !instance.scene().nodes.iter().any(reads_it) {
+            return Ok(false);
+        }
+        let origin = instance.scene().origin.clone();
+        // A built-in scene reloads by its name; one from disk (or a bare .fs) by its path.
+        let name = origin.strip_prefix("<embedded>/scenes/").unwrap_or(&origin);
+        let scene = load_scene(&self.running, name).map_err(|e| e.to_string())?;
+        let remap =
+            instance.replace_scene_rebuilding(scene, gpu, &self.running, size, &reads_it).map_err(|e| e.to_string())?;
+        report.scene_changed = true;
+        report.remap = Some(remap);
+        Ok(true)
+    }
+
     /// Ok(true) if the running scene was replaced by its edited file.
     fn reload_scene(
         &self,
@@ -200,7 +236,7 @@ impl LiveReload {
                     return Ok(false);
                 }
                 let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
-                parse_scene(&path.display().to_string(), &source).map_err(|e| e.to_string())?
+                parse_scene_with(&self.running, &path.display().to_string(), &source).map_err(|e| e.to_string())?
             }
         };
         let remap = instance.replace_scene(scene, gpu, &self.running, size).map_err(|e| e.to_string())?;

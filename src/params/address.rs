@@ -74,6 +74,18 @@ pub enum ControlEvent<A: Addressing = Indexed> {
     },
     /// A show command: trigger a clip or a column, move through the cue list.
     Show(ShowCommand),
+    /// What the audio analysis heard this frame, for nodes that sample sound as a texture.
+    Audio(AudioSnapshot),
+}
+
+/// A frame of sound as shaders sample it (ISF `audio` and `audioFFT` inputs).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct AudioSnapshot {
+    /// The newest samples, −1 to 1, oldest first.
+    pub wave: Vec<f32>,
+    /// The spectrum in linear-frequency bins from 0 Hz to half the sample rate, 0 (−60 dBFS or
+    /// less) to 1 (0 dBFS).
+    pub spectrum: Vec<f32>,
 }
 
 /// What a performer asks of a show's clips and cues. Layers, clips, columns and cues are
@@ -112,7 +124,10 @@ impl ControlEvent {
                 seconds: *seconds,
             }),
             ControlEvent::ResumeTracks => Some(ControlEvent::ResumeTracks),
-            ControlEvent::Tempo { .. } | ControlEvent::Phase { .. } | ControlEvent::Show(_) => Some(self.clone()),
+            ControlEvent::Tempo { .. }
+            | ControlEvent::Phase { .. }
+            | ControlEvent::Show(_)
+            | ControlEvent::Audio(_) => Some(self.clone()),
         }
     }
 }

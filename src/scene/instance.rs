@@ -154,6 +154,7 @@ impl SceneInstance {
                     };
                     self.messages.extend(refused);
                 }
+                ControlEvent::Audio(snapshot) => self.nodes.iter_mut().for_each(|n| n.hear(snapshot)),
             }
         }
     }
@@ -331,10 +332,33 @@ impl SceneInstance {
         assets: &Assets,
         output_size: (u32, u32),
     ) -> Result<Remap, ShaderError> {
-        // A changed sample count rebuilds every node (pipelines are made for one count).
+        self.replace_scene_rebuilding(scene, gpu, assets, output_size, &|_| false)
+    }
+
+    /// [`Self::replace_scene`], creating anew the nodes `rebuild` picks even where they are
+    /// unchanged (their file changed: an ISF shader).
+    pub fn replace_scene_rebuilding(
+        &mut self,
+        scene: Scene,
+        gpu: &Gpu,
+        assets: &Assets,
+        output_size: (u32, u32),
+        rebuild: &dyn Fn(&super::SceneNode) -> bool,
+    ) -> Result<Remap, ShaderError> {
+        // A changed sample count rebuilds every node (pipelines are made for one count); so does
+        // a changed list of parameters (a file that declares them changed).
         let same_msaa = self.scene.msaa == scene.msaa;
+        let same_decls = |a: &ParamSet, b: &ParamSet| {
+            a.decls().len() == b.decls().len() && a.decls().iter().zip(b.decls()).all(|(x, y)| x.name == y.name)
+        };
         let kept = |n: &super::SceneNode| {
-            self.scene.nodes.iter().position(|o| same_msaa && o.id == n.id && o.technique.name == n.technique.name)
+            self.scene.nodes.iter().position(|o| {
+                same_msaa
+                    && o.id == n.id
+                    && o.technique.name == n.technique.name
+                    && same_decls(&o.params, &n.params)
+                    && !rebuild(n)
+            })
         };
         let mut fresh: Vec<Option<Box<dyn Technique>>> = Vec::with_capacity(scene.nodes.len());
         for (i, n) in scene.nodes.iter().enumerate() {

@@ -125,8 +125,12 @@ pub struct SceneNode {
     pub technique: &'static TechniqueInfo,
     /// Declarations (with the scene's defaults and ranges) and start values.
     pub params: ParamSet,
-    /// Upstream node indices, in the technique's input order.
+    /// Upstream node indices, in the order of `slots`.
     pub inputs: Vec<usize>,
+    /// The names of its texture inputs: the technique's, or what its file declares (ISF).
+    pub slots: Vec<String>,
+    /// Whether it samples sound (see [`techniques::Declared::hears_audio`]).
+    pub hears_audio: bool,
 }
 
 /// A track resolved to a parameter (or one of its components).
@@ -151,6 +155,11 @@ impl std::fmt::Debug for SceneNode {
 }
 
 impl Scene {
+    /// Whether some node samples sound (the audio analysis runs for it).
+    pub fn hears_audio(&self) -> bool {
+        self.nodes.iter().any(|n| n.hears_audio)
+    }
+
     /// Index of a node by id.
     pub fn node_index(&self, id: &str) -> Option<usize> {
         self.nodes.iter().position(|n| n.id == id)
@@ -232,7 +241,8 @@ impl Scene {
                 params.index(edit.file).ok_or_else(|| format!("output {number}: the warp has no file parameter"))?;
             params.set_at(index, ParamValue::Text(crate::params::Text::new(file)));
             params.snap();
-            self.nodes.push(SceneNode { id, technique, params, inputs: vec![node] });
+            let slots = technique.inputs.iter().map(|s| s.to_string()).collect();
+            self.nodes.push(SceneNode { id, technique, params, inputs: vec![node], slots, hears_audio: false });
             node = self.nodes.len() - 1;
         }
         self.outputs.push(SceneOutput { node, monitor: output.monitor, fullscreen: output.fullscreen });
@@ -316,10 +326,23 @@ pub fn parse_value_override(text: &str, decl: &ParamDecl) -> Result<ParamValue, 
 /// looked up in `scenes/` (disk first, then the built-in copies).
 ///
 /// A show (`shows/<name>`, or a file whose top level has `layers`) loads as the flat scene of
-/// all its clips (see [`super::show`]): every command takes shows where it takes scenes.
+/// all its clips (see [`super::show`]): every command takes shows where it takes scenes. An ISF
+/// shader (`.fs`) loads as a scene of its own (see [`techniques::isf::scene_for`]).
 pub fn load_scene(assets: &Assets, name_or_path: &str) -> Result<Scene, SceneErrors> {
     if names_a_show(name_or_path) {
         return super::show::load_show(assets, name_or_path, false);
+    }
+    if name_or_path.ends_with(".fs") {
+        // A bare ISF shader plays as a generated one-node scene (a filter over a default input).
+        let text = techniques::isf::scene_for(assets, name_or_path).map_err(|e| {
+            SceneErrors(vec![SceneError {
+                origin: e.origin,
+                line: e.line as usize,
+                column: e.column as usize,
+                message: e.message,
+            }])
+        })?;
+        return parse_scene_with(assets, name_or_path, &text);
     }
     let path = std::path::Path::new(name_or_path);
     let (origin, source) = if path.is_file() {
@@ -330,7 +353,7 @@ pub fn load_scene(assets: &Assets, name_or_path: &str) -> Result<Scene, SceneErr
         let asset = assets.load(AssetKind::Scene, name_or_path).map_err(|m| one_error(name_or_path, m))?;
         (asset.origin, asset.source)
     };
-    parse_scene(&origin, &source)
+    parse_scene_with(assets, &origin, &source)
 }
 
 /// Whether `name_or_path` is a show: under `shows/`, or a file whose top level has `layers`.
@@ -347,10 +370,16 @@ fn one_error(origin: &str, message: String) -> SceneErrors {
     SceneErrors(vec![SceneError { origin: origin.into(), line: 1, column: 1, message }])
 }
 
-/// Parses and validates scene text; `origin` names it in errors.
+/// Parses and validates scene text; `origin` names it in errors. Files that nodes declare their
+/// parameters from (ISF shaders) are found through [`Assets::discover`].
 pub fn parse_scene(origin: &str, source: &str) -> Result<Scene, SceneErrors> {
+    parse_scene_with(&Assets::discover(), origin, source)
+}
+
+/// [`parse_scene`] with the files nodes name found through `assets`.
+pub fn parse_scene_with(assets: &Assets, origin: &str, source: &str) -> Result<Scene, SceneErrors> {
     let file: SceneFile = read_ron(origin, source)?;
-    Validator { origin, source, errors: Vec::new(), more: 0 }.validate(file)
+    Validator { origin, source, assets, errors: Vec::new(), more: 0 }.validate(file)
 }
 
 /// RON text as `T` (a scene or a show file), a syntax or schema error located in `origin`.
@@ -434,6 +463,8 @@ pub const MAX_TEXTURE_BYTES: u64 = 8 << 30;
 struct Validator<'a> {
     origin: &'a str,
     source: &'a str,
+    /// Where files that declare a node's parameters are read from.
+    assets: &'a Assets,
     errors: Vec<SceneError>,
     /// Errors past [`MAX_REPORTED_ERRORS`], counted only.
     more: usize,
@@ -635,6 +666,33 @@ impl Validator<'_> {
             return None;
         };
         let mut decls = (technique.params)();
+        let mut slots: Vec<String> = technique.inputs.iter().map(|s| s.to_string()).collect();
+        let mut hears_audio = false;
+        if let Some(declarer) = technique.declare {
+            let file = match node.params.get(declarer.file_param) {
+                Some(RawValue::Text(file)) => Some(file.clone()),
+                _ => decls.iter().find(|d| d.name == declarer.file_param).and_then(|d| match d.default {
+                    ParamValue::Text(t) => Some(t.as_str().to_string()),
+                    _ => None,
+                }),
+            };
+            let key = format!("\"{}\"", declarer.file_param);
+            match file.map(|f| (declarer.declare)(self.assets, &f)) {
+                Some(Ok(declared)) => {
+                    decls.extend(declared.params);
+                    slots = declared.inputs;
+                    hears_audio = declared.hears_audio;
+                }
+                Some(Err(message)) => {
+                    self.error(&[anchor, "params", &key], message);
+                    return None;
+                }
+                None => {
+                    self.error(&[anchor], format!("node '{}' needs its '{}' parameter", node.id, declarer.file_param));
+                    return None;
+                }
+            }
+        }
         let names: Vec<String> = decls.iter().map(|d| d.name.clone()).collect();
         for (name, (lo, hi)) in &node.ranges {
             let key = format!("\"{name}\"");
@@ -677,20 +735,21 @@ impl Validator<'_> {
             }
         }
         for slot in node.inputs.keys() {
-            if !technique.inputs.contains(&slot.as_str()) {
+            if !slots.contains(slot) {
                 let key = format!("\"{slot}\"");
                 self.error(
                     &[anchor, "inputs", &key],
-                    format!("technique '{}' has no input '{slot}' (inputs: {:?})", technique.name, technique.inputs),
+                    format!("technique '{}' has no input '{slot}' (inputs: {slots:?})", technique.name),
                 );
             }
         }
-        for slot in technique.inputs {
-            if !node.inputs.contains_key(*slot) {
+        for slot in &slots {
+            if !node.inputs.contains_key(slot) {
                 self.error(&[anchor], format!("node '{}' needs its input '{slot}' wired to a node", node.id));
             }
         }
-        Some(SceneNode { id: node.id.clone(), technique, params: ParamSet::new(decls), inputs: Vec::new() })
+        let params = ParamSet::new(decls);
+        Some(SceneNode { id: node.id.clone(), technique, params, inputs: Vec::new(), slots, hears_audio })
     }
 
     /// Resolves input wiring into each node's `inputs` (file indices) and returns the node
@@ -702,8 +761,8 @@ impl Validator<'_> {
         }
         let index: BTreeMap<&str, usize> = file.nodes.iter().enumerate().map(|(i, n)| (n.id.as_str(), i)).collect();
         for (i, node) in file.nodes.iter().enumerate() {
-            for slot in nodes[i].technique.inputs {
-                let Some(source) = node.inputs.get(*slot) else {
+            for slot in &nodes[i].slots {
+                let Some(source) = node.inputs.get(slot) else {
                     continue;
                 };
                 match index.get(source.as_str()) {

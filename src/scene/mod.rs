@@ -12,7 +12,7 @@ pub use error::{SceneError, SceneErrors};
 pub use instance::{SceneInstance, SceneView};
 pub use load::{
     AudioMapping, BoundTrack, MAX_NAME_CHARS, Scene, SceneNode, SceneOutput, check_audio, load_scene, names_a_show,
-    parse_scene, parse_value_override, resolve_target,
+    parse_scene, parse_scene_with, parse_value_override, resolve_target,
 };
 pub use player::{Player, SeekError};
 pub use schema::{

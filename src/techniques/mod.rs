@@ -18,6 +18,7 @@ pub mod fader;
 pub mod grid_fluid;
 pub mod image;
 pub mod image_pass;
+pub mod isf;
 pub mod kleinian;
 pub mod mesh2d_draw;
 pub mod picture_pass;
@@ -34,7 +35,7 @@ pub mod warp;
 use crate::assets::{AssetKind, Assets};
 use crate::gpu::{Gpu, ShaderError};
 use crate::graph::{FrameGraph, TextureHandle};
-use crate::params::{ParamDecl, ParamSet, ParamValue};
+use crate::params::{AudioSnapshot, ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 
 /// Every technique indra knows, by scene name.
@@ -55,6 +56,7 @@ pub const REGISTRY: &[TechniqueInfo] = &[
     fader::INFO,
     video::INFO,
     camera::INFO,
+    isf::INFO,
 ];
 
 /// Finds a technique by the name scenes use.
@@ -85,6 +87,30 @@ pub struct TechniqueInfo {
     /// For a stage output (a projection-mapping warp): the parameters the scene loader and the
     /// output windows work through — so neither knows a technique by name.
     pub stage: Option<StageEdit>,
+    /// For a technique whose parameters and inputs come from a file the node names (an ISF
+    /// shader's inputs): the scene loader reads them through it, after `params`.
+    pub declare: Option<Declarer>,
+}
+
+/// See [`TechniqueInfo::declare`].
+#[derive(Clone, Copy)]
+pub struct Declarer {
+    /// The text parameter naming the file.
+    pub file_param: &'static str,
+    /// Reads the file a node names: its parameters and input slots, or one located sentence.
+    pub declare: fn(&Assets, &str) -> Result<Declared, String>,
+}
+
+/// What a file declares for a node (see [`Declarer`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Declared {
+    /// Parameters, after the technique's own.
+    pub params: Vec<ParamDecl>,
+    /// Texture inputs, in order (the node's input slots).
+    pub inputs: Vec<String>,
+    /// Whether the node samples sound ([`Technique::hear`]): the scene then runs the audio
+    /// analysis even where no parameter is mapped to it.
+    pub hears_audio: bool,
 }
 
 /// The parameters, by name, of a technique that maps an image onto a wall: what an output's
@@ -228,6 +254,10 @@ pub trait Technique: Send {
     fn status(&self) -> Option<String> {
         None
     }
+
+    /// What the audio analysis heard this frame (only nodes that sample sound use it; the
+    /// scene asks for it through [`Declared::hears_audio`]).
+    fn hear(&mut self, _audio: &AudioSnapshot) {}
 
     /// Things to tell the performer since the last call (e.g. "the cloth blew up and was reset").
     fn take_messages(&mut self) -> Vec<String> {

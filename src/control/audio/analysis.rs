@@ -10,6 +10,8 @@ use std::sync::Arc;
 
 use realfft::RealToComplex;
 
+pub use crate::params::AudioSnapshot;
+
 /// Samples per spectrum (≈ 43 ms at 48 kHz).
 pub const FFT_SIZE: usize = 2048;
 
@@ -19,6 +21,11 @@ pub const BANDS: usize = crate::scene::AUDIO_BANDS;
 pub const LOWEST_HZ: f32 = 30.0;
 /// Upper edge of the last band.
 pub const HIGHEST_HZ: f32 = 16_000.0;
+
+/// Samples in an [`AudioSnapshot`]'s waveform.
+pub const SNAPSHOT_SAMPLES: usize = 256;
+/// Bins in an [`AudioSnapshot`]'s spectrum (each four FFT bins, up to half the sample rate).
+pub const SNAPSHOT_BINS: usize = 256;
 
 /// Band values are dB above this floor, scaled to 0–1 at 0 dBFS.
 const FLOOR_DB: f32 = -60.0;
@@ -57,6 +64,9 @@ pub struct AudioFrame {
     pub beat: bool,
     /// The tempo the onsets suggest, once a few seconds were heard.
     pub bpm: Option<f64>,
+    /// What shaders sample (ISF `audio` and `audioFFT` inputs): the newest samples and the
+    /// spectrum in linear bins.
+    pub snapshot: AudioSnapshot,
 }
 
 /// Running analysis state.
@@ -143,10 +153,11 @@ impl Analyzer {
         };
         let (low, mid, high) = (mean_of(0.0..250.0), mean_of(250.0..4000.0), mean_of(4000.0..f32::MAX));
         let onset = self.onset(&magnitudes, seconds);
+        let snapshot = self.snapshot(&magnitudes);
         self.previous = magnitudes;
         let bpm = self.tempo();
         let beat = self.beat(onset, bpm, seconds);
-        AudioFrame { level, peak, bands, low, mid, high, onset, beat, bpm }
+        AudioFrame { level, peak, bands, low, mid, high, onset, beat, bpm, snapshot }
     }
 
     /// Whether a beat falls at `seconds`: an onset near (or past) the predicted beat is the beat
@@ -175,6 +186,22 @@ impl Analyzer {
         }
         self.last_beat = Some(seconds);
         true
+    }
+
+    /// The newest [`SNAPSHOT_SAMPLES`] samples and [`SNAPSHOT_BINS`] spectrum bins, each the
+    /// mean of four FFT bins (about 94 Hz wide at 48 kHz), 0 (−60 dBFS or less) to 1 (0 dBFS)
+    /// as the bands are.
+    fn snapshot(&self, magnitudes: &[f32]) -> AudioSnapshot {
+        let wave = self.history.iter().skip(FFT_SIZE - SNAPSHOT_SAMPLES).copied().collect();
+        let per_bin = (FFT_SIZE / 2) / SNAPSHOT_BINS;
+        let spectrum = (0..SNAPSHOT_BINS)
+            .map(|b| {
+                let bins = &magnitudes[b * per_bin..(b + 1) * per_bin];
+                let mean = bins.iter().sum::<f32>() / per_bin as f32;
+                ((20.0 * mean.max(1e-9).log10() - FLOOR_DB) / -FLOOR_DB).clamp(0.0, 1.0)
+            })
+            .collect();
+        AudioSnapshot { wave, spectrum }
     }
 
     /// Magnitudes of the last [`FFT_SIZE`] samples, scaled so a full-scale sine peaks at 1.

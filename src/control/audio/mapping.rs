@@ -15,6 +15,8 @@ pub struct AudioMapper {
     envelopes: Vec<f32>,
     /// Mappings from here on were learned (the scene's come first).
     learned_from: usize,
+    /// Whether a node samples the sound itself (each frame's [`ControlEvent::Audio`]).
+    heard: bool,
 }
 
 impl AudioMapper {
@@ -27,7 +29,12 @@ impl AudioMapper {
     /// so a learned mapping wins where both write one parameter), at rest.
     pub fn with_learned(scene: &Scene, learned: Vec<AudioMapping>) -> Self {
         let mappings: Vec<AudioMapping> = scene.audio.iter().cloned().chain(learned).collect();
-        Self { envelopes: vec![0.0; mappings.len()], mappings, learned_from: scene.audio.len() }
+        Self {
+            envelopes: vec![0.0; mappings.len()],
+            mappings,
+            learned_from: scene.audio.len(),
+            heard: scene.hears_audio(),
+        }
     }
 
     /// Whether some mapping writes `node`'s parameter `param`, and whether a learned one does.
@@ -36,9 +43,9 @@ impl AudioMapper {
         (self.mappings.iter().any(writes), self.mappings[self.learned_from..].iter().any(writes))
     }
 
-    /// Whether the scene maps any audio.
+    /// Whether the scene uses no audio: no mapping, and no node that samples it.
     pub fn is_empty(&self) -> bool {
-        self.mappings.is_empty()
+        self.mappings.is_empty() && !self.heard
     }
 
     /// The writes for one frame of `dt` seconds: each mapping's envelope moves towards its
@@ -46,6 +53,9 @@ impl AudioMapper {
     /// onset or beat mapped to a trigger fires it, a level fires it as it rises through half.
     pub fn events(&mut self, frame: &AudioFrame, dt: f64, scene: &Scene) -> Vec<ControlEvent> {
         let mut events = Vec::new();
+        if self.heard {
+            events.push(ControlEvent::Audio(frame.snapshot.clone()));
+        }
         for (m, envelope) in self.mappings.iter().zip(&mut self.envelopes) {
             let input = match m.source {
                 AudioSource::Level => frame.level,

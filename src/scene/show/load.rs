@@ -228,6 +228,8 @@ impl Builder<'_> {
                 technique: &blend::INFO,
                 params,
                 inputs: Vec::new(),
+                slots: blend::INFO.inputs.iter().map(|s| s.to_string()).collect(),
+                hears_audio: false,
             });
         }
         let mut master_params = ParamSet::new((fader::INFO.params)());
@@ -241,6 +243,8 @@ impl Builder<'_> {
             technique: &fader::INFO,
             params: master_params,
             inputs: Vec::new(),
+            slots: fader::INFO.inputs.iter().map(|s| s.to_string()).collect(),
+            hears_audio: false,
         });
         let columns = (0..layers.iter().map(|l| l.clips.len()).max().unwrap_or(0))
             .map(|i| file.columns.get(i).cloned().unwrap_or_else(|| format!("column {}", i + 1)))
@@ -350,15 +354,26 @@ impl Builder<'_> {
         if t.kind == "cut" {
             return Some(Transition { kind: None, length: Length::Seconds(0.0), quantize: t.quantize });
         }
-        if t.kind.is_empty() || !t.kind.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_') {
-            self.error(anchors, format!("transition kind '{}': use cut or a name of a-z, 0-9 and _", t.kind));
+        let isf = super::mixer::is_isf(&t.kind);
+        let named =
+            !t.kind.is_empty() && t.kind.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+        if !(isf || named) {
+            self.error(
+                anchors,
+                format!("transition kind '{}': use cut, a name of a-z, 0-9 and _, or an ISF transition's .fs", t.kind),
+            );
             return None;
         }
         let kind = match self.kinds.iter().position(|k| *k == t.kind) {
             Some(i) => i,
             None => {
                 let file = super::transition_file(&t.kind);
-                if let Err(e) = self.assets.load(AssetKind::Shader, &file) {
+                let found = if isf {
+                    isf_transition_problem(self.assets, &t.kind).map_or(Ok(()), Err)
+                } else {
+                    self.assets.load(AssetKind::Shader, &file).map(|_| ())
+                };
+                if let Err(e) = found {
                     let anchor = format!("\"{}\"", t.kind);
                     self.error(&[&anchor], format!("transition '{}': {e}", t.kind));
                     return None;
@@ -514,5 +529,18 @@ fn budget(scene: &Scene, show: &Show) -> Result<(), String> {
             gib(crate::scene::load::MAX_TEXTURE_BYTES),
             clips.join(", ")
         )
+    })
+}
+
+/// Why ISF file `file` cannot be a transition (it does not compile, or lacks `startImage`,
+/// `endImage` or `progress`), if it cannot.
+fn isf_transition_problem(assets: &Assets, file: &str) -> Option<String> {
+    use crate::techniques::isf::{IsfFiles, header::Role};
+    let header = match IsfFiles::read(assets, file).and_then(|f| f.compile().map_err(|e| e.to_string())) {
+        Ok(compiled) => compiled.header,
+        Err(e) => return Some(e),
+    };
+    (header.role() != Role::Transition).then(|| {
+        format!("{file} is not an ISF transition: it needs image inputs startImage and endImage and a progress")
     })
 }

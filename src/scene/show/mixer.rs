@@ -7,11 +7,18 @@
 //! the colour at `uv` (0–1 from the top left) when it is `progress` (0 → 1) of the way from the
 //! outgoing clip (`from_color(uv)`) to the incoming one (`to_color(uv)`). The base declares the
 //! bindings and helpers (see `shaders/transition.wgsl`); indra adds the entry point.
+//!
+//! A kind that is a path to an ISF transition (`shaders/isf/Directional Wipe.fs`: a shader with
+//! `startImage`, `endImage` and `progress`) runs as an `isf` node per layer, its `progress` the
+//! transition's and its `TIME` the seconds since the transition began.
 
 use crate::assets::{AssetKind, Assets};
 use crate::gpu::{Gpu, JoinedSource, ShaderError};
 use crate::graph::{FrameGraph, TextureHandle};
+use crate::params::{ParamSet, ParamValue, Text};
 use crate::techniques::image_pass::{ImageKernel, ImagePass};
+use crate::techniques::{NodeSetup, Technique, isf};
+use crate::time::FrameTime;
 
 use super::{LayerView, Show};
 
@@ -54,10 +61,27 @@ pub struct TransitionUniforms {
     pub pad2: [f32; 2],
 }
 
+/// Whether transition kind `kind` is an ISF shader (`startImage`, `endImage`, `progress`) —
+/// a path to a `.fs` file — rather than a WGSL transition's name.
+pub fn is_isf(kind: &str) -> bool {
+    kind.ends_with(".fs")
+}
+
+/// An ISF transition for one layer: the shader as a node, and its parameters (`progress` set
+/// each frame).
+struct IsfTransition {
+    node: Box<dyn Technique>,
+    params: ParamSet,
+    progress: usize,
+}
+
 /// The show's transition pipelines, and one pass per layer.
 pub struct Mixer {
-    kernels: Vec<ImageKernel>,
+    /// Per kind: its WGSL kernel (`None` for an ISF kind).
+    kernels: Vec<Option<ImageKernel>>,
     passes: Vec<ImagePass>,
+    /// Per kind: for an ISF kind, one node per layer.
+    isf: Vec<Vec<IsfTransition>>,
     files: Vec<String>,
 }
 
@@ -67,7 +91,15 @@ impl Mixer {
         let device = &gpu.device;
         let load = |name: &str| assets.load(AssetKind::Shader, name).map(|a| (a.origin, a.source));
         let mut kernels = Vec::with_capacity(show.kinds.len());
+        let mut isf = Vec::with_capacity(show.kinds.len());
         for kind in &show.kinds {
+            if is_isf(kind) {
+                let layers = (0..show.layers.len()).map(|l| isf_transition(gpu, assets, kind, l));
+                isf.push(layers.collect::<Result<Vec<_>, _>>()?);
+                kernels.push(None);
+                continue;
+            }
+            isf.push(Vec::new());
             let file = transition_file(kind);
             let located = |message: String| ShaderError { origin: file.clone(), line: 1, column: 1, message };
             let (origin, source) = load(&file).map_err(located)?;
@@ -76,15 +108,15 @@ impl Mixer {
             let size = size_of::<TransitionUniforms>() as u64;
             let kernel = ImageKernel::new(device, (joined.origin(), &text), "transition_main", 2, size)
                 .map_err(|e| joined.relocate(e))?;
-            kernels.push(kernel);
+            kernels.push(Some(kernel));
         }
-        let passes = match kernels.first() {
+        let passes = match kernels.iter().flatten().next() {
             Some(k) => show.layers.iter().map(|_| ImagePass::new(device, k)).collect(),
             None => Vec::new(),
         };
-        let mut files: Vec<String> = show.kinds.iter().map(|k| transition_file(k)).collect();
+        let mut files: Vec<String> = show.kinds.iter().filter(|k| !is_isf(k)).map(|k| transition_file(k)).collect();
         files.push(TRANSITION_BASE.into());
-        Ok(Self { kernels, passes, files })
+        Ok(Self { kernels, passes, isf, files })
     }
 
     /// Whether the mixer was built from shader file `name` (to rebuild it after an edit).
@@ -94,14 +126,37 @@ impl Mixer {
 
     /// This frame's use of the mixer: each layer's pass lent out once.
     pub fn frame(&mut self) -> MixerFrame<'_> {
-        MixerFrame { kernels: &self.kernels, passes: self.passes.iter_mut().map(Some).collect() }
+        MixerFrame {
+            kernels: &self.kernels,
+            passes: self.passes.iter_mut().map(Some).collect(),
+            isf: self.isf.iter_mut().map(|layers| layers.iter_mut().map(Some).collect()).collect(),
+        }
     }
+}
+
+/// ISF transition `file` for layer `layer`, built as an `isf` node would be.
+fn isf_transition(gpu: &Gpu, assets: &Assets, file: &str, layer: usize) -> Result<IsfTransition, ShaderError> {
+    let located = |message: String| ShaderError { origin: file.to_string(), line: 1, column: 1, message };
+    let declared =
+        (isf::INFO.declare.expect("the isf technique declares its inputs").declare)(assets, file).map_err(located)?;
+    let mut decls = (isf::INFO.params)();
+    decls.extend(declared.params);
+    let mut params = ParamSet::new(decls);
+    let index = |name: &str| params.index(name).ok_or_else(|| located(format!("an ISF transition needs '{name}'")));
+    let (file_param, progress) = (index("file")?, index("progress")?);
+    params.set_at(file_param, ParamValue::Text(Text::new(file)));
+    params.snap();
+    let id = format!("show/layer{}/transition", layer + 1);
+    let setup = NodeSetup { gpu, assets, id: &id, output_size: (1920, 1080), msaa: 1, params: &params, seed: 0 };
+    let node = (isf::INFO.create)(&setup)?;
+    Ok(IsfTransition { node, params, progress })
 }
 
 /// The mixer during one frame's declaration (see [`Mixer::frame`]).
 pub struct MixerFrame<'r> {
-    kernels: &'r [ImageKernel],
+    kernels: &'r [Option<ImageKernel>],
     passes: Vec<Option<&'r mut ImagePass>>,
+    isf: Vec<Vec<Option<&'r mut IsfTransition>>>,
 }
 
 impl<'r> MixerFrame<'r> {
@@ -115,7 +170,15 @@ impl<'r> MixerFrame<'r> {
         from: TextureHandle,
         to: TextureHandle,
     ) -> TextureHandle {
-        let Some(kernel) = view.kind.and_then(|k| self.kernels.get(k)) else { return to };
+        let Some(kind) = view.kind else { return to };
+        if let Some(t) = self.isf.get_mut(kind).and_then(|layers| layers.get_mut(layer)).and_then(Option::take) {
+            // The shader's own clock is the transition's: seconds since it began.
+            t.params.set_at(t.progress, ParamValue::Float(view.progress.clamp(0.0, 1.0)));
+            t.params.snap();
+            let time = FrameTime { frame: 0, seconds: f64::from(view.seconds), dt: 0.0, seed: 0 };
+            return t.node.add_passes(graph, &t.params, &time, &[from, to]);
+        }
+        let Some(Some(kernel)) = self.kernels.get(kind) else { return to };
         let Some(pass) = self.passes.get_mut(layer).and_then(Option::take) else { return to };
         let (w, h) = graph.output_size();
         let uniforms = TransitionUniforms {

@@ -32,6 +32,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     check: None,
     stage: None,
+    declare: None,
 };
 
 crate::technique_params! {

@@ -35,6 +35,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     check: None,
     stage: None,
+    declare: None,
 };
 
 /// The colour target format.

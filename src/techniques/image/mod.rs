@@ -38,6 +38,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     check: None,
     stage: None,
+    declare: None,
 };
 
 /// The bundled height maps, by the path scenes use.

@@ -25,6 +25,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     check: None,
     stage: None,
+    declare: None,
 };
 
 /// The output format: linear HDR so that post effects (StarGlow) can follow.

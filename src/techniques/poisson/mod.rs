@@ -24,6 +24,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     check: Some(check_settings),
     stage: None,
+    declare: None,
 };
 
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;

@@ -34,6 +34,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     check: None,
     stage: None,
+    declare: None,
 };
 
 /// Intermediate and output format.

@@ -43,6 +43,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
     check: None,
     stage: None,
+    declare: None,
 };
 
 /// The clip bundled with indra (made by `tools/make-demo-clip` from the Kleinian scene).

@@ -38,6 +38,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         grid: "grid",
         save: "save",
     }),
+    declare: None,
 };
 
 /// Output format: linear HDR like every node.

@@ -1,0 +1,686 @@
+//! An ISF node on the GPU: one render pipeline per target format from the compiled stages, a
+//! uniform buffer per pass, feedback buffers (persistent targets, ping-ponged so the pass that
+//! writes one reads its last frame), imported images, and each frame's passes in the frame graph.
+
+use std::collections::BTreeMap;
+
+use super::compile::Compiled;
+use super::header::{InputKind, Pass};
+use super::translate::{FIRST_TEXTURE_BINDING, SAMPLER_BINDING, TextureSource, UNIFORM_BINDING};
+use super::{IsfFiles, Settings};
+use crate::gpu::{BindGroupCache, DEFAULT_MAX_AGE, ShaderError};
+use crate::graph::{Extent, FrameGraph, PersistentTexture, PingPong, TextureDesc, TextureHandle};
+use crate::params::{AudioSnapshot, ParamSet, ParamValue};
+use crate::techniques::image_pass::{self, ImageKernel, ImagePass};
+use crate::techniques::{NodeSetup, Technique};
+use crate::time::FrameTime;
+
+/// The node's image: linear HDR like every node's.
+const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// A target without `FLOAT`: 8 bits a channel, as GL hosts make them.
+const BYTE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// A `FLOAT` target (half floats: filterable everywhere, enough for feedback).
+const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The most texture memory one node's pass targets may take (a size expression that asks for
+/// more is refused): an eighth of the scene's whole budget.
+pub const MAX_TARGET_BYTES: u64 = 1 << 30;
+
+/// The largest imported image file read.
+const IMPORTED_FILE_LIMIT: u64 = 64 << 20;
+
+/// Builds an ISF node from the file its `file` parameter names.
+pub fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
+    let file = Settings::read(setup.params).file;
+    let files = IsfFiles::read(setup.assets, file.as_str()).map_err(|message| ShaderError {
+        origin: file.as_str().into(),
+        line: 1,
+        column: 1,
+        message,
+    })?;
+    let compiled = files.compile()?;
+    Ok(Box::new(IsfNode::new(setup, &files, compiled)?))
+}
+
+/// The pipelines of one compiled shader.
+struct Pipelines {
+    layout: wgpu::BindGroupLayout,
+    /// Target format → pipeline.
+    by_format: BTreeMap<FormatKey, wgpu::RenderPipeline>,
+    sampler: wgpu::Sampler,
+}
+
+/// `wgpu::TextureFormat` is not `Ord`: formats by the two this node renders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum FormatKey {
+    Byte,
+    Float,
+}
+
+impl FormatKey {
+    fn of(format: wgpu::TextureFormat) -> Self {
+        if format == BYTE_FORMAT { FormatKey::Byte } else { FormatKey::Float }
+    }
+}
+
+/// One pass's GPU state.
+struct PassState {
+    uniforms: wgpu::Buffer,
+    groups: BindGroupCache<Vec<u64>>,
+}
+
+/// A persistent target.
+struct Feedback {
+    buffers: PingPong,
+    size: (u32, u32),
+    format: wgpu::TextureFormat,
+}
+
+/// A live ISF node.
+pub struct IsfNode {
+    compiled: Compiled,
+    pipelines: Pipelines,
+    passes: Vec<PassState>,
+    /// Persistent targets by name.
+    feedback: BTreeMap<String, Feedback>,
+    /// Imported images by name.
+    imported: BTreeMap<String, PersistentTexture>,
+    /// Sound as textures, by input name: the waveform (`audio`) or spectrum (`audioFFT`), one
+    /// row, written each frame from what the audio analysis heard.
+    audio: BTreeMap<String, AudioTexture>,
+    queue: wgpu::Queue,
+    /// What a texture nothing has written yet reads: transparent black.
+    black: PersistentTexture,
+    present: (ImageKernel, ImagePass),
+    /// The parameter positions of the shader's inputs (by name, found once).
+    positions: Vec<Option<usize>>,
+    device: wgpu::Device,
+    id: String,
+    messages: Vec<String>,
+    /// The last size-expression problem told, so it is told once.
+    size_problem: Option<String>,
+    /// Per input: whether an event fired in the latest step (triggers are seen in the step they
+    /// fire in; the frame drawn after it shows them).
+    fired: Vec<bool>,
+}
+
+/// One sound input's texture.
+struct AudioTexture {
+    texture: PersistentTexture,
+    /// Whether it holds the spectrum (else the waveform).
+    spectrum: bool,
+}
+
+impl AudioTexture {
+    /// `width` samples or bins wide, holding silence.
+    fn new(device: &wgpu::Device, queue: &wgpu::Queue, name: &str, width: u32, spectrum: bool) -> Self {
+        let texture = PersistentTexture::new(device, name, (width, 1), AUDIO_FORMAT);
+        let made = Self { texture, spectrum };
+        made.write(queue, &AudioSnapshot::default());
+        made
+    }
+
+    /// Writes what `audio` heard, resampled to the texture's width: a spectrum as 0–1 per bin, a
+    /// waveform as ISF hosts give it (0.5 is silence, 0 and 1 full scale), in every channel.
+    fn write(&self, queue: &wgpu::Queue, audio: &AudioSnapshot) {
+        let width = self.texture.texture.width() as usize;
+        let source = if self.spectrum { &audio.spectrum } else { &audio.wave };
+        let value = |i: usize| -> f32 {
+            let x = if source.is_empty() { 0.0 } else { source[(i * source.len() / width).min(source.len() - 1)] };
+            if self.spectrum { x.clamp(0.0, 1.0) } else { (x * 0.5 + 0.5).clamp(0.0, 1.0) }
+        };
+        let texels: Vec<u16> = (0..width)
+            .flat_map(|i| {
+                let v = half::f16::from_f32(value(i)).to_bits();
+                [v, v, v, half::f16::ONE.to_bits()]
+            })
+            .collect();
+        queue.write_texture(
+            self.texture.texture.as_image_copy(),
+            bytemuck::cast_slice(&texels),
+            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(8 * width as u32), rows_per_image: Some(1) },
+            self.texture.texture.size(),
+        );
+    }
+}
+
+/// Sound textures: half floats (filterable everywhere).
+const AUDIO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// Samples or bins of a sound texture when the input asks for no `MAX`.
+const AUDIO_WIDTH: u32 = 256;
+
+/// The present kernel's (unused) uniform block.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct PresentUniforms {
+    pad: [u32; 4],
+}
+
+impl IsfNode {
+    fn new(setup: &NodeSetup<'_>, files: &IsfFiles, compiled: Compiled) -> Result<Self, ShaderError> {
+        let device = &setup.gpu.device;
+        let origin = files.fs.0.as_str();
+        let pipelines = build_pipelines(device, origin, &compiled)?;
+        let passes = (0..compiled.header.passes.len())
+            .map(|i| PassState {
+                uniforms: device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(&format!("{}/pass{i}/uniforms", setup.id)),
+                    size: u64::from(compiled.program.uniforms.size),
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                }),
+                groups: BindGroupCache::new(DEFAULT_MAX_AGE),
+            })
+            .collect();
+        let black = PersistentTexture::new(device, "isf/black", (1, 1), BYTE_FORMAT);
+        let (present_origin, present_source) = setup.shader_source("isf_present.wgsl", &image_pass::bindings(1))?;
+        let kernel = ImageKernel::new(
+            device,
+            (&present_origin, &present_source),
+            "isf_present",
+            1,
+            size_of::<PresentUniforms>() as u64,
+        )?;
+        let present_pass = ImagePass::new(device, &kernel);
+        let positions = compiled.header.inputs.iter().map(|i| setup.params.index(&i.name)).collect();
+        let audio = compiled
+            .header
+            .inputs
+            .iter()
+            .filter_map(|i| {
+                let (max, spectrum) = match i.kind {
+                    InputKind::Audio { max } => (max, false),
+                    InputKind::AudioFft { max } => (max, true),
+                    _ => return None,
+                };
+                let width = max.unwrap_or(AUDIO_WIDTH).clamp(1, 4096);
+                let label = format!("{}/{}", setup.id, i.name);
+                Some((i.name.clone(), AudioTexture::new(device, &setup.gpu.queue, &label, width, spectrum)))
+            })
+            .collect();
+        let mut node = Self {
+            audio,
+            queue: setup.gpu.queue.clone(),
+            imported: BTreeMap::new(),
+            feedback: BTreeMap::new(),
+            compiled,
+            pipelines,
+            passes,
+            black,
+            present: (kernel, present_pass),
+            positions,
+            device: device.clone(),
+            id: setup.id.to_string(),
+            messages: Vec::new(),
+            size_problem: None,
+            fired: Vec::new(),
+        };
+        node.fired = vec![false; node.compiled.header.inputs.len()];
+        // A size expression that fails with the defaults fails the node (a located error).
+        for pass in &node.compiled.header.passes {
+            node.pass_size(pass, setup.params, setup.output_size).map_err(|message| ShaderError {
+                origin: origin.to_string(),
+                line: 1,
+                column: 1,
+                message,
+            })?;
+        }
+        node.import_images(setup, files)?;
+        Ok(node)
+    }
+
+    /// Reads, decodes and uploads the `IMPORTED` images (paths relative to the shader).
+    fn import_images(&mut self, setup: &NodeSetup<'_>, files: &IsfFiles) -> Result<(), ShaderError> {
+        for (name, path) in &self.compiled.header.imported {
+            let beside = files.path.as_ref().and_then(|p| p.parent()).map(|d| d.join(path));
+            let located = beside.as_ref().map_or(path.clone(), |p| p.display().to_string());
+            let failed = |message: String| ShaderError { origin: files.fs.0.clone(), line: 1, column: 1, message };
+            let bytes = setup
+                .assets
+                .read_file(&located, IMPORTED_FILE_LIMIT, None)
+                .map_err(|e| failed(format!("IMPORTED '{name}': {e}")))?;
+            let max_side = setup.gpu.device.limits().max_texture_dimension_2d;
+            let still = crate::media::still::decode(&bytes.bytes, &bytes.origin, max_side, 256 << 20)
+                .map_err(|e| failed(format!("IMPORTED '{name}': {e}")))?;
+            let crate::media::clip::Picture::Rgba(pixels) = still.picture else {
+                return Err(failed(format!("IMPORTED '{name}': only 8-bit images (PNG, JPEG) are imported")));
+            };
+            let texture = PersistentTexture::new(&self.device, &format!("isf/{name}"), still.size, BYTE_FORMAT);
+            setup.gpu.queue.write_texture(
+                texture.texture.as_image_copy(),
+                &pixels,
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(4 * still.size.0),
+                    rows_per_image: Some(still.size.1),
+                },
+                texture.texture.size(),
+            );
+            self.imported.insert(name.clone(), texture);
+        }
+        Ok(())
+    }
+
+    /// The value of input `k` now: the node's parameter, or the header's default where the
+    /// parameter is missing (a file changed under a running scene).
+    fn input_value(&self, k: usize, params: &ParamSet) -> Option<ParamValue> {
+        let input = &self.compiled.header.inputs[k];
+        let value = self.positions[k].map(|p| params.value_at(p));
+        let default = input.decl().map(|d| d.default);
+        match value {
+            Some(v) if default.is_some_and(|d| d.ty() == v.ty()) => Some(v),
+            _ => default,
+        }
+    }
+
+    /// A pass's size: its expressions over `$WIDTH`, `$HEIGHT` and the inputs, or the render size.
+    fn pass_size(&self, pass: &Pass, params: &ParamSet, output: (u32, u32)) -> Result<(u32, u32), String> {
+        let var = |name: &str| -> Option<f64> {
+            match name {
+                "WIDTH" => Some(f64::from(output.0)),
+                "HEIGHT" => Some(f64::from(output.1)),
+                _ => {
+                    let k = self.compiled.header.inputs.iter().position(|i| i.name == name)?;
+                    Some(match self.input_value(k, params)? {
+                        ParamValue::Float(x) => f64::from(x),
+                        ParamValue::Enum(i) => match &self.compiled.header.inputs[k].kind {
+                            InputKind::Long { values, .. } => f64::from(values.get(i as usize).copied().unwrap_or(0)),
+                            _ => f64::from(i),
+                        },
+                        ParamValue::Bool(b) | ParamValue::Trigger(b) => f64::from(u8::from(b)),
+                        _ => return None,
+                    })
+                }
+            }
+        };
+        let max_side = self.device.limits().max_texture_dimension_2d;
+        let side = |expression: &Option<String>, full: u32, axis: &str| -> Result<u32, String> {
+            let Some(text) = expression else { return Ok(full) };
+            let v = super::expr::evaluate(text, &var).map_err(|e| format!("{axis} of a pass: {e}"))?;
+            // A fraction of a pixel (a small render of `$WIDTH / 100`) is one pixel, as in GL hosts.
+            if !v.is_finite() || v <= 0.0 || v > f64::from(max_side) {
+                return Err(format!("{axis} of a pass, '{text}', is {v}; it must be above 0 and at most {max_side}"));
+            }
+            Ok(v.max(1.0) as u32)
+        };
+        let size = (side(&pass.width, output.0, "WIDTH")?, side(&pass.height, output.1, "HEIGHT")?);
+        let bytes = crate::graph::texture_bytes(size, if pass.float { FLOAT_FORMAT } else { BYTE_FORMAT });
+        if bytes > MAX_TARGET_BYTES {
+            return Err(format!("a pass of {}×{} takes {bytes} bytes; at most {MAX_TARGET_BYTES}", size.0, size.1));
+        }
+        Ok(size)
+    }
+
+    /// The uniform block's bytes for one pass.
+    fn uniform_bytes(&self, params: &ParamSet, time: &FrameTime, pass: PassUniforms<'_>) -> Vec<u8> {
+        let layout = &self.compiled.program.uniforms;
+        let mut bytes = vec![0u8; layout.size as usize];
+        let mut put = |name: &str, values: &[f32], int: bool| {
+            let Some(offset) = layout.offset(name) else { return };
+            for (i, v) in values.iter().enumerate() {
+                let at = offset as usize + 4 * i;
+                let word = if int { (*v as i32).to_le_bytes() } else { v.to_le_bytes() };
+                bytes[at..at + 4].copy_from_slice(&word);
+            }
+        };
+        let date = Settings::read(params).date;
+        put("PASSINDEX", &[pass.index as f32], true);
+        put("FRAMEINDEX", &[time.frame as f32], true);
+        put("TIME", &[time.seconds as f32], false);
+        put("TIMEDELTA", &[time.dt], false);
+        put("RENDERSIZE", &[pass.size.0 as f32, pass.size.1 as f32], false);
+        put("_isf_final", &[f32::from(u8::from(pass.is_final))], true);
+        put("DATE", &[date[0], date[1], date[2], ((f64::from(date[3]) + time.seconds) % 86_400.0) as f32], false);
+        for (k, input) in self.compiled.header.inputs.iter().enumerate() {
+            let Some(value) = self.input_value(k, params) else { continue };
+            match (&input.kind, value) {
+                (InputKind::Long { values, .. }, ParamValue::Enum(i)) => {
+                    put(&input.name, &[values.get(i as usize).copied().unwrap_or(0) as f32], true);
+                }
+                (InputKind::Event, _) => {
+                    put(&format!("_isf_b_{}", input.name), &[f32::from(u8::from(self.fired[k]))], true)
+                }
+                (InputKind::Bool { .. }, ParamValue::Bool(b)) => {
+                    put(&format!("_isf_b_{}", input.name), &[f32::from(u8::from(b))], true);
+                }
+                (_, v) => put(&input.name, &v.components(), false),
+            }
+        }
+        for (name, size) in pass.texture_sizes {
+            put(&format!("_isf_size_{name}"), &[size.0 as f32, size.1 as f32], false);
+        }
+        bytes
+    }
+
+    /// The persistent target `name` at `size` and `format`, made (or remade, cleared) to fit.
+    fn feedback(&mut self, name: &str, size: (u32, u32), format: wgpu::TextureFormat) -> &mut Feedback {
+        let fits = self.feedback.get(name).is_some_and(|f| f.size == size && f.format == format);
+        if !fits {
+            let buffers = PingPong::new(&self.device, &format!("{}/{name}", self.id), size, format);
+            self.feedback.insert(name.to_string(), Feedback { buffers, size, format });
+        }
+        self.feedback.get_mut(name).expect("made above")
+    }
+}
+
+/// What differs between the passes of a frame.
+struct PassUniforms<'a> {
+    index: usize,
+    size: (u32, u32),
+    is_final: bool,
+    texture_sizes: &'a [(String, (u32, u32))],
+}
+
+fn build_pipelines(device: &wgpu::Device, origin: &str, compiled: &Compiled) -> Result<Pipelines, ShaderError> {
+    let visibility = wgpu::ShaderStages::VERTEX_FRAGMENT;
+    let mut entries = vec![
+        wgpu::BindGroupLayoutEntry {
+            binding: UNIFORM_BINDING,
+            visibility,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: wgpu::BufferSize::new(u64::from(compiled.program.uniforms.size)),
+            },
+            count: None,
+        },
+        wgpu::BindGroupLayoutEntry {
+            binding: SAMPLER_BINDING,
+            visibility,
+            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            count: None,
+        },
+    ];
+    entries.extend((0..compiled.program.textures.len()).map(|i| wgpu::BindGroupLayoutEntry {
+        binding: FIRST_TEXTURE_BINDING + i as u32,
+        visibility,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }));
+    let layout =
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("isf"), entries: &entries });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("isf"),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let module = |m: &naga::Module, label: &str| {
+        device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(m.clone())),
+        })
+    };
+    let by_format = crate::gpu::validated(device, origin, || {
+        let (vs, fs) = (module(&compiled.vertex, "isf.vs"), module(&compiled.fragment, "isf.fs"));
+        let mut by_format = BTreeMap::new();
+        for format in [BYTE_FORMAT, FLOAT_FORMAT] {
+            let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(origin),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &vs,
+                    entry_point: Some("main"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module: &fs,
+                    entry_point: Some("main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: None,
+                multisample: wgpu::MultisampleState::default(),
+                multiview_mask: None,
+                cache: None,
+            });
+            by_format.insert(FormatKey::of(format), pipeline);
+        }
+        by_format
+    })?;
+    let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("isf_sampler"),
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        ..Default::default()
+    });
+    Ok(Pipelines { layout, by_format, sampler })
+}
+
+impl Technique for IsfNode {
+    fn simulates_on_gpu(&self) -> bool {
+        // Feedback buffers are state: a sought frame must have run every pass before it.
+        self.compiled.header.passes.iter().any(|p| p.persistent)
+    }
+
+    fn step(&mut self, params: &ParamSet, _time: &FrameTime) {
+        // This step's events only: a frame reached by seeking shows what playing shows.
+        for k in 0..self.compiled.header.inputs.len() {
+            self.fired[k] = matches!(self.input_value(k, params), Some(ParamValue::Trigger(true)));
+        }
+    }
+
+    fn hear(&mut self, audio: &AudioSnapshot) {
+        for texture in self.audio.values() {
+            texture.write(&self.queue, audio);
+        }
+    }
+
+    fn take_messages(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.messages)
+    }
+
+    fn status(&self) -> Option<String> {
+        let h = &self.compiled.header;
+        let role = format!("{:?}", h.role()).to_lowercase();
+        Some(format!(
+            "ISF {role}, {} pass(es){}",
+            h.passes.len(),
+            if h.credit.is_empty() { String::new() } else { format!(" — {}", h.credit) }
+        ))
+    }
+
+    fn add_passes<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        params: &ParamSet,
+        time: &FrameTime,
+        inputs: &[TextureHandle],
+    ) -> TextureHandle {
+        let output = graph.output_size();
+        let header_passes = self.compiled.header.passes.clone();
+        // Sizes first: a bad size (an input driven out of range) keeps the render size, told once.
+        let mut sizes = Vec::with_capacity(header_passes.len());
+        for pass in &header_passes {
+            match self.pass_size(pass, params, output) {
+                Ok(size) => sizes.push(size),
+                Err(problem) => {
+                    if self.size_problem.as_ref() != Some(&problem) {
+                        self.messages.push(format!("{}: {problem}; the pass keeps the render size", self.id));
+                        self.size_problem = Some(problem);
+                    }
+                    sizes.push(output);
+                }
+            }
+        }
+        // Persistent targets, (re)made to their size; both halves imported.
+        let mut feedback_handles: BTreeMap<String, [TextureHandle; 2]> = BTreeMap::new();
+        for (pass, size) in header_passes.iter().zip(&sizes) {
+            let Some(target) = pass.target.as_ref().filter(|_| pass.persistent) else { continue };
+            if feedback_handles.contains_key(target) {
+                continue;
+            }
+            let format = if pass.float { FLOAT_FORMAT } else { BYTE_FORMAT };
+            let id = self.id.clone();
+            let f = self.feedback(target, *size, format);
+            let (write, history) = f.buffers.write_and_history();
+            let write = graph.import_texture(format!("{id}/{target}.next"), write);
+            let history = graph.import_texture(format!("{id}/{target}"), history);
+            feedback_handles.insert(target.clone(), [history, write]);
+        }
+        let black = graph.import_texture(format!("{}/black", self.id), &self.black);
+        // What each texture slot reads now: (handle, size).
+        let slots = self.compiled.program.textures.clone();
+        let mut node_inputs = inputs.iter();
+        let mut current: Vec<Option<(TextureHandle, (u32, u32))>> = Vec::with_capacity(slots.len());
+        for slot in &slots {
+            current.push(match slot.source {
+                TextureSource::Node => node_inputs.next().map(|&h| (h, graph.texture_size(h))),
+                TextureSource::Target => feedback_handles.get(&slot.name).map(|h| {
+                    let f = &self.feedback[&slot.name];
+                    (h[0], f.size)
+                }),
+                TextureSource::Imported => self.imported.get(&slot.name).map(|t| {
+                    let size = (t.texture.width(), t.texture.height());
+                    (graph.import_texture(format!("{}/{}", self.id, slot.name), t), size)
+                }),
+                TextureSource::Audio | TextureSource::AudioFft => self.audio.get(&slot.name).map(|a| {
+                    let size = (a.texture.texture.width(), 1);
+                    (graph.import_texture(format!("{}/{}", self.id, slot.name), &a.texture), size)
+                }),
+            });
+        }
+        let slot_of = |name: &str| slots.iter().position(|s| s.name == name);
+        let target_sizes: BTreeMap<String, (u32, u32)> =
+            header_passes.iter().zip(&sizes).filter_map(|(p, size)| Some((p.target.clone()?, *size))).collect();
+        // Uniforms per pass, built before the passes borrow the node.
+        let mut plans = Vec::with_capacity(header_passes.len());
+        let mut written: BTreeMap<String, usize> = BTreeMap::new();
+        let last = header_passes.len() - 1;
+        for (i, (pass, &size)) in header_passes.iter().zip(&sizes).enumerate() {
+            let to_output = i == last && pass.target.is_none();
+            // A target nothing wrote yet reads black but has its own size (IMG_SIZE).
+            let bound: Vec<(TextureHandle, (u32, u32))> = current
+                .iter()
+                .zip(&slots)
+                .map(|(c, slot)| c.unwrap_or((black, target_sizes.get(&slot.name).copied().unwrap_or((1, 1)))))
+                .collect();
+            let texture_sizes: Vec<(String, (u32, u32))> =
+                slots.iter().zip(&bound).map(|(s, b)| (s.name.clone(), b.1)).collect();
+            let bytes = self.uniform_bytes(
+                params,
+                time,
+                PassUniforms { index: i, size, is_final: to_output, texture_sizes: &texture_sizes },
+            );
+            let (dest, format) = match &pass.target {
+                _ if to_output => (
+                    graph.create_texture(format!("{}/image", self.id), TextureDesc::full(OUTPUT_FORMAT)),
+                    OUTPUT_FORMAT,
+                ),
+                Some(target) if pass.persistent => {
+                    let writes = written.entry(target.clone()).or_insert(0);
+                    let handles = feedback_handles[target];
+                    // Ping-pong: the first write of a frame goes to the other half, a second
+                    // write back to the first, and so on.
+                    let dest = handles[1 - *writes % 2];
+                    *writes += 1;
+                    (dest, if pass.float { FLOAT_FORMAT } else { BYTE_FORMAT })
+                }
+                Some(target) => {
+                    let format = if pass.float { FLOAT_FORMAT } else { BYTE_FORMAT };
+                    let desc =
+                        TextureDesc { extent: Extent::Absolute(size.0, size.1), format, layers: None, samples: 1 };
+                    (graph.create_texture(format!("{}/{target}", self.id), desc), format)
+                }
+                None => {
+                    // A pass without a target before the last: it renders into a scratch image
+                    // that nothing reads (as in GL hosts); still drawn, for its side effects.
+                    let desc = TextureDesc {
+                        extent: Extent::Absolute(size.0, size.1),
+                        format: BYTE_FORMAT,
+                        layers: None,
+                        samples: 1,
+                    };
+                    (graph.create_texture(format!("{}/pass{i}", self.id), desc), BYTE_FORMAT)
+                }
+            };
+            if let Some(k) = pass.target.as_ref().and_then(|t| slot_of(t)).filter(|_| !to_output) {
+                current[k] = Some((dest, size));
+            }
+            plans.push((bound.into_iter().map(|b| b.0).collect::<Vec<_>>(), dest, format, bytes));
+        }
+        self.fired.iter_mut().for_each(|f| *f = false);
+        // Feedback halves swap once per write this frame.
+        for (target, writes) in &written {
+            if writes % 2 == 1
+                && let Some(f) = self.feedback.get_mut(target)
+            {
+                f.buffers.swap();
+            }
+        }
+        let last_target = header_passes[last].target.as_ref();
+        let Self { pipelines, passes, present, id, .. } = self;
+        let pipelines = &*pipelines;
+        let mut image = None;
+        for (i, ((bound, dest, format, bytes), state)) in plans.into_iter().zip(passes.iter_mut()).enumerate() {
+            let mut builder = graph.add_pass(format!("{id}/pass{i}"));
+            let mut read = bound.clone();
+            read.sort_by_key(|h| h.0);
+            read.dedup();
+            for h in read {
+                builder = builder.read(h);
+            }
+            if header_passes[i].persistent {
+                builder = builder.side_effect();
+            }
+            builder.render_target(dest).record(move |ctx| {
+                ctx.queue.write_buffer(&state.uniforms, 0, &bytes);
+                state.groups.begin_frame();
+                let mut key: Vec<u64> = bound.iter().map(|&h| ctx.texture_id(h)).collect();
+                key.push(0);
+                let group = state
+                    .groups
+                    .get_or_create(key, || {
+                        let mut entries = vec![
+                            wgpu::BindGroupEntry {
+                                binding: UNIFORM_BINDING,
+                                resource: state.uniforms.as_entire_binding(),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: SAMPLER_BINDING,
+                                resource: wgpu::BindingResource::Sampler(&pipelines.sampler),
+                            },
+                        ];
+                        for (k, &h) in bound.iter().enumerate() {
+                            entries.push(wgpu::BindGroupEntry {
+                                binding: FIRST_TEXTURE_BINDING + k as u32,
+                                resource: wgpu::BindingResource::TextureView(ctx.view(h)),
+                            });
+                        }
+                        ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                            label: Some("isf"),
+                            layout: &pipelines.layout,
+                            entries: &entries,
+                        })
+                    })
+                    .clone();
+                let mut rp = ctx.begin_color_pass(dest, wgpu::Color::TRANSPARENT);
+                rp.set_pipeline(&pipelines.by_format[&FormatKey::of(format)]);
+                rp.set_bind_group(0, &group, &[]);
+                rp.draw(0..6, 0..1);
+            });
+            if i == last && last_target.is_none() {
+                image = Some(dest);
+            }
+        }
+        if let Some(target) = last_target {
+            // The last pass wrote a buffer: the node's image is that buffer, made linear.
+            let k = slots.iter().position(|s| &s.name == target).expect("every target has a slot");
+            let (source, _) = current[k].unwrap_or((black, (1, 1)));
+            let (kernel, pass) = present;
+            image =
+                Some(pass.declare(graph, &format!("{id}/present"), kernel, PresentUniforms { pad: [0; 4] }, &[source]));
+        }
+        image.expect("the last pass makes the image")
+    }
+}
