@@ -326,15 +326,16 @@ pub fn parse_value_override(text: &str, decl: &ParamDecl) -> Result<ParamValue, 
 /// looked up in `scenes/` (disk first, then the built-in copies).
 ///
 /// A show (`shows/<name>`, or a file whose top level has `layers`) loads as the flat scene of
-/// all its clips (see [`super::show`]): every command takes shows where it takes scenes. An ISF
-/// shader (`.fs`) loads as a scene of its own (see [`techniques::isf::scene_for`]).
+/// all its clips (see [`super::show`]): every command takes shows where it takes scenes. A file a
+/// technique plays (an ISF shader, `.fs`) loads as a scene of its own (see
+/// [`techniques::Declarer::scene_for`]).
 pub fn load_scene(assets: &Assets, name_or_path: &str) -> Result<Scene, SceneErrors> {
     if names_a_show(name_or_path) {
         return super::show::load_show(assets, name_or_path, false);
     }
-    if name_or_path.ends_with(".fs") {
-        // A bare ISF shader plays as a generated one-node scene (a filter over a default input).
-        let text = techniques::isf::scene_for(assets, name_or_path).map_err(|e| {
+    if let Some((_, declarer)) = techniques::file_technique(name_or_path) {
+        // A bare shader file (ISF) plays as a generated scene (a filter over a default input).
+        let text = (declarer.scene_for)(assets, name_or_path).map_err(|e| {
             SceneErrors(vec![SceneError {
                 origin: e.origin,
                 line: e.line as usize,

@@ -97,8 +97,19 @@ pub struct TechniqueInfo {
 pub struct Declarer {
     /// The text parameter naming the file.
     pub file_param: &'static str,
+    /// The extension of such files (`fs`): a file of it named on the command line plays as a
+    /// scene of its own, and names a show transition.
+    pub extension: &'static str,
     /// Reads the file a node names: its parameters and input slots, or one located sentence.
     pub declare: fn(&Assets, &str) -> Result<Declared, String>,
+    /// The scene text that plays such a file on its own (inputs wired to default sources).
+    pub scene_for: fn(&Assets, &str) -> Result<String, ShaderError>,
+}
+
+/// The technique that plays files like `path` (by extension; see [`Declarer`]).
+pub fn file_technique(path: &str) -> Option<(&'static TechniqueInfo, Declarer)> {
+    let ext = std::path::Path::new(path).extension()?.to_str()?;
+    REGISTRY.iter().find_map(|t| t.declare.filter(|d| d.extension == ext).map(|d| (t, d)))
 }
 
 /// What a file declares for a node (see [`Declarer`]).

@@ -532,15 +532,18 @@ fn budget(scene: &Scene, show: &Show) -> Result<(), String> {
     })
 }
 
-/// Why ISF file `file` cannot be a transition (it does not compile, or lacks `startImage`,
-/// `endImage` or `progress`), if it cannot.
+/// Why shader file `file` cannot be a transition (it does not load, or lacks the image inputs
+/// `startImage` and `endImage` or a `progress`), if it cannot.
 fn isf_transition_problem(assets: &Assets, file: &str) -> Option<String> {
-    use crate::techniques::isf::{IsfFiles, header::Role};
-    let header = match IsfFiles::read(assets, file).and_then(|f| f.compile().map_err(|e| e.to_string())) {
-        Ok(compiled) => compiled.header,
-        Err(e) => return Some(e),
-    };
-    (header.role() != Role::Transition).then(|| {
-        format!("{file} is not an ISF transition: it needs image inputs startImage and endImage and a progress")
-    })
+    let (_, declarer) = crate::techniques::file_technique(file)?;
+    match (declarer.declare)(assets, file) {
+        Err(e) => Some(e),
+        Ok(d) => {
+            let has = |slot: &str| d.inputs.iter().any(|i| i == slot);
+            let transition = has("startImage") && has("endImage") && d.params.iter().any(|p| p.name == "progress");
+            (!transition).then(|| {
+                format!("{file} is not an ISF transition: it needs image inputs startImage and endImage and a progress")
+            })
+        }
+    }
 }

@@ -17,7 +17,7 @@ use crate::gpu::{Gpu, JoinedSource, ShaderError};
 use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamSet, ParamValue, Text};
 use crate::techniques::image_pass::{ImageKernel, ImagePass};
-use crate::techniques::{NodeSetup, Technique, isf};
+use crate::techniques::{self, NodeSetup, Technique};
 use crate::time::FrameTime;
 
 use super::{LayerView, Show};
@@ -61,10 +61,10 @@ pub struct TransitionUniforms {
     pub pad2: [f32; 2],
 }
 
-/// Whether transition kind `kind` is an ISF shader (`startImage`, `endImage`, `progress`) —
-/// a path to a `.fs` file — rather than a WGSL transition's name.
+/// Whether transition kind `kind` is a shader file a technique plays (an ISF transition:
+/// `startImage`, `endImage`, `progress`) rather than a WGSL transition's name.
 pub fn is_isf(kind: &str) -> bool {
-    kind.ends_with(".fs")
+    techniques::file_technique(kind).is_some()
 }
 
 /// An ISF transition for one layer: the shader as a node, and its parameters (`progress` set
@@ -137,18 +137,19 @@ impl Mixer {
 /// ISF transition `file` for layer `layer`, built as an `isf` node would be.
 fn isf_transition(gpu: &Gpu, assets: &Assets, file: &str, layer: usize) -> Result<IsfTransition, ShaderError> {
     let located = |message: String| ShaderError { origin: file.to_string(), line: 1, column: 1, message };
-    let declared =
-        (isf::INFO.declare.expect("the isf technique declares its inputs").declare)(assets, file).map_err(located)?;
-    let mut decls = (isf::INFO.params)();
+    let (technique, declarer) =
+        techniques::file_technique(file).ok_or_else(|| located("no technique plays this file".into()))?;
+    let declared = (declarer.declare)(assets, file).map_err(located)?;
+    let mut decls = (technique.params)();
     decls.extend(declared.params);
     let mut params = ParamSet::new(decls);
     let index = |name: &str| params.index(name).ok_or_else(|| located(format!("an ISF transition needs '{name}'")));
-    let (file_param, progress) = (index("file")?, index("progress")?);
+    let (file_param, progress) = (index(declarer.file_param)?, index("progress")?);
     params.set_at(file_param, ParamValue::Text(Text::new(file)));
     params.snap();
     let id = format!("show/layer{}/transition", layer + 1);
     let setup = NodeSetup { gpu, assets, id: &id, output_size: (1920, 1080), msaa: 1, params: &params, seed: 0 };
-    let node = (isf::INFO.create)(&setup)?;
+    let node = (technique.create)(&setup)?;
     Ok(IsfTransition { node, params, progress })
 }
 

@@ -39,7 +39,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create: node::create,
     check: None,
     stage: None,
-    declare: Some(Declarer { file_param: "file", declare }),
+    declare: Some(Declarer { file_param: "file", extension: "fs", declare, scene_for }),
 };
 
 crate::technique_params! {
