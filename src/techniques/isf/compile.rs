@@ -4,7 +4,7 @@
 
 use naga::front::glsl::{Frontend, Options};
 
-use super::header::Header;
+use super::header::{Header, InputKind};
 use super::translate::{Program, Stage, translate};
 use crate::gpu::ShaderError;
 
@@ -19,6 +19,9 @@ pub struct Compiled {
     pub vertex: naga::Module,
     /// The fragment stage.
     pub fragment: naga::Module,
+    /// The compute variants (see [`Program::compute`]), one per storage format, where the shader
+    /// has them and naga takes them; `None`: it is rasterised.
+    pub compute: Option<[naga::Module; 2]>,
 }
 
 /// The `.fs` text and, if there is one, the `.vs` companion, each with the origin its errors name.
@@ -33,6 +36,7 @@ pub struct Sources<'a> {
 pub fn compile(sources: &Sources<'_>) -> Result<Compiled, ShaderError> {
     let (fs_origin, fs) = sources.fs;
     let header = Header::parse(fs).map_err(|(line, message)| located(fs_origin, line, 1, message))?;
+    check_sizes(&header).map_err(|message| located(fs_origin, header.passes_line, 1, message))?;
     let program = translate(&header, fs, sources.vs.map(|v| v.1)).map_err(|(stage, line, message)| {
         let origin = if stage == "vs" { sources.vs.map_or(fs_origin, |v| v.0) } else { fs_origin };
         located(origin, line, 1, message)
@@ -40,7 +44,48 @@ pub fn compile(sources: &Sources<'_>) -> Result<Compiled, ShaderError> {
     let vs_origin = sources.vs.map_or("<indra>/isf_default.vs", |v| v.0);
     let fragment = stage_module(fs_origin, &program.fragment, naga::ShaderStage::Fragment)?;
     let vertex = stage_module(vs_origin, &program.vertex, naga::ShaderStage::Vertex)?;
-    Ok(Compiled { header, program, vertex, fragment })
+    // The fragment stage is what errors are reported from; a compute variant naga refuses
+    // (a construct only rasterising allows) leaves the shader rasterised.
+    let compute = program.compute.as_ref().and_then(|[a, b]| {
+        let module = |s: &Stage| stage_module(fs_origin, s, naga::ShaderStage::Compute).ok();
+        Some([module(a)?, module(b)?])
+    });
+    Ok(Compiled { header, program, vertex, fragment, compute })
+}
+
+/// The size expressions of every pass, evaluated at 1920×1080 with the inputs' defaults: one
+/// that does not parse, names an unknown variable, or gives 0, a negative or a non-finite
+/// number is refused with the file (the node checks again each frame, against the device).
+fn check_sizes(header: &Header) -> Result<(), String> {
+    let defaults: Vec<(String, f64)> = header
+        .inputs
+        .iter()
+        .filter_map(|i| {
+            let v = match &i.kind {
+                InputKind::Float { default, .. } => f64::from(*default),
+                InputKind::Long { values, default, .. } => f64::from(values[*default as usize]),
+                InputKind::Bool { default } => f64::from(u8::from(*default)),
+                InputKind::Event => 0.0,
+                _ => return None,
+            };
+            Some((i.name.clone(), v))
+        })
+        .collect();
+    let var = |name: &str| match name {
+        "WIDTH" => Some(1920.0),
+        "HEIGHT" => Some(1080.0),
+        _ => defaults.iter().find(|(n, _)| n == name).map(|d| d.1),
+    };
+    for (i, pass) in header.passes.iter().enumerate() {
+        for (axis, text) in [("WIDTH", &pass.width), ("HEIGHT", &pass.height)] {
+            let Some(text) = text else { continue };
+            let v = super::expr::evaluate(text, &var).map_err(|e| format!("{axis} of pass {i}: {e}"))?;
+            if !v.is_finite() || v <= 0.0 || v > 65_536.0 {
+                return Err(format!("{axis} of pass {i}, '{text}', is {v} at 1920×1080; it must be a size in pixels"));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn stage_module(origin: &str, stage: &Stage, kind: naga::ShaderStage) -> Result<naga::Module, ShaderError> {
@@ -84,6 +129,18 @@ mod tests {
         assert_eq!((e.origin.as_str(), e.line), ("t.fs", 4), "{e}");
         let bad_header = compile_file("/*{ \"INPUTS\": [ }*/ void main() {}").unwrap_err();
         assert!(bad_header.message.contains("not JSON"), "{bad_header}");
+    }
+
+    #[test]
+    fn a_bad_size_expression_is_located_at_passes() {
+        for (expression, says) in [("floor($WIDTH", "floor"), ("$WIDTH - $WIDTH", "is 0"), ("$DEPTH", "$DEPTH")] {
+            let fs = format!(
+                "/*{{\n\"PASSES\": [\n {{ \"TARGET\": \"a\", \"WIDTH\": \"{expression}\" }}, {{}} ] }}*/\nvoid main() {{}}\n"
+            );
+            let e = compile_file(&fs).unwrap_err();
+            assert_eq!(e.line, 2, "{e}");
+            assert!(e.message.contains(says), "{e}");
+        }
     }
 
     #[test]

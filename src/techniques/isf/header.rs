@@ -116,6 +116,8 @@ pub struct Header {
     pub imported: Vec<(String, String)>,
     /// The 1-based line the `.fs` body starts on after the header (for messages).
     pub body_line: u32,
+    /// The 1-based line of `PASSES` (where a bad size expression is reported).
+    pub passes_line: u32,
 }
 
 /// What a shader is by its inputs: a generator, a filter (`inputImage`) or a transition
@@ -172,6 +174,7 @@ impl Header {
                 header.inputs.push(input);
             }
         }
+        header.passes_line = at("PASSES");
         header.passes = parse_passes(&top).map_err(|m| (at("PASSES"), m))?;
         header.imported = parse_imported(&top).map_err(|m| (at("IMPORTED"), m))?;
         Ok(header)

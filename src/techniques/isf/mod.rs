@@ -225,8 +225,11 @@ mod tests {
         assert_eq!(names.len(), 64, "{names:?}");
         for name in names {
             let declared = declare(&assets, name).unwrap_or_else(|e| panic!("{e}"));
-            let h = IsfFiles::read(&assets, name).unwrap().compile().unwrap().header;
-            assert_eq!(declared.inputs, h.image_inputs());
+            let files = IsfFiles::read(&assets, name).unwrap();
+            let compiled = files.compile().unwrap();
+            assert_eq!(declared.inputs, compiled.header.image_inputs());
+            // Every shader without a vertex stage runs as a compute shader.
+            assert_eq!(compiled.compute.is_some(), files.vs.is_none(), "{name}");
         }
     }
 }

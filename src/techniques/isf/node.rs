@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use super::compile::Compiled;
 use super::header::{InputKind, Pass};
-use super::translate::{FIRST_TEXTURE_BINDING, SAMPLER_BINDING, TextureSource, UNIFORM_BINDING};
+use super::translate::{FIRST_TEXTURE_BINDING, SAMPLER_BINDING, TextureSource, UNIFORM_BINDING, storage_binding};
 use super::{IsfFiles, Settings};
 use crate::gpu::{BindGroupCache, DEFAULT_MAX_AGE, ShaderError};
 use crate::graph::{Extent, FrameGraph, PersistentTexture, PingPong, TextureDesc, TextureHandle};
@@ -44,10 +44,16 @@ pub fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> 
 
 /// The pipelines of one compiled shader.
 struct Pipelines {
-    layout: wgpu::BindGroupLayout,
-    /// Target format → pipeline.
-    by_format: BTreeMap<FormatKey, wgpu::RenderPipeline>,
+    /// Target format → its bind group layout and pipeline.
+    by_format: BTreeMap<FormatKey, (wgpu::BindGroupLayout, Pipeline)>,
     sampler: wgpu::Sampler,
+}
+
+/// How a pass runs: as a compute shader writing a storage image where the shader allows it, or
+/// rasterised (a `.vs`, varyings, derivatives).
+enum Pipeline {
+    Compute(wgpu::ComputePipeline),
+    Raster(wgpu::RenderPipeline),
 }
 
 /// `wgpu::TextureFormat` is not `Ord`: formats by the two this node renders.
@@ -373,7 +379,8 @@ struct PassUniforms<'a> {
 }
 
 fn build_pipelines(device: &wgpu::Device, origin: &str, compiled: &Compiled) -> Result<Pipelines, ShaderError> {
-    let visibility = wgpu::ShaderStages::VERTEX_FRAGMENT;
+    let compute = compiled.compute.is_some();
+    let visibility = if compute { wgpu::ShaderStages::COMPUTE } else { wgpu::ShaderStages::VERTEX_FRAGMENT };
     let mut entries = vec![
         wgpu::BindGroupLayoutEntry {
             binding: UNIFORM_BINDING,
@@ -392,7 +399,8 @@ fn build_pipelines(device: &wgpu::Device, origin: &str, compiled: &Compiled) -> 
             count: None,
         },
     ];
-    entries.extend((0..compiled.program.textures.len()).map(|i| wgpu::BindGroupLayoutEntry {
+    let textures = compiled.program.textures.len();
+    entries.extend((0..textures).map(|i| wgpu::BindGroupLayoutEntry {
         binding: FIRST_TEXTURE_BINDING + i as u32,
         visibility,
         ty: wgpu::BindingType::Texture {
@@ -402,13 +410,6 @@ fn build_pipelines(device: &wgpu::Device, origin: &str, compiled: &Compiled) -> 
         },
         count: None,
     }));
-    let layout =
-        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("isf"), entries: &entries });
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("isf"),
-        bind_group_layouts: &[Some(&layout)],
-        immediate_size: 0,
-    });
     let module = |m: &naga::Module, label: &str| {
         device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(label),
@@ -416,35 +417,64 @@ fn build_pipelines(device: &wgpu::Device, origin: &str, compiled: &Compiled) -> 
         })
     };
     let by_format = crate::gpu::validated(device, origin, || {
-        let (vs, fs) = (module(&compiled.vertex, "isf.vs"), module(&compiled.fragment, "isf.fs"));
         let mut by_format = BTreeMap::new();
-        for format in [BYTE_FORMAT, FLOAT_FORMAT] {
-            let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(origin),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &vs,
-                    entry_point: Some("main"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                fragment: Some(wgpu::FragmentState {
-                    module: &fs,
-                    entry_point: Some("main"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
+        for (k, format) in [BYTE_FORMAT, FLOAT_FORMAT].into_iter().enumerate() {
+            let mut entries = entries.clone();
+            if compute {
+                entries.push(wgpu::BindGroupLayoutEntry {
+                    binding: storage_binding(textures),
+                    visibility,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
                         format,
-                        blend: None,
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: None,
-                multisample: wgpu::MultisampleState::default(),
-                multiview_mask: None,
-                cache: None,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                });
+            }
+            let layout = device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("isf"), entries: &entries });
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("isf"),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
             });
-            by_format.insert(FormatKey::of(format), pipeline);
+            let pipeline = match &compiled.compute {
+                Some(variants) => Pipeline::Compute(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(origin),
+                    layout: Some(&pipeline_layout),
+                    module: &module(&variants[k], "isf.compute"),
+                    entry_point: Some("main"),
+                    compilation_options: Default::default(),
+                    cache: None,
+                })),
+                None => Pipeline::Raster(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(origin),
+                    layout: Some(&pipeline_layout),
+                    vertex: wgpu::VertexState {
+                        module: &module(&compiled.vertex, "isf.vs"),
+                        entry_point: Some("main"),
+                        compilation_options: Default::default(),
+                        buffers: &[],
+                    },
+                    fragment: Some(wgpu::FragmentState {
+                        module: &module(&compiled.fragment, "isf.fs"),
+                        entry_point: Some("main"),
+                        compilation_options: Default::default(),
+                        targets: &[Some(wgpu::ColorTargetState {
+                            format,
+                            blend: None,
+                            write_mask: wgpu::ColorWrites::ALL,
+                        })],
+                    }),
+                    primitive: wgpu::PrimitiveState::default(),
+                    depth_stencil: None,
+                    multisample: wgpu::MultisampleState::default(),
+                    multiview_mask: None,
+                    cache: None,
+                })),
+            };
+            by_format.insert(FormatKey::of(format), (layout, pipeline));
         }
         by_format
     })?;
@@ -454,7 +484,7 @@ fn build_pipelines(device: &wgpu::Device, origin: &str, compiled: &Compiled) -> 
         min_filter: wgpu::FilterMode::Linear,
         ..Default::default()
     });
-    Ok(Pipelines { layout, by_format, sampler })
+    Ok(Pipelines { by_format, sampler })
 }
 
 impl Technique for IsfNode {
@@ -607,7 +637,7 @@ impl Technique for IsfNode {
             if let Some(k) = pass.target.as_ref().and_then(|t| slot_of(t)).filter(|_| !to_output) {
                 current[k] = Some((dest, size));
             }
-            plans.push((bound.into_iter().map(|b| b.0).collect::<Vec<_>>(), dest, format, bytes));
+            plans.push((bound.into_iter().map(|b| b.0).collect::<Vec<_>>(), dest, format, bytes, size));
         }
         self.fired.iter_mut().for_each(|f| *f = false);
         // Feedback halves swap once per write this frame.
@@ -622,7 +652,7 @@ impl Technique for IsfNode {
         let Self { pipelines, passes, present, id, .. } = self;
         let pipelines = &*pipelines;
         let mut image = None;
-        for (i, ((bound, dest, format, bytes), state)) in plans.into_iter().zip(passes.iter_mut()).enumerate() {
+        for (i, ((bound, dest, format, bytes, size), state)) in plans.into_iter().zip(passes.iter_mut()).enumerate() {
             let mut builder = graph.add_pass(format!("{id}/pass{i}"));
             let mut read = bound.clone();
             read.sort_by_key(|h| h.0);
@@ -633,11 +663,16 @@ impl Technique for IsfNode {
             if header_passes[i].persistent {
                 builder = builder.side_effect();
             }
-            builder.render_target(dest).record(move |ctx| {
+            let (layout, pipeline) = &pipelines.by_format[&FormatKey::of(format)];
+            let builder = match pipeline {
+                Pipeline::Compute(_) => builder.write(dest),
+                Pipeline::Raster(_) => builder.render_target(dest),
+            };
+            builder.record(move |ctx| {
                 ctx.queue.write_buffer(&state.uniforms, 0, &bytes);
                 state.groups.begin_frame();
                 let mut key: Vec<u64> = bound.iter().map(|&h| ctx.texture_id(h)).collect();
-                key.push(0);
+                key.push(ctx.texture_id(dest));
                 let group = state
                     .groups
                     .get_or_create(key, || {
@@ -657,17 +692,37 @@ impl Technique for IsfNode {
                                 resource: wgpu::BindingResource::TextureView(ctx.view(h)),
                             });
                         }
+                        if matches!(pipeline, Pipeline::Compute(_)) {
+                            entries.push(wgpu::BindGroupEntry {
+                                binding: storage_binding(bound.len()),
+                                resource: wgpu::BindingResource::TextureView(ctx.view(dest)),
+                            });
+                        }
                         ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                             label: Some("isf"),
-                            layout: &pipelines.layout,
+                            layout,
                             entries: &entries,
                         })
                     })
                     .clone();
-                let mut rp = ctx.begin_color_pass(dest, wgpu::Color::TRANSPARENT);
-                rp.set_pipeline(&pipelines.by_format[&FormatKey::of(format)]);
-                rp.set_bind_group(0, &group, &[]);
-                rp.draw(0..6, 0..1);
+                match pipeline {
+                    Pipeline::Compute(pipeline) => {
+                        let mut cp = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                            label: Some("isf"),
+                            timestamp_writes: None,
+                        });
+                        cp.set_pipeline(pipeline);
+                        cp.set_bind_group(0, &group, &[]);
+                        cp.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+                    }
+                    Pipeline::Raster(pipeline) => {
+                        // Cleared first, as GL hosts do: a .vs may move the quad off some pixels.
+                        let mut rp = ctx.begin_color_pass(dest, wgpu::Color::TRANSPARENT);
+                        rp.set_pipeline(pipeline);
+                        rp.set_bind_group(0, &group, &[]);
+                        rp.draw(0..6, 0..1);
+                    }
+                }
             });
             if i == last && last_target.is_none() {
                 image = Some(dest);

@@ -407,3 +407,25 @@ void main() {
     let e = indra::scene::show::parse_show(&assets, "isf-show.ron", &filter, false).err().unwrap().to_string();
     assert!(e.contains("not an ISF transition"), "{e}");
 }
+
+#[test]
+fn an_imported_image_is_read_beside_the_shader_the_right_way_up() {
+    let (dir, assets) = shader_dir("imported");
+    // Two pixels: red on top, blue below.
+    let mut image = image::RgbaImage::new(1, 2);
+    image.put_pixel(0, 0, image::Rgba([255, 0, 0, 255]));
+    image.put_pixel(0, 1, image::Rgba([0, 0, 255, 255]));
+    image.save(dir.join("two.png")).unwrap();
+    let file = dir.join("imported.fs");
+    let shader = r#"/*{ "IMPORTED": { "two": { "PATH": "two.png" } } }*/
+void main() { gl_FragColor = IMG_NORM_PIXEL(two, vec2(0.5, isf_FragNormCoord.y > 0.5 ? 0.75 : 0.25)); }
+"#;
+    std::fs::write(&file, shader).unwrap();
+    let frame = &render(&assets, &scene(&file, "", ""), (16, 16), &[0])[0];
+    assert_eq!((rgb(frame, 8, 2), rgb(frame, 8, 13)), ([255, 0, 0], [0, 0, 255]));
+    // A missing file is one message naming it; the scene does not start.
+    std::fs::write(&file, shader.replace("two.png", "gone.png")).unwrap();
+    let scene = parse_scene_with(&assets, "isf.ron", &scene(&file, "", "")).unwrap();
+    let e = OffscreenRenderer::new(gpu(), &assets, scene, Some((16, 16)), None, None).err().unwrap().to_string();
+    assert!(e.contains("IMPORTED 'two'") && e.contains("gone.png"), "{e}");
+}

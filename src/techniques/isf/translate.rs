@@ -126,7 +126,24 @@ pub struct Program {
     pub uniforms: UniformLayout,
     /// The textures, bound from [`FIRST_TEXTURE_BINDING`] on, in this order.
     pub textures: Vec<TextureSlot>,
+    /// The same fragment shader as a compute shader writing a storage image (one per target
+    /// format: `rgba8`, `rgba16f`), where it needs nothing only rasterising gives — no `.vs`, no
+    /// varyings, no derivatives or `discard`. GPUs built for compute (the H200) rasterise at a
+    /// fraction of their memory bandwidth; this runs at full speed on all.
+    pub compute: Option<[Stage; 2]>,
 }
+
+/// The binding of the storage image a compute variant writes: after the textures.
+pub fn storage_binding(textures: usize) -> u32 {
+    FIRST_TEXTURE_BINDING + textures as u32
+}
+
+/// The storage formats of [`Program::compute`], in order.
+pub const COMPUTE_FORMATS: [&str; 2] = ["rgba8", "rgba16f"];
+
+/// Identifiers a shader may use only when rasterised.
+const FRAGMENT_ONLY: &[&str] =
+    &["dFdx", "dFdy", "fwidth", "discard", "gl_FrontFacing", "gl_PointCoord", "gl_FragDepth"];
 
 /// One stage's translated text.
 #[derive(Clone, Debug)]
@@ -241,7 +258,7 @@ pub fn translate(header: &Header, fs: &str, vs: Option<&str>) -> Result<Program,
     let vertex = assemble(
         &[
             "#version 450".into(),
-            declarations,
+            declarations.clone(),
             format!("{COMMON} layout(location = 0) out vec2 isf_FragNormCoord; {VERT_INIT}"),
         ],
         &vs_out.text,
@@ -250,7 +267,45 @@ pub fn translate(header: &Header, fs: &str, vs: Option<&str>) -> Result<Program,
             vs_out.inits, vs_out.copies
         ),
     );
-    Ok(Program { fragment, vertex, uniforms, textures })
+    let rasterised_only =
+        vs.is_some() || !fs_out.varyings.is_empty() || FRAGMENT_ONLY.iter().any(|w| contains_word(&fs_out.text, w));
+    let compute = (!rasterised_only).then(|| {
+        COMPUTE_FORMATS.map(|format| {
+            let binding = storage_binding(textures.len());
+            assemble(
+                &[
+                    "#version 450".into(),
+                    format!("layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in; {declarations}"),
+                    format!(
+                        "layout(set = 0, binding = {binding}, {format}) uniform writeonly image2D _isf_dst; {COMMON} \
+                         vec2 isf_FragNormCoord;"
+                    ),
+                    "vec4 isf_FragColor; vec4 isf_FragCoord;".into(),
+                ],
+                &fs_out.text,
+                &format!(
+                    "void main() {{ ivec2 _isf_p = ivec2(gl_GlobalInvocationID.xy); \
+                     if (_isf_p.x >= int(RENDERSIZE.x) || _isf_p.y >= int(RENDERSIZE.y)) {{ return; }} \
+                     vec2 _isf_c = vec2(_isf_p) + 0.5; \
+                     isf_FragNormCoord = vec2(_isf_c.x / RENDERSIZE.x, 1.0 - _isf_c.y / RENDERSIZE.y); \
+                     isf_FragCoord = vec4(_isf_c.x, RENDERSIZE.y - _isf_c.y, 0.5, 1.0); \
+                     isf_FragColor = vec4(0.0); {} isf_main(); \
+                     imageStore(_isf_dst, _isf_p, _isf_final != 0 ? _isf_decode(isf_FragColor) : isf_FragColor); }}",
+                    fs_out.inits
+                ),
+            )
+        })
+    });
+    Ok(Program { fragment, vertex, uniforms, textures, compute })
+}
+
+/// Whether `word` occurs in `text` as a whole identifier.
+fn contains_word(text: &str, word: &str) -> bool {
+    text.match_indices(word).any(|(i, _)| {
+        let before = text[..i].bytes().next_back().is_none_or(|c| !is_ident(c));
+        let after = text[i + word.len()..].bytes().next().is_none_or(|c| !is_ident(c));
+        before && after
+    })
 }
 
 /// The vertex stage when a shader has no `.vs`.
