@@ -34,20 +34,25 @@ pub fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bo
     }
 }
 
+/// A bind-group layout entry for a filterable 2-D float texture at `binding` (a node's image).
+pub fn texture_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
 /// The two layout entries of a filtered 2-D float texture at `binding` and its sampler at
 /// `binding + 1` (how a node samples an upstream node's image).
 pub fn sampled_texture_entries(binding: u32, visibility: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 2] {
     [
-        wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        },
+        texture_entry(binding, visibility),
         wgpu::BindGroupLayoutEntry {
             binding: binding + 1,
             visibility,

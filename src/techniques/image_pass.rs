@@ -71,16 +71,7 @@ impl ImageKernel {
                 count: None,
             },
         ];
-        entries.extend((0..inputs.min(MAX_INPUTS)).map(|i| wgpu::BindGroupLayoutEntry {
-            binding: 2 + i as u32,
-            visibility: stage,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        }));
+        entries.extend((0..inputs.min(MAX_INPUTS)).map(|i| crate::gpu::texture_entry(2 + i as u32, stage)));
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: DST_BINDING,
             visibility: stage,

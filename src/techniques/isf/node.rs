@@ -400,16 +400,7 @@ fn build_pipelines(device: &wgpu::Device, origin: &str, compiled: &Compiled) -> 
         },
     ];
     let textures = compiled.program.textures.len();
-    entries.extend((0..textures).map(|i| wgpu::BindGroupLayoutEntry {
-        binding: FIRST_TEXTURE_BINDING + i as u32,
-        visibility,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: true },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    }));
+    entries.extend((0..textures).map(|i| crate::gpu::texture_entry(FIRST_TEXTURE_BINDING + i as u32, visibility)));
     let module = |m: &naga::Module, label: &str| {
         device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(label),
