@@ -111,6 +111,11 @@ pub struct RunArgs {
     /// later takes (panel button, OSC /indra/record/start) go beside it. Never overwrites.
     #[arg(long, value_name = "FILE")]
     pub record_video: Option<PathBuf>,
+    /// Send the output as shown to a network stream from the start: srt://HOST:PORT,
+    /// udp://HOST:PORT or rtmp://HOST/APP/KEY (H.264 tuned for latency, through ffmpeg). The show
+    /// never waits for the network: frames the encoder cannot take are dropped and counted.
+    #[arg(long, value_name = "URL")]
+    pub stream: Option<String>,
 }
 
 /// Where OSC listens unless told otherwise: loopback, so nothing on the network can reach it.
@@ -146,6 +151,7 @@ impl Default for RunArgs {
             audio_learn: "audio-learn.ron".into(),
             no_watch: false,
             record_video: None,
+            stream: None,
         }
     }
 }
@@ -177,6 +183,11 @@ pub struct RenderArgs {
     /// 422 HQ; .webm: VP9), through ffmpeg, at 1/dt frames per second.
     #[arg(long, value_name = "FILE")]
     pub video: Option<PathBuf>,
+    /// Send the frames to a network stream instead: srt://HOST:PORT, udp://HOST:PORT or
+    /// rtmp://HOST/APP/KEY — H.264 tuned for latency (no B-frames, a keyframe a second) in
+    /// MPEG-TS (FLV for RTMP), through ffmpeg.
+    #[arg(long, value_name = "URL", conflicts_with = "video")]
+    pub stream: Option<String>,
     /// Video codec: h264, h265, prores, vp9, av1, ffv1, hap, hap_alpha, hap_q (in .mov; clips
     /// indra and VJ tools play frame-exact), or an ffmpeg encoder name (default: the container's).
     #[arg(long, requires = "video")]
@@ -345,6 +356,7 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         monitor: args.monitor,
         watch: !args.no_watch,
         record_video: args.record_video.clone(),
+        stream: args.stream.clone(),
     };
     let web = match &args.web {
         Some(addr) => {
@@ -426,6 +438,12 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     let fps = 1.0 / dt;
     // ffmpeg starts before the GPU and the seek, so a missing one or a bad codec fails at once.
     let mut sink = match &args.video {
+        None if args.stream.is_some() => {
+            let url = args.stream.clone().unwrap_or_default();
+            let settings =
+                VideoSettings { path: url.into(), size, fps, codec: None, quality: None, audio: None, stream: true };
+            FrameSink::Video(VideoWriter::start(settings).map_err(|e| e.to_string())?)
+        }
         Some(path) => {
             let settings = VideoSettings {
                 path: path.clone(),
@@ -434,6 +452,7 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
                 codec: args.codec.clone(),
                 quality: args.quality,
                 audio: args.audio.clone().map(|file| (file, args.start as f64 * dt)),
+                stream: false,
             };
             if settings.encoded_size() != size {
                 let (w, h) = settings.encoded_size();

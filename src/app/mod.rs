@@ -26,6 +26,8 @@ pub struct WindowOptions {
     pub watch: bool,
     /// Record the show to this video from the start; also where later takes go (panel, OSC).
     pub record_video: Option<std::path::PathBuf>,
+    /// Send the output to this network stream from the start (see `run --stream`).
+    pub stream: Option<String>,
 }
 
 /// A window title showing `scene` (cut to a scene name's greatest length: the display server

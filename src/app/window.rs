@@ -55,6 +55,8 @@ struct Running {
     retry: Option<(GpuTrouble, Instant)>,
     /// Since when frames wait for a stalled one to finish.
     waiting_since: Option<Instant>,
+    /// The network stream (`run --stream`), from the start.
+    stream: Option<LiveRecorder>,
     /// The video recording in progress.
     video: Option<LiveRecorder>,
     /// Takes stopped whose files ffmpeg is still closing, off the render thread.
@@ -185,6 +187,28 @@ impl WindowApp {
         if self.options.record_video.is_some() {
             hub.record_requests.push(RecordRequest::Start(None));
         }
+        // The stream starts with the show; a receiver or ffmpeg that is missing is one message.
+        let stream = self.options.stream.as_ref().and_then(|url| {
+            let settings = crate::offscreen::VideoSettings {
+                path: url.into(),
+                size: (config.width, config.height),
+                fps: 1.0 / f64::from(clock.now().dt),
+                codec: None,
+                quality: None,
+                audio: None,
+                stream: true,
+            };
+            match LiveRecorder::start(&gpu.device, settings, DEFAULT_IN_FLIGHT) {
+                Ok(stream) => {
+                    log::info!("streaming to {url}");
+                    Some(stream)
+                }
+                Err(e) => {
+                    overlay.report(format!("cannot stream to {url}: {e}"));
+                    None
+                }
+            }
+        });
         Ok(Running {
             window,
             surface,
@@ -207,6 +231,7 @@ impl WindowApp {
             retry: None,
             waiting_since: None,
             video: None,
+            stream,
             finishing: Vec::new(),
             take_starts: std::collections::VecDeque::new(),
             outputs,
@@ -216,6 +241,12 @@ impl WindowApp {
 }
 
 /// The panel's line for a running take: file, length in show time, lost frames.
+/// The panel's line for the network stream: where, frames sent, frames the network lost us.
+fn stream_status(stream: &LiveRecorder) -> String {
+    let counts = stream.counts();
+    format!("⇢ {}  {} frame(s) sent, {} dropped", stream.path().display(), counts.queued, counts.dropped())
+}
+
 fn recording_status(video: &LiveRecorder, dt: f32) -> String {
     let counts = video.counts();
     let seconds = counts.offered as f64 * f64::from(dt);
@@ -249,6 +280,12 @@ impl ApplicationHandler for WindowApp {
         if let Some(r) = self.running.as_mut() {
             r.stop_recording();
             r.wait_for_takes();
+            if let Some(stream) = r.stream.take() {
+                match stream.finish(&r.gpu.device) {
+                    Ok(report) => log::info!("stream ended: {report}"),
+                    Err(e) => log::warn!("the stream ended badly: {e}"),
+                }
+            }
         }
     }
 
@@ -417,7 +454,7 @@ impl Running {
                     &output.view,
                     BlitTarget { view: &target, format: self.config.format, size },
                 );
-                if let Some(video) = self.video.as_mut() {
+                for video in self.video.iter_mut().chain(self.stream.as_mut()) {
                     video.capture(&self.gpu.device, &mut encoder, &output.view, steps);
                 }
                 for (i, window) in self.outputs.iter_mut().enumerate() {
@@ -442,6 +479,11 @@ impl Running {
             video.after_submit();
             video.poll(&self.gpu.device);
             self.overlay.recording = Some(recording_status(video, self.player.last_step().dt));
+        }
+        if let Some(stream) = self.stream.as_mut() {
+            stream.after_submit();
+            stream.poll(&self.gpu.device);
+            self.overlay.streaming = Some(stream_status(stream));
         }
         // The frame must finish before it is shown: waiting here, within the watchdog's limit,
         // is what catches a stuck GPU on drivers whose present would otherwise block for good
@@ -600,6 +642,7 @@ impl Running {
                 codec: None,
                 quality: None,
                 audio: None,
+                stream: false,
             };
             LiveRecorder::start(&self.gpu.device, settings, DEFAULT_IN_FLIGHT).map_err(|e| e.to_string())
         });

@@ -31,7 +31,13 @@ pub struct VideoSettings {
     /// A sound track: the audio file and the second of it the first frame shows (a render that
     /// starts at frame n starts n × dt into the file).
     pub audio: Option<(PathBuf, f64)>,
+    /// `path` is a network stream's URL (`srt://`, `udp://`, `rtmp://`), not a file: H.264 tuned
+    /// for latency (no B-frames, a keyframe a second) in MPEG-TS, or FLV for RTMP.
+    pub stream: bool,
 }
+
+/// The URL schemes `--stream` sends to, with the container each carries.
+pub const STREAM_SCHEMES: &[(&str, &str)] = &[("srt", "mpegts"), ("udp", "mpegts"), ("rtmp", "flv"), ("rtmps", "flv")];
 
 /// Why a video could not be written; each is one sentence for the user.
 #[derive(Debug, thiserror::Error)]
@@ -165,12 +171,23 @@ impl VideoSettings {
     /// The full ffmpeg command line after the program name.
     pub fn ffmpeg_args(&self) -> Result<Vec<String>, VideoError> {
         // A video goes to a file: `http://…` or `rtmp://…` would make ffmpeg stream to the
-        // network from an option meant for a file name.
+        // network from an option meant for a file name. Streams are asked for by name.
         let named = self.path.display().to_string();
-        if named.contains("://") {
+        let stream_format = if self.stream {
+            let scheme = named.split_once("://").map(|(s, _)| s.to_ascii_lowercase()).unwrap_or_default();
+            let format = STREAM_SCHEMES.iter().find(|(s, _)| *s == scheme).map(|(_, f)| *f);
+            Some(format.ok_or_else(|| {
+                VideoError::Settings(format!(
+                    "'{named}': a stream goes to srt://HOST:PORT, udp://HOST:PORT or rtmp://…"
+                ))
+            })?)
+        } else {
+            None
+        };
+        if named.contains("://") && !self.stream {
             return Err(VideoError::Settings(format!("'{named}' is a URL; video and audio options take file names")));
         }
-        let container = default_codec(&self.path)?;
+        let container = if self.stream { "h264" } else { default_codec(&self.path)? };
         let codec = self.codec.as_deref().unwrap_or(container);
         if !(self.fps.is_finite() && self.fps > 0.0) {
             return Err(VideoError::Settings(format!("{} frames per second is no frame rate", self.fps)));
@@ -195,6 +212,11 @@ impl VideoSettings {
         ]
         .map(String::from)
         .to_vec();
+        if self.stream {
+            // A stream goes out in real time: frames a render makes faster than that are paced
+            // (a receiver, like a screen, takes them at the frame rate; a burst is lost).
+            args.insert(args.iter().position(|a| a == "-f").unwrap_or(0), "-re".into());
+        }
         if let Some((file, offset)) = &self.audio {
             args.extend(["-ss".into(), format!("{offset:.6}"), "-i".into(), ffmpeg_file(file)]);
             args.extend(["-map".into(), "0:v".into(), "-map".into(), "1:a".into()]);
@@ -222,6 +244,17 @@ impl VideoSettings {
             "bt709".into(),
         ]);
         args.extend(codec_args(codec, self.quality)?);
+        if let Some(format) = stream_format {
+            // Latency over size: the fastest preset, no look-ahead or B-frames, a keyframe a
+            // second so a receiver that joins late starts within one.
+            let keyframes = (self.fps.round() as u32).max(1).to_string();
+            args.extend(
+                ["-preset", "ultrafast", "-tune", "zerolatency", "-bf", "0", "-g", &keyframes, "-f", format]
+                    .map(String::from),
+            );
+            args.push(named);
+            return Ok(args);
+        }
         if matches!(self.path.extension().and_then(|e| e.to_str()), Some("mp4" | "mov")) {
             // The index at the front: the file plays while it still downloads.
             args.extend(["-movflags".into(), "+faststart".into()]);
@@ -241,7 +274,7 @@ impl VideoWriter {
         let program = std::env::var_os(FFMPEG_ENV).unwrap_or_else(|| "ffmpeg".into());
         let encoder = args.iter().skip_while(|a| *a != "-c:v").nth(1).cloned().unwrap_or_default();
         check_encoder(&program, &encoder)?;
-        if let Some(folder) = settings.path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        if let Some(folder) = settings.path.parent().filter(|p| !p.as_os_str().is_empty() && !settings.stream) {
             std::fs::create_dir_all(folder).map_err(|e| VideoError::Ffmpeg {
                 path: settings.path.display().to_string(),
                 detail: format!("cannot create {}: {e}", folder.display()),
@@ -332,7 +365,15 @@ mod tests {
     use super::*;
 
     fn settings(path: &str) -> VideoSettings {
-        VideoSettings { path: path.into(), size: (64, 48), fps: 60.0, codec: None, quality: None, audio: None }
+        VideoSettings {
+            path: path.into(),
+            size: (64, 48),
+            fps: 60.0,
+            codec: None,
+            quality: None,
+            audio: None,
+            stream: false,
+        }
     }
 
     #[test]

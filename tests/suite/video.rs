@@ -170,7 +170,15 @@ fn solid(gpu: &indra::gpu::Gpu, size: (u32, u32), level: f32) -> wgpu::Texture {
 }
 
 fn live_settings(path: &Path, size: (u32, u32)) -> indra::offscreen::VideoSettings {
-    indra::offscreen::VideoSettings { path: path.into(), size, fps: 30.0, codec: None, quality: None, audio: None }
+    indra::offscreen::VideoSettings {
+        path: path.into(),
+        size,
+        fps: 30.0,
+        codec: None,
+        quality: None,
+        audio: None,
+        stream: false,
+    }
 }
 
 #[test]
@@ -259,4 +267,73 @@ fn frames_a_busy_readback_cannot_take_are_counted_not_lost_silently() {
     assert_eq!(report.written, 2);
     assert!(report.to_string().contains("8 frame(s) were not recorded"), "{report}");
     assert_eq!(probe(&path)["nb_read_frames"], "2");
+}
+
+/// A free loopback port (bound, then let go, for a receiver to take).
+fn free_port() -> u16 {
+    std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
+}
+
+#[test]
+fn a_render_streams_over_srt_and_udp_to_an_ffmpeg_receiver() {
+    let dir = temp_dir("stream");
+    let (base, pngs) = (["render", "kleinian_classic", "--size", "96x64"], dir.join("png"));
+    let o = indra(&base).args(["--frames", "1", "--out", pngs.to_str().unwrap()]).output().unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+    let sent = image::open(pngs.join("kleinian_classic_00000.png")).unwrap().to_rgba8().into_raw();
+    for scheme in ["srt", "udp"] {
+        let port = free_port();
+        let (listen, send) = match scheme {
+            "srt" => (format!("srt://127.0.0.1:{port}?mode=listener"), format!("srt://127.0.0.1:{port}?mode=caller")),
+            _ => (
+                format!("udp://127.0.0.1:{port}?overrun_nonfatal=1&fifo_size=100000"),
+                format!("udp://127.0.0.1:{port}"),
+            ),
+        };
+        let received = dir.join(format!("{scheme}.rgba"));
+        // The receiver writes the frames as raw RGBA.
+        let mut receiver = Command::new("ffmpeg")
+            // A second of stream is enough to find the codec's parameters (5 s by default).
+            .args([
+                "-v",
+                "error",
+                "-y",
+                "-analyzeduration",
+                "1000000",
+                "-f",
+                "mpegts",
+                "-i",
+                &listen,
+                // SRT ends with the sender; UDP never does, so its receiver stops after 20.
+                "-frames:v",
+                if scheme == "udp" { "20" } else { "1000" },
+                "-vf",
+                "scale=in_color_matrix=bt709:in_range=tv",
+            ])
+            .args(["-f", "rawvideo", "-pix_fmt", "rgba", received.to_str().unwrap()])
+            .spawn()
+            .expect("ffmpeg is needed for this test: run tools/setup-system test");
+        std::thread::sleep(std::time::Duration::from_millis(700));
+        // Three seconds, sent in real time.
+        let o = indra(&base).args(["--frames", "180", "--stream", &send]).output().unwrap();
+        assert!(o.status.success(), "{scheme}: {}", text(&o));
+        let start = std::time::Instant::now();
+        while receiver.try_wait().unwrap().is_none() && start.elapsed().as_secs() < 20 {
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        let _ = receiver.kill();
+        let bytes = std::fs::read(&received).unwrap_or_default();
+        let frame = 96 * 64 * 4;
+        // UDP: the 20 the receiver asked for. SRT: all but the few still in flight when the
+        // sender closed (its linger is not waited for).
+        let arrived = bytes.len() / frame;
+        let enough = if scheme == "udp" { arrived == 20 } else { arrived >= 150 };
+        assert!(bytes.len().is_multiple_of(frame) && enough, "{scheme}: {arrived} frames of 96x64 arrived");
+        // The static scene comes through the encoder close to the PNG of its frame.
+        let diff = mean_difference(&bytes[..frame], &sent);
+        assert!(diff < 6.0, "{scheme}: the first frame differs by {diff:.2} levels");
+    }
+    // A URL of another kind is one sentence, before any frame.
+    let o = indra(&base).args(["--frames", "1", "--stream", "http://127.0.0.1:1/x"]).output().unwrap();
+    assert!(!o.status.success() && text(&o).contains("srt://HOST:PORT"), "{}", text(&o));
 }

@@ -137,7 +137,12 @@ fn frames(path: &Path) -> u64 {
         .arg(path)
         .output()
         .expect("ffprobe runs (tools/setup-system test installs ffmpeg)");
-    String::from_utf8_lossy(&o.stdout).trim().parse().unwrap_or_else(|_| panic!("{} is no video", path.display()))
+    // MPEG-TS lists the stream under its program too: the first count is the stream's.
+    let out = String::from_utf8_lossy(&o.stdout);
+    out.lines()
+        .find(|l| !l.trim().is_empty())
+        .and_then(|l| l.trim().parse().ok())
+        .unwrap_or_else(|| panic!("{} is no video", path.display()))
 }
 
 #[test]
@@ -184,6 +189,42 @@ fn the_show_records_takes_started_and_stopped_over_osc_and_finishes_on_sigterm()
 }
 
 /// The virtual screen as RGB bytes (ffmpeg's X11 grabber), `size` pixels from the top left.
+#[test]
+fn the_show_streams_over_srt_from_the_start_until_sigterm() {
+    let display = VirtualDisplay::start();
+    let dir = scratch_dir("window-stream");
+    let port = std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let received = dir.join("received.ts");
+    let mut receiver = Command::new("ffmpeg")
+        .args(["-v", "error", "-y", "-f", "mpegts", "-i", &format!("srt://127.0.0.1:{port}?mode=listener")])
+        .args(["-c", "copy", received.to_str().unwrap()])
+        .spawn()
+        .expect("ffmpeg is needed for this test: run tools/setup-system test");
+    std::thread::sleep(Duration::from_millis(500));
+    let url = format!("srt://127.0.0.1:{port}?mode=caller");
+    let (mut show, _) = Show::start(&display, &dir, "kleinian", &["--stream".as_ref(), url.as_ref()]);
+    show.wait_for("streaming to");
+    std::thread::sleep(Duration::from_secs(3));
+    assert!(Command::new("kill").args(["-TERM", &show.child.id().to_string()]).status().unwrap().success());
+    let log = show.wait_for("stream ended");
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while receiver.try_wait().unwrap().is_none() && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let _ = receiver.kill();
+    let size = std::fs::metadata(&received).map(|m| m.len()).unwrap_or(0);
+    assert!(size > 0, "nothing arrived:\n{log}");
+    let n = frames(&received);
+    let sent: u64 = log
+        .split("stream ended: recorded ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no frame count in:\n{log}"));
+    // All but the few in flight when the show closed the stream.
+    assert!(n > 10 && n + 10 >= sent, "{n} of {sent} frames arrived:\n{log}");
+}
+
 fn grab(display: &str, size: (u32, u32)) -> Vec<u8> {
     let o = Command::new("ffmpeg")
         .args(["-v", "error", "-f", "x11grab", "-video_size", &format!("{}x{}", size.0, size.1), "-i", display])

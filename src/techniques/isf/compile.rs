@@ -144,6 +144,28 @@ mod tests {
     }
 
     #[test]
+    fn what_older_files_write_compiles() {
+        // GL ES guards and precision, gl_FragData, an input declared again, a uniform the host
+        // does not know (0, as in GL hosts), a varying with no vertex stage to feed it.
+        let fs = r#"/*{ "INPUTS": [ { "NAME": "inputImage", "TYPE": "image" }, { "NAME": "amt", "TYPE": "float" } ] }*/
+#ifdef GL_ES
+precision mediump float;
+#endif
+uniform sampler2D inputImage;
+uniform float amt, extra;
+varying vec2 left_coord;
+const int N = 2;
+void main() {
+    vec4 c = vec4(0.0);
+    for (int i = 0; i < N; i++) c += texture2D(inputImage, vv_FragNormCoord + left_coord * float(i));
+    gl_FragData[0] = c * amt + extra;
+}
+"#;
+        let c = compile_file(fs).unwrap_or_else(|e| panic!("{e}"));
+        assert!(c.compute.is_some(), "no vertex stage: it runs as compute");
+    }
+
+    #[test]
     fn a_good_file_compiles_both_stages() {
         let fs = "/*{ \"INPUTS\": [ { \"NAME\": \"level\", \"TYPE\": \"float\" } ] }*/\n\
                   void main() { gl_FragColor = vec4(isf_FragNormCoord, level, TIME); }\n";

@@ -127,8 +127,8 @@ pub struct Program {
     /// The textures, bound from [`FIRST_TEXTURE_BINDING`] on, in this order.
     pub textures: Vec<TextureSlot>,
     /// The same fragment shader as a compute shader writing a storage image (one per target
-    /// format: `rgba8`, `rgba16f`), where it needs nothing only rasterising gives — no `.vs`, no
-    /// varyings, no derivatives or `discard`. GPUs built for compute (the H200) rasterise at a
+    /// format: `rgba8`, `rgba16f`), where it needs nothing only rasterising gives — no `.vs`
+    /// (varyings without one are plain globals), no derivatives or `discard`. GPUs built for compute (the H200) rasterise at a
     /// fraction of their memory bandwidth; this runs at full speed on all.
     pub compute: Option<[Stage; 2]>,
 }
@@ -226,7 +226,7 @@ pub fn translate(header: &Header, fs: &str, vs: Option<&str>) -> Result<Program,
         }
         d
     };
-    let context = Context { textures: &textures, bools: &bools };
+    let context = Context { textures: &textures, bools: &bools, uniforms: &uniforms };
 
     // Varyings get locations by name, the same in both stages; 0 is isf_FragNormCoord.
     let vs_text = vs.unwrap_or(DEFAULT_VS);
@@ -267,9 +267,13 @@ pub fn translate(header: &Header, fs: &str, vs: Option<&str>) -> Result<Program,
             vs_out.inits, vs_out.copies
         ),
     );
-    let rasterised_only =
-        vs.is_some() || !fs_out.varyings.is_empty() || FRAGMENT_ONLY.iter().any(|w| contains_word(&fs_out.text, w));
-    let compute = (!rasterised_only).then(|| {
+    let rasterised_only = vs.is_some() || FRAGMENT_ONLY.iter().any(|w| contains_word(&fs_out.text, w));
+    let cs_out = if rasterised_only {
+        None
+    } else {
+        Some(rewrite(fs, StageKind::Compute, &context, &mut locations).map_err(|(l, m)| ("fs", l, m))?)
+    };
+    let compute = cs_out.map(|cs_out| {
         COMPUTE_FORMATS.map(|format| {
             let binding = storage_binding(textures.len());
             assemble(
@@ -282,7 +286,7 @@ pub fn translate(header: &Header, fs: &str, vs: Option<&str>) -> Result<Program,
                     ),
                     "vec4 isf_FragColor; vec4 isf_FragCoord;".into(),
                 ],
-                &fs_out.text,
+                &cs_out.text,
                 &format!(
                     "void main() {{ ivec2 _isf_p = ivec2(gl_GlobalInvocationID.xy); \
                      if (_isf_p.x >= int(RENDERSIZE.x) || _isf_p.y >= int(RENDERSIZE.y)) {{ return; }} \
@@ -291,7 +295,7 @@ pub fn translate(header: &Header, fs: &str, vs: Option<&str>) -> Result<Program,
                      isf_FragCoord = vec4(_isf_c.x, RENDERSIZE.y - _isf_c.y, 0.5, 1.0); \
                      isf_FragColor = vec4(0.0); {} isf_main(); \
                      imageStore(_isf_dst, _isf_p, _isf_final != 0 ? _isf_decode(isf_FragColor) : isf_FragColor); }}",
-                    fs_out.inits
+                    cs_out.inits
                 ),
             )
         })
@@ -340,13 +344,15 @@ fn assemble(prelude: &[String], body: &str, epilogue: &str) -> Stage {
 enum StageKind {
     Vertex,
     Fragment,
+    /// The fragment shader as a compute shader: no stage before it, varyings are plain globals.
+    Compute,
 }
 
 impl StageKind {
     fn tag(self) -> &'static str {
         match self {
             StageKind::Vertex => "vs",
-            StageKind::Fragment => "fs",
+            StageKind::Fragment | StageKind::Compute => "fs",
         }
     }
 }
@@ -373,6 +379,16 @@ impl Locations {
 struct Context<'a> {
     textures: &'a [TextureSlot],
     bools: &'a [String],
+    uniforms: &'a UniformLayout,
+}
+
+impl Context<'_> {
+    /// Whether `name` is something the host declares (an input, a built-in, an image).
+    fn declares(&self, name: &str) -> bool {
+        self.uniforms.offset(name).is_some()
+            || self.bools.iter().any(|b| b == name)
+            || self.textures.iter().any(|t| t.name == name)
+    }
 }
 
 struct Varying {
@@ -492,9 +508,41 @@ fn rewrite(
             last_word = name;
             continue;
         }
+        if depth == 0 && word == "uniform" {
+            // A shader that declares uniforms itself (old files redeclare their inputs): the
+            // host's declaration stands; one the host does not know reads 0 in GL hosts, as a
+            // plain global does here. A sampler of its own has nothing to sample.
+            let end = src[i..].find(';').map(|e| i + e).ok_or_else(|| (line(start), "a uniform without ';'".into()))?;
+            let words: Vec<&str> = src[i..end]
+                .split(|c: char| c.is_whitespace() || c == ',')
+                .filter(|w| !w.is_empty() && !matches!(*w, "highp" | "mediump" | "lowp"))
+                .collect();
+            let ty = words.first().copied().unwrap_or_default();
+            let names = &words[1.min(words.len())..];
+            let unknown: Vec<&str> =
+                names.iter().copied().filter(|n| !cx.declares(n.split('[').next().unwrap_or(n))).collect();
+            out.extend(std::iter::repeat_n('\n', src[i..end].matches('\n').count()));
+            if ty.starts_with("sampler") || unknown.is_empty() {
+                i = end + 1;
+            } else {
+                out.push_str(&format!("{ty} {}", unknown.join(", ")));
+                i = end;
+            }
+            continue;
+        }
+        if word == "gl_FragData" {
+            // GL 2's array of outputs: an ISF shader has one.
+            let rest = &src[i..];
+            let index: String = rest.chars().take_while(|c| *c != ']').filter(|c| !c.is_whitespace()).collect();
+            if index == "[0" {
+                out.push_str("isf_FragColor");
+                i += rest.find(']').map_or(0, |e| e + 1);
+                continue;
+            }
+        }
         let global_io = depth == 0
             && (word == "varying"
-                || (word == "in" && stage == StageKind::Fragment)
+                || (word == "in" && stage != StageKind::Vertex)
                 || (word == "out" && stage == StageKind::Vertex));
         if global_io {
             let end = src[i..].find(';').map(|e| i + e).ok_or_else(|| (line(start), "a varying without ';'".into()))?;
@@ -509,6 +557,7 @@ fn rewrite(
                         copies.push_str(&match stage {
                             StageKind::Vertex => format!("{element} = {name}[{k}]; "),
                             StageKind::Fragment => format!("{name}[{k}] = {element}; "),
+                            StageKind::Compute => String::new(),
                         });
                     }
                 }
@@ -529,7 +578,7 @@ fn rewrite(
 fn replace_word(word: &str, stage: StageKind, cx: &Context<'_>) -> String {
     match word {
         "gl_FragColor" => return "isf_FragColor".into(),
-        "gl_FragCoord" if stage == StageKind::Fragment => return "isf_FragCoord".into(),
+        "gl_FragCoord" if stage != StageKind::Vertex => return "isf_FragCoord".into(),
         "main" => return "isf_main".into(),
         "vv_FragNormCoord" => return "isf_FragNormCoord".into(),
         "vv_vertShaderInit" => return "isf_vertShaderInit".into(),
@@ -597,7 +646,7 @@ fn varying_declaration(
     stage: StageKind,
     locations: &Locations,
 ) -> Result<(String, Vec<(String, u32)>), String> {
-    let io = if stage == StageKind::Fragment { "in" } else { "out" };
+    let io = if stage == StageKind::Vertex { "out" } else { "in" };
     let mut words = rest.split(',');
     let first = words.next().unwrap_or_default().trim();
     let mut parts: Vec<&str> = first.split_whitespace().collect();
@@ -619,6 +668,14 @@ fn varying_declaration(
         };
         if name == "isf_FragNormCoord" {
             names.push((name, count));
+            continue;
+        }
+        if stage == StageKind::Compute {
+            // Nothing feeds it: a plain global, zero, as an unwritten varying reads in GL hosts.
+            let ty = qualifiers_and_type.split_whitespace().last().unwrap_or("float");
+            let array = raw.find('[').map_or("", |b| &raw[b..]);
+            out.push_str(&format!("{ty} {name}{array};"));
+            names.push((name, 0));
             continue;
         }
         let (location, _) = locations.by_name.get(&name).copied().unwrap_or((1, 1));
