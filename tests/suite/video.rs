@@ -271,20 +271,22 @@ fn frames_a_busy_readback_cannot_take_are_counted_not_lost_silently() {
 
 /// A free loopback port (bound, then let go, for a receiver to take).
 fn free_port() -> u16 {
-    std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
+    std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
 }
 
 #[test]
-fn a_render_streams_over_srt_and_udp_to_an_ffmpeg_receiver() {
+fn a_render_streams_over_srt_udp_and_rtmp_to_an_ffmpeg_receiver() {
     let dir = temp_dir("stream");
     let (base, pngs) = (["render", "kleinian_classic", "--size", "96x64"], dir.join("png"));
     let o = indra(&base).args(["--frames", "1", "--out", pngs.to_str().unwrap()]).output().unwrap();
     assert!(o.status.success(), "{}", text(&o));
     let sent = image::open(pngs.join("kleinian_classic_00000.png")).unwrap().to_rgba8().into_raw();
-    for scheme in ["srt", "udp"] {
+    for scheme in ["srt", "udp", "rtmp"] {
         let port = free_port();
         let (listen, send) = match scheme {
             "srt" => (format!("srt://127.0.0.1:{port}?mode=listener"), format!("srt://127.0.0.1:{port}?mode=caller")),
+            // ffmpeg as the RTMP server a streaming PC would run.
+            "rtmp" => (format!("rtmp://127.0.0.1:{port}/live/indra"), format!("rtmp://127.0.0.1:{port}/live/indra")),
             _ => (
                 format!("udp://127.0.0.1:{port}?overrun_nonfatal=1&fifo_size=100000"),
                 format!("udp://127.0.0.1:{port}"),
@@ -292,24 +294,18 @@ fn a_render_streams_over_srt_and_udp_to_an_ffmpeg_receiver() {
         };
         let received = dir.join(format!("{scheme}.rgba"));
         // The receiver writes the frames as raw RGBA.
-        let mut receiver = Command::new("ffmpeg")
-            // A second of stream is enough to find the codec's parameters (5 s by default).
-            .args([
-                "-v",
-                "error",
-                "-y",
-                "-analyzeduration",
-                "1000000",
-                "-f",
-                "mpegts",
-                "-i",
-                &listen,
-                // SRT ends with the sender; UDP never does, so its receiver stops after 20.
-                "-frames:v",
-                if scheme == "udp" { "20" } else { "1000" },
-                "-vf",
-                "scale=in_color_matrix=bt709:in_range=tv",
-            ])
+        let mut receiver = Command::new("ffmpeg");
+        // A second of stream is enough to find the codec's parameters (5 s by default).
+        receiver.args(["-v", "error", "-y", "-analyzeduration", "1000000"]);
+        if scheme == "rtmp" {
+            receiver.args(["-listen", "1", "-f", "flv"]);
+        } else {
+            receiver.args(["-f", "mpegts"]);
+        }
+        // SRT and RTMP end with the sender; UDP never does, so its receiver stops after 20.
+        let count = if scheme == "udp" { "20" } else { "1000" };
+        let mut receiver = receiver
+            .args(["-i", &listen, "-frames:v", count, "-vf", "scale=in_color_matrix=bt709:in_range=tv"])
             .args(["-f", "rawvideo", "-pix_fmt", "rgba", received.to_str().unwrap()])
             .spawn()
             .expect("ffmpeg is needed for this test: run tools/setup-system test");
@@ -324,8 +320,8 @@ fn a_render_streams_over_srt_and_udp_to_an_ffmpeg_receiver() {
         let _ = receiver.kill();
         let bytes = std::fs::read(&received).unwrap_or_default();
         let frame = 96 * 64 * 4;
-        // UDP: the 20 the receiver asked for. SRT: all but the few still in flight when the
-        // sender closed (its linger is not waited for).
+        // UDP: the 20 the receiver asked for. SRT, RTMP: all but the few still in flight when
+        // the sender closed.
         let arrived = bytes.len() / frame;
         let enough = if scheme == "udp" { arrived == 20 } else { arrived >= 150 };
         assert!(bytes.len().is_multiple_of(frame) && enough, "{scheme}: {arrived} frames of 96x64 arrived");
