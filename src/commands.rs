@@ -440,8 +440,16 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     let mut sink = match &args.video {
         None if args.stream.is_some() => {
             let url = args.stream.clone().unwrap_or_default();
-            let settings =
-                VideoSettings { path: url.into(), size, fps, codec: None, quality: None, audio: None, stream: true };
+            let settings = VideoSettings {
+                path: url.into(),
+                size,
+                fps,
+                codec: None,
+                quality: None,
+                audio: None,
+                stream: true,
+                pace: true,
+            };
             FrameSink::Video(VideoWriter::start(settings).map_err(|e| e.to_string())?)
         }
         Some(path) => {
@@ -453,6 +461,7 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
                 quality: args.quality,
                 audio: args.audio.clone().map(|file| (file, args.start as f64 * dt)),
                 stream: false,
+                pace: false,
             };
             if settings.encoded_size() != size {
                 let (w, h) = settings.encoded_size();

@@ -197,6 +197,7 @@ impl WindowApp {
                 quality: None,
                 audio: None,
                 stream: true,
+                pace: false,
             };
             match LiveRecorder::start(&gpu.device, settings, DEFAULT_IN_FLIGHT) {
                 Ok(stream) => {
@@ -643,6 +644,7 @@ impl Running {
                 quality: None,
                 audio: None,
                 stream: false,
+                pace: false,
             };
             LiveRecorder::start(&self.gpu.device, settings, DEFAULT_IN_FLIGHT).map_err(|e| e.to_string())
         });

@@ -34,6 +34,8 @@ pub struct VideoSettings {
     /// `path` is a network stream's URL (`srt://`, `udp://`, `rtmp://`), not a file: H.264 tuned
     /// for latency (no B-frames, a keyframe a second) in MPEG-TS, or FLV for RTMP.
     pub stream: bool,
+    /// For a stream: frames come faster than real time (a render), so ffmpeg paces them to `fps`.
+    pub pace: bool,
 }
 
 /// The URL schemes `--stream` sends to, with the container each carries.
@@ -212,9 +214,10 @@ impl VideoSettings {
         ]
         .map(String::from)
         .to_vec();
-        if self.stream {
+        if self.stream && self.pace {
             // A stream goes out in real time: frames a render makes faster than that are paced
-            // (a receiver, like a screen, takes them at the frame rate; a burst is lost).
+            // (a receiver, like a screen, takes them at the frame rate; a burst is lost). Not for
+            // the live show, whose frames come in real time: pacing them again costs ≈ 90 ms.
             args.insert(args.iter().position(|a| a == "-f").unwrap_or(0), "-re".into());
         }
         if let Some((file, offset)) = &self.audio {
@@ -373,6 +376,7 @@ mod tests {
             quality: None,
             audio: None,
             stream: false,
+            pace: false,
         }
     }
 

@@ -178,6 +178,7 @@ fn live_settings(path: &Path, size: (u32, u32)) -> indra::offscreen::VideoSettin
         quality: None,
         audio: None,
         stream: false,
+        pace: false,
     }
 }
 
