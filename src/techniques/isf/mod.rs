@@ -7,7 +7,8 @@
 //!
 //! - [`header`]: the JSON header; [`expr`]: pass sizes; [`translate`]: the GLSL rewrite;
 //!   [`compile`]: naga's GLSL front end and validation, errors at the `.fs`/`.vs` line;
-//!   `node`: pipelines, buffers and the frame's passes.
+//!   `pipeline`: the compute or render pipelines; `sound`: audio inputs as textures; `node`:
+//!   buffers and the frame's passes.
 //! - Time is the fixed clock's (`TIME`, `TIMEDELTA`, `FRAMEINDEX`) and `DATE` the node's `date`
 //!   parameter advanced by it — never the wall clock — so an ISF scene renders the same bytes
 //!   twice and frame N sought equals frame N played.
@@ -18,8 +19,10 @@ pub mod compile;
 pub mod expr;
 pub mod header;
 mod node;
+mod pipeline;
 #[cfg(test)]
 mod render_tests;
+mod sound;
 pub mod translate;
 
 use crate::assets::Assets;

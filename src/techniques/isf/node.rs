@@ -6,6 +6,8 @@ use std::collections::BTreeMap;
 
 use super::compile::Compiled;
 use super::header::{InputKind, Pass};
+use super::pipeline::{BYTE_FORMAT, FLOAT_FORMAT, FormatKey, OUTPUT_FORMAT, Pipeline, Pipelines, build_pipelines};
+use super::sound::{AUDIO_WIDTH, AudioTexture};
 use super::translate::{FIRST_TEXTURE_BINDING, SAMPLER_BINDING, TextureSource, UNIFORM_BINDING, storage_binding};
 use super::{IsfFiles, Settings};
 use crate::gpu::{BindGroupCache, DEFAULT_MAX_AGE, ShaderError};
@@ -14,13 +16,6 @@ use crate::params::{AudioSnapshot, ParamSet, ParamValue};
 use crate::techniques::image_pass::{self, ImageKernel, ImagePass};
 use crate::techniques::{NodeSetup, Technique};
 use crate::time::FrameTime;
-
-/// The node's image: linear HDR like every node's.
-const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// A target without `FLOAT`: 8 bits a channel, as GL hosts make them.
-const BYTE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
-/// A `FLOAT` target (half floats: filterable everywhere, enough for feedback).
-const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// The most texture memory one node's pass targets may take (a size expression that asks for
 /// more is refused): an eighth of the scene's whole budget.
@@ -40,33 +35,6 @@ pub fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> 
     })?;
     let compiled = files.compile()?;
     Ok(Box::new(IsfNode::new(setup, &files, compiled)?))
-}
-
-/// The pipelines of one compiled shader.
-struct Pipelines {
-    /// Target format → its bind group layout and pipeline.
-    by_format: BTreeMap<FormatKey, (wgpu::BindGroupLayout, Pipeline)>,
-    sampler: wgpu::Sampler,
-}
-
-/// How a pass runs: as a compute shader writing a storage image where the shader allows it, or
-/// rasterised (a `.vs`, varyings, derivatives).
-enum Pipeline {
-    Compute(wgpu::ComputePipeline),
-    Raster(wgpu::RenderPipeline),
-}
-
-/// `wgpu::TextureFormat` is not `Ord`: formats by the two this node renders.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-enum FormatKey {
-    Byte,
-    Float,
-}
-
-impl FormatKey {
-    fn of(format: wgpu::TextureFormat) -> Self {
-        if format == BYTE_FORMAT { FormatKey::Byte } else { FormatKey::Float }
-    }
 }
 
 /// One pass's GPU state.
@@ -109,52 +77,6 @@ pub struct IsfNode {
     /// fire in; the frame drawn after it shows them).
     fired: Vec<bool>,
 }
-
-/// One sound input's texture.
-struct AudioTexture {
-    texture: PersistentTexture,
-    /// Whether it holds the spectrum (else the waveform).
-    spectrum: bool,
-}
-
-impl AudioTexture {
-    /// `width` samples or bins wide, holding silence.
-    fn new(device: &wgpu::Device, queue: &wgpu::Queue, name: &str, width: u32, spectrum: bool) -> Self {
-        let texture = PersistentTexture::new(device, name, (width, 1), AUDIO_FORMAT);
-        let made = Self { texture, spectrum };
-        made.write(queue, &AudioSnapshot::default());
-        made
-    }
-
-    /// Writes what `audio` heard, resampled to the texture's width: a spectrum as 0–1 per bin, a
-    /// waveform as ISF hosts give it (0.5 is silence, 0 and 1 full scale), in every channel.
-    fn write(&self, queue: &wgpu::Queue, audio: &AudioSnapshot) {
-        let width = self.texture.texture.width() as usize;
-        let source = if self.spectrum { &audio.spectrum } else { &audio.wave };
-        let value = |i: usize| -> f32 {
-            let x = if source.is_empty() { 0.0 } else { source[(i * source.len() / width).min(source.len() - 1)] };
-            if self.spectrum { x.clamp(0.0, 1.0) } else { (x * 0.5 + 0.5).clamp(0.0, 1.0) }
-        };
-        let texels: Vec<u16> = (0..width)
-            .flat_map(|i| {
-                let v = half::f16::from_f32(value(i)).to_bits();
-                [v, v, v, half::f16::ONE.to_bits()]
-            })
-            .collect();
-        queue.write_texture(
-            self.texture.texture.as_image_copy(),
-            bytemuck::cast_slice(&texels),
-            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(8 * width as u32), rows_per_image: Some(1) },
-            self.texture.texture.size(),
-        );
-    }
-}
-
-/// Sound textures: half floats (filterable everywhere).
-const AUDIO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-
-/// Samples or bins of a sound texture when the input asks for no `MAX`.
-const AUDIO_WIDTH: u32 = 256;
 
 /// The present kernel's (unused) uniform block.
 #[repr(C)]
@@ -376,106 +298,6 @@ struct PassUniforms<'a> {
     size: (u32, u32),
     is_final: bool,
     texture_sizes: &'a [(String, (u32, u32))],
-}
-
-fn build_pipelines(device: &wgpu::Device, origin: &str, compiled: &Compiled) -> Result<Pipelines, ShaderError> {
-    let compute = compiled.compute.is_some();
-    let visibility = if compute { wgpu::ShaderStages::COMPUTE } else { wgpu::ShaderStages::VERTEX_FRAGMENT };
-    let mut entries = vec![
-        wgpu::BindGroupLayoutEntry {
-            binding: UNIFORM_BINDING,
-            visibility,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: wgpu::BufferSize::new(u64::from(compiled.program.uniforms.size)),
-            },
-            count: None,
-        },
-        wgpu::BindGroupLayoutEntry {
-            binding: SAMPLER_BINDING,
-            visibility,
-            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-            count: None,
-        },
-    ];
-    let textures = compiled.program.textures.len();
-    entries.extend((0..textures).map(|i| crate::gpu::texture_entry(FIRST_TEXTURE_BINDING + i as u32, visibility)));
-    let module = |m: &naga::Module, label: &str| {
-        device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(label),
-            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(m.clone())),
-        })
-    };
-    let by_format = crate::gpu::validated(device, origin, || {
-        let mut by_format = BTreeMap::new();
-        for (k, format) in [BYTE_FORMAT, FLOAT_FORMAT].into_iter().enumerate() {
-            let mut entries = entries.clone();
-            if compute {
-                entries.push(wgpu::BindGroupLayoutEntry {
-                    binding: storage_binding(textures),
-                    visibility,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                });
-            }
-            let layout = device
-                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("isf"), entries: &entries });
-            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("isf"),
-                bind_group_layouts: &[Some(&layout)],
-                immediate_size: 0,
-            });
-            let pipeline = match &compiled.compute {
-                Some(variants) => Pipeline::Compute(device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(origin),
-                    layout: Some(&pipeline_layout),
-                    module: &module(&variants[k], "isf.compute"),
-                    entry_point: Some("main"),
-                    compilation_options: Default::default(),
-                    cache: None,
-                })),
-                None => Pipeline::Raster(device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(origin),
-                    layout: Some(&pipeline_layout),
-                    vertex: wgpu::VertexState {
-                        module: &module(&compiled.vertex, "isf.vs"),
-                        entry_point: Some("main"),
-                        compilation_options: Default::default(),
-                        buffers: &[],
-                    },
-                    fragment: Some(wgpu::FragmentState {
-                        module: &module(&compiled.fragment, "isf.fs"),
-                        entry_point: Some("main"),
-                        compilation_options: Default::default(),
-                        targets: &[Some(wgpu::ColorTargetState {
-                            format,
-                            blend: None,
-                            write_mask: wgpu::ColorWrites::ALL,
-                        })],
-                    }),
-                    primitive: wgpu::PrimitiveState::default(),
-                    depth_stencil: None,
-                    multisample: wgpu::MultisampleState::default(),
-                    multiview_mask: None,
-                    cache: None,
-                })),
-            };
-            by_format.insert(FormatKey::of(format), (layout, pipeline));
-        }
-        by_format
-    })?;
-    let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-        label: Some("isf_sampler"),
-        mag_filter: wgpu::FilterMode::Linear,
-        min_filter: wgpu::FilterMode::Linear,
-        ..Default::default()
-    });
-    Ok(Pipelines { by_format, sampler })
 }
 
 impl Technique for IsfNode {
