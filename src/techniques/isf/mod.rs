@@ -231,8 +231,10 @@ mod tests {
             let files = IsfFiles::read(&assets, name).unwrap();
             let compiled = files.compile().unwrap();
             assert_eq!(declared.inputs, compiled.header.image_inputs());
-            // Every shader without a vertex stage runs as a compute shader.
+            // Every shader without a vertex stage runs as a compute shader; of those with one,
+            // only 3d Rotate moves the quad (so only it clears its target first).
             assert_eq!(compiled.compute.is_some(), files.vs.is_none(), "{name}");
+            assert_eq!(compiled.program.covers_target, !name.contains("3d Rotate"), "{name}");
         }
     }
 }

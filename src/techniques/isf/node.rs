@@ -462,6 +462,7 @@ impl Technique for IsfNode {
             }
         }
         let last_target = header_passes[last].target.as_ref();
+        let covers_target = self.compiled.program.covers_target;
         let Self { pipelines, passes, present, id, .. } = self;
         let pipelines = &*pipelines;
         let mut image = None;
@@ -529,8 +530,28 @@ impl Technique for IsfNode {
                         cp.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
                     }
                     Pipeline::Raster(pipeline) => {
-                        // Cleared first, as GL hosts do: a .vs may move the quad off some pixels.
-                        let mut rp = ctx.begin_color_pass(dest, wgpu::Color::TRANSPARENT);
+                        // Cleared first, as GL hosts do, where a .vs moves the quad off some
+                        // pixels; a quad over everything needs no clear (on the H200 the clear
+                        // costs as much as the draw).
+                        let load = if covers_target {
+                            wgpu::LoadOp::Load
+                        } else {
+                            wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+                        };
+                        let view = ctx.view(dest).clone();
+                        let mut rp = ctx.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                            label: Some("isf"),
+                            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                                view: &view,
+                                depth_slice: None,
+                                resolve_target: None,
+                                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
+                            })],
+                            depth_stencil_attachment: None,
+                            timestamp_writes: None,
+                            occlusion_query_set: None,
+                            multiview_mask: None,
+                        });
                         rp.set_pipeline(pipeline);
                         rp.set_bind_group(0, &group, &[]);
                         rp.draw(0..6, 0..1);

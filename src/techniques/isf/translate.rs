@@ -131,6 +131,10 @@ pub struct Program {
     /// (varyings without one are plain globals), no derivatives or `discard`. GPUs built for compute (the H200) rasterise at a
     /// fraction of their memory bandwidth; this runs at full speed on all.
     pub compute: Option<[Stage; 2]>,
+    /// Whether a rasterised pass draws every pixel of its target: the vertex stage leaves the
+    /// quad where `isf_vertShaderInit` puts it (it never writes `gl_Position` itself) and the
+    /// fragment stage never discards, so the target needs no clear first.
+    pub covers_target: bool,
 }
 
 /// The binding of the storage image a compute variant writes: after the textures.
@@ -300,7 +304,8 @@ pub fn translate(header: &Header, fs: &str, vs: Option<&str>) -> Result<Program,
             )
         })
     });
-    Ok(Program { fragment, vertex, uniforms, textures, compute })
+    let covers_target = !contains_word(&vs_out.text, "gl_Position") && !contains_word(&fs_out.text, "discard");
+    Ok(Program { fragment, vertex, uniforms, textures, compute, covers_target })
 }
 
 /// Whether `word` occurs in `text` as a whole identifier.
