@@ -4,7 +4,7 @@
 
 use naga::front::glsl::{Frontend, Options};
 
-use super::header::{Header, InputKind};
+use super::header::Header;
 use super::translate::{Program, Stage, translate};
 use crate::gpu::ShaderError;
 
@@ -57,20 +57,8 @@ pub fn compile(sources: &Sources<'_>) -> Result<Compiled, ShaderError> {
 /// that does not parse, names an unknown variable, or gives 0, a negative or a non-finite
 /// number is refused with the file (the node checks again each frame, against the device).
 fn check_sizes(header: &Header) -> Result<(), String> {
-    let defaults: Vec<(String, f64)> = header
-        .inputs
-        .iter()
-        .filter_map(|i| {
-            let v = match &i.kind {
-                InputKind::Float { default, .. } => f64::from(*default),
-                InputKind::Long { values, default, .. } => f64::from(values[*default as usize]),
-                InputKind::Bool { default } => f64::from(u8::from(*default)),
-                InputKind::Event => 0.0,
-                _ => return None,
-            };
-            Some((i.name.clone(), v))
-        })
-        .collect();
+    let defaults: Vec<(String, f64)> =
+        header.inputs.iter().filter_map(|i| Some((i.name.clone(), i.number(i.decl()?.default)?))).collect();
     let var = |name: &str| match name {
         "WIDTH" => Some(1920.0),
         "HEIGHT" => Some(1080.0),

@@ -77,11 +77,6 @@ impl InputKind {
     pub fn is_audio(&self) -> bool {
         matches!(self, InputKind::Audio { .. } | InputKind::AudioFft { .. })
     }
-
-    /// Whether this input is sampled as a texture (image, audio).
-    pub fn is_texture(&self) -> bool {
-        matches!(self, InputKind::Image | InputKind::Audio { .. } | InputKind::AudioFft { .. })
-    }
 }
 
 /// One pass (`PASSES`), or the single implicit pass.
@@ -204,6 +199,20 @@ impl Header {
 }
 
 impl Input {
+    /// What the shader receives for parameter value `value` of this input, as a number (what
+    /// `$name` means in a size expression): a `long`'s chosen VALUE, a bool or event as 0 or 1.
+    /// `None` for inputs that are no single number (colours, points, images).
+    pub fn number(&self, value: ParamValue) -> Option<f64> {
+        Some(match (&self.kind, value) {
+            (InputKind::Long { values, .. }, ParamValue::Enum(i)) => {
+                f64::from(values.get(i as usize).copied().unwrap_or(0))
+            }
+            (_, ParamValue::Float(x)) => f64::from(x),
+            (_, ParamValue::Bool(b) | ParamValue::Trigger(b)) => f64::from(u8::from(b)),
+            _ => return None,
+        })
+    }
+
     /// The parameter this input is, if it is one.
     pub fn decl(&self) -> Option<ParamDecl> {
         let doc = self.label.clone().unwrap_or_else(|| self.name.clone());

@@ -52,7 +52,7 @@ struct Feedback {
 
 /// A live ISF node.
 pub struct IsfNode {
-    compiled: Compiled,
+    compiled: std::sync::Arc<Compiled>,
     pipelines: Pipelines,
     passes: Vec<PassState>,
     /// Persistent targets by name.
@@ -68,6 +68,12 @@ pub struct IsfNode {
     present: (ImageKernel, ImagePass),
     /// The parameter positions of the shader's inputs (by name, found once).
     positions: Vec<Option<usize>>,
+    /// Per input: the header's default, what a missing parameter reads.
+    defaults: Vec<Option<ParamValue>>,
+    /// Per input: its offset in the uniform block (a bool's or event's int), found once.
+    input_offsets: Vec<Option<u32>>,
+    /// Per texture slot: the offset of its size in the uniform block.
+    size_offsets: Vec<Option<u32>>,
     device: wgpu::Device,
     id: String,
     messages: Vec<String>,
@@ -112,6 +118,19 @@ impl IsfNode {
         )?;
         let present_pass = ImagePass::new(device, &kernel);
         let positions = compiled.header.inputs.iter().map(|i| setup.params.index(&i.name)).collect();
+        let defaults = compiled.header.inputs.iter().map(|i| i.decl().map(|d| d.default)).collect();
+        let layout = &compiled.program.uniforms;
+        let input_offsets = compiled
+            .header
+            .inputs
+            .iter()
+            .map(|i| match i.kind {
+                InputKind::Bool { .. } | InputKind::Event => layout.offset(&format!("_isf_b_{}", i.name)),
+                _ => layout.offset(&i.name),
+            })
+            .collect();
+        let size_offsets =
+            compiled.program.textures.iter().map(|t| layout.offset(&format!("_isf_size_{}", t.name))).collect();
         let audio = compiled
             .header
             .inputs
@@ -132,12 +151,15 @@ impl IsfNode {
             queue: setup.gpu.queue.clone(),
             imported: BTreeMap::new(),
             feedback: BTreeMap::new(),
-            compiled,
+            compiled: std::sync::Arc::new(compiled),
             pipelines,
             passes,
             black,
             present: (kernel, present_pass),
             positions,
+            defaults,
+            input_offsets,
+            size_offsets,
             device: device.clone(),
             id: setup.id.to_string(),
             messages: Vec::new(),
@@ -193,9 +215,8 @@ impl IsfNode {
     /// The value of input `k` now: the node's parameter, or the header's default where the
     /// parameter is missing (a file changed under a running scene).
     fn input_value(&self, k: usize, params: &ParamSet) -> Option<ParamValue> {
-        let input = &self.compiled.header.inputs[k];
         let value = self.positions[k].map(|p| params.value_at(p));
-        let default = input.decl().map(|d| d.default);
+        let default = self.defaults[k];
         match value {
             Some(v) if default.is_some_and(|d| d.ty() == v.ty()) => Some(v),
             _ => default,
@@ -210,15 +231,7 @@ impl IsfNode {
                 "HEIGHT" => Some(f64::from(output.1)),
                 _ => {
                     let k = self.compiled.header.inputs.iter().position(|i| i.name == name)?;
-                    Some(match self.input_value(k, params)? {
-                        ParamValue::Float(x) => f64::from(x),
-                        ParamValue::Enum(i) => match &self.compiled.header.inputs[k].kind {
-                            InputKind::Long { values, .. } => f64::from(values.get(i as usize).copied().unwrap_or(0)),
-                            _ => f64::from(i),
-                        },
-                        ParamValue::Bool(b) | ParamValue::Trigger(b) => f64::from(u8::from(b)),
-                        _ => return None,
-                    })
+                    self.compiled.header.inputs[k].number(self.input_value(k, params)?)
                 }
             }
         };
@@ -244,14 +257,15 @@ impl IsfNode {
     fn uniform_bytes(&self, params: &ParamSet, time: &FrameTime, pass: PassUniforms<'_>) -> Vec<u8> {
         let layout = &self.compiled.program.uniforms;
         let mut bytes = vec![0u8; layout.size as usize];
-        let mut put = |name: &str, values: &[f32], int: bool| {
-            let Some(offset) = layout.offset(name) else { return };
+        let mut put_at = |offset: Option<u32>, values: &[f32], int: bool| {
+            let Some(offset) = offset else { return };
             for (i, v) in values.iter().enumerate() {
                 let at = offset as usize + 4 * i;
                 let word = if int { (*v as i32).to_le_bytes() } else { v.to_le_bytes() };
                 bytes[at..at + 4].copy_from_slice(&word);
             }
         };
+        let mut put = |name: &str, values: &[f32], int: bool| put_at(layout.offset(name), values, int);
         let date = Settings::read(params).date;
         put("PASSINDEX", &[pass.index as f32], true);
         put("FRAMEINDEX", &[time.frame as f32], true);
@@ -262,21 +276,18 @@ impl IsfNode {
         put("DATE", &[date[0], date[1], date[2], ((f64::from(date[3]) + time.seconds) % 86_400.0) as f32], false);
         for (k, input) in self.compiled.header.inputs.iter().enumerate() {
             let Some(value) = self.input_value(k, params) else { continue };
+            let offset = self.input_offsets[k];
             match (&input.kind, value) {
-                (InputKind::Long { values, .. }, ParamValue::Enum(i)) => {
-                    put(&input.name, &[values.get(i as usize).copied().unwrap_or(0) as f32], true);
+                // Events as this step saw them; longs, bools as the numbers the shader takes.
+                (InputKind::Event, _) => put_at(offset, &[f32::from(u8::from(self.fired[k]))], true),
+                (InputKind::Long { .. } | InputKind::Bool { .. }, v) => {
+                    put_at(offset, &[input.number(v).unwrap_or(0.0) as f32], true);
                 }
-                (InputKind::Event, _) => {
-                    put(&format!("_isf_b_{}", input.name), &[f32::from(u8::from(self.fired[k]))], true)
-                }
-                (InputKind::Bool { .. }, ParamValue::Bool(b)) => {
-                    put(&format!("_isf_b_{}", input.name), &[f32::from(u8::from(b))], true);
-                }
-                (_, v) => put(&input.name, &v.components(), false),
+                (_, v) => put_at(offset, &v.components(), false),
             }
         }
-        for (name, size) in pass.texture_sizes {
-            put(&format!("_isf_size_{name}"), &[size.0 as f32, size.1 as f32], false);
+        for (offset, size) in self.size_offsets.iter().zip(pass.texture_sizes) {
+            put_at(*offset, &[size.0 as f32, size.1 as f32], false);
         }
         bytes
     }
@@ -297,7 +308,8 @@ struct PassUniforms<'a> {
     index: usize,
     size: (u32, u32),
     is_final: bool,
-    texture_sizes: &'a [(String, (u32, u32))],
+    /// Each texture slot's size, in slot order.
+    texture_sizes: &'a [(u32, u32)],
 }
 
 impl Technique for IsfNode {
@@ -341,10 +353,12 @@ impl Technique for IsfNode {
         inputs: &[TextureHandle],
     ) -> TextureHandle {
         let output = graph.output_size();
-        let header_passes = self.compiled.header.passes.clone();
+        // The compiled shader is shared, not copied, while the node's state changes below.
+        let compiled = std::sync::Arc::clone(&self.compiled);
+        let header_passes = &compiled.header.passes;
         // Sizes first: a bad size (an input driven out of range) keeps the render size, told once.
         let mut sizes = Vec::with_capacity(header_passes.len());
-        for pass in &header_passes {
+        for pass in header_passes {
             match self.pass_size(pass, params, output) {
                 Ok(size) => sizes.push(size),
                 Err(problem) => {
@@ -373,10 +387,10 @@ impl Technique for IsfNode {
         }
         let black = graph.import_texture(format!("{}/black", self.id), &self.black);
         // What each texture slot reads now: (handle, size).
-        let slots = self.compiled.program.textures.clone();
+        let slots = &compiled.program.textures;
         let mut node_inputs = inputs.iter();
         let mut current: Vec<Option<(TextureHandle, (u32, u32))>> = Vec::with_capacity(slots.len());
-        for slot in &slots {
+        for slot in slots {
             current.push(match slot.source {
                 TextureSource::Node => node_inputs.next().map(|&h| (h, graph.texture_size(h))),
                 TextureSource::Target => feedback_handles.get(&slot.name).map(|h| {
@@ -405,11 +419,10 @@ impl Technique for IsfNode {
             // A target nothing wrote yet reads black but has its own size (IMG_SIZE).
             let bound: Vec<(TextureHandle, (u32, u32))> = current
                 .iter()
-                .zip(&slots)
+                .zip(slots)
                 .map(|(c, slot)| c.unwrap_or((black, target_sizes.get(&slot.name).copied().unwrap_or((1, 1)))))
                 .collect();
-            let texture_sizes: Vec<(String, (u32, u32))> =
-                slots.iter().zip(&bound).map(|(s, b)| (s.name.clone(), b.1)).collect();
+            let texture_sizes: Vec<(u32, u32)> = bound.iter().map(|b| b.1).collect();
             let bytes = self.uniform_bytes(
                 params,
                 time,
