@@ -1,6 +1,8 @@
 //! Network stream latency: from a frame handed to `--stream`'s encoder (as the live recorder
 //! hands it, paced at 60 fps) to the same frame decoded by an ffmpeg receiver on loopback, for
-//! SRT (with its default 120 ms receive buffer, and with 20 ms), UDP and RTMP. Each frame carries its number in eight black-or-white blocks, which survive
+//! SRT (with its default 120 ms receive buffer, and with 20 ms), UDP and RTMP; and from a frame
+//! handed to `--pipewire-out`'s source to a GStreamer `pipewiresrc` consumer, where a PipeWire
+//! daemon runs (`tools/bench-pipewire`). Each frame carries its number in eight black-or-white blocks, which survive
 //! H.264; the receiver's raw frames are read as they come and matched to their send times.
 //! Run: `cargo bench --bench stream` (needs ffmpeg with SRT; prints medians and 95th percentiles).
 
@@ -8,7 +10,7 @@ use std::io::Read;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use indra::offscreen::{VideoSettings, VideoWriter};
+use indra::offscreen::{PipeWireOut, VideoSettings, VideoWriter};
 
 /// Frame side: eight 8-pixel blocks across the top carry the number.
 const SIDE: u32 = 64;
@@ -35,7 +37,49 @@ fn number(gray: &[u8]) -> u32 {
     (0..8).map(|b| u32::from(gray[(6 * SIDE + b * 8 + 4) as usize] > 128) << b).sum()
 }
 
+/// Frames handed to `send` at 60 fps, numbered, against their arrival in `receiver` (a
+/// process writing 64×64 grey frames to its standard output): latencies in ms, sorted.
+fn measure(mut receiver: Command, mut send: impl FnMut(&[u8]), finish: impl FnOnce()) -> Vec<f64> {
+    let mut receiver = receiver.stdout(Stdio::piped()).spawn().expect("the receiver runs");
+    let mut out = receiver.stdout.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut arrivals = Vec::new();
+        let mut buf = vec![0u8; (SIDE * SIDE) as usize];
+        while out.read_exact(&mut buf).is_ok() {
+            arrivals.push((number(&buf), Instant::now()));
+        }
+        arrivals
+    });
+    std::thread::sleep(Duration::from_millis(500));
+    let start = Instant::now();
+    let mut sent = Vec::new();
+    for n in 0..FRAMES {
+        let due = start + Duration::from_secs_f64(f64::from(n) / FPS);
+        std::thread::sleep(due.saturating_duration_since(Instant::now()));
+        sent.push(Instant::now());
+        send(&frame(n));
+    }
+    finish();
+    std::thread::sleep(Duration::from_millis(500));
+    let _ = receiver.kill();
+    let _ = receiver.wait();
+    let arrivals = reader.join().unwrap();
+    // Numbers wrap at 256: match each arrival to the latest frame sent before it with that number.
+    let mut ms: Vec<f64> = arrivals
+        .iter()
+        .filter_map(|(n, at)| {
+            let k = (0..FRAMES).rev().find(|&k| k % 256 == *n && sent[k as usize] <= *at)?;
+            Some(at.duration_since(sent[k as usize]).as_secs_f64() * 1000.0)
+        })
+        .collect();
+    ms.sort_by(f64::total_cmp);
+    ms
+}
+
 fn latencies(scheme: &str) -> Vec<f64> {
+    if scheme == "pipewire" {
+        return pipewire_latencies();
+    }
     let port = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
     let (listen, send) = match scheme {
         "srt" => (format!("srt://127.0.0.1:{port}?mode=listener"), format!("srt://127.0.0.1:{port}?mode=caller")),
@@ -56,21 +100,7 @@ fn latencies(scheme: &str) -> Vec<f64> {
     } else {
         receiver.args(["-f", "mpegts"]);
     }
-    let mut receiver = receiver
-        .args(["-i", &listen, "-f", "rawvideo", "-pix_fmt", "gray", "-"])
-        .stdout(Stdio::piped())
-        .spawn()
-        .expect("ffmpeg runs");
-    let mut out = receiver.stdout.take().unwrap();
-    let reader = std::thread::spawn(move || {
-        let mut arrivals = Vec::new();
-        let mut buf = vec![0u8; (SIDE * SIDE) as usize];
-        while out.read_exact(&mut buf).is_ok() {
-            arrivals.push((number(&buf), Instant::now()));
-        }
-        arrivals
-    });
-    std::thread::sleep(Duration::from_millis(500));
+    receiver.args(["-i", &listen, "-f", "rawvideo", "-pix_fmt", "gray", "-"]);
     let settings = VideoSettings {
         path: send.into(),
         size: (SIDE, SIDE),
@@ -81,34 +111,51 @@ fn latencies(scheme: &str) -> Vec<f64> {
         stream: true,
         pace: false,
     };
-    let mut writer = VideoWriter::start(settings).expect("the stream starts");
-    let start = Instant::now();
-    let mut sent = Vec::new();
-    for n in 0..FRAMES {
-        let due = start + Duration::from_secs_f64(f64::from(n) / FPS);
-        std::thread::sleep(due.saturating_duration_since(Instant::now()));
-        sent.push(Instant::now());
-        writer.write(&frame(n)).expect("the encoder takes the frame");
+    let writer = std::cell::RefCell::new(None::<VideoWriter>);
+    measure(
+        receiver,
+        |rgba| {
+            // ffmpeg starts once the receiver listens (`measure` waits half a second first).
+            let mut writer = writer.borrow_mut();
+            let writer = writer.get_or_insert_with(|| VideoWriter::start(settings.clone()).expect("the stream starts"));
+            writer.write(rgba).expect("the encoder takes the frame");
+        },
+        || drop(writer.take().map(VideoWriter::finish)),
+    )
+}
+
+/// The PipeWire source (`--pipewire-out`) read by a GStreamer consumer, on the session in
+/// `XDG_RUNTIME_DIR` (tools/bench-pipewire starts one).
+fn pipewire_latencies() -> Vec<f64> {
+    let mut source = PipeWireOut::start("indra-bench", (SIDE, SIDE), FPS, false).expect("a PipeWire daemon runs");
+    // The node appears with the first frame's format, and a consumer started before its target
+    // exists never links: one frame, then wait for the node.
+    source.write(&frame(255)).expect("the source takes a frame");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while !Command::new("pw-cli")
+        .args(["ls", "Node"])
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).contains("node.name = \"indra-bench\""))
+    {
+        assert!(Instant::now() < deadline, "the node did not appear");
+        std::thread::sleep(Duration::from_millis(50));
     }
-    let _ = writer.finish();
-    std::thread::sleep(Duration::from_millis(500));
-    let _ = receiver.kill();
-    let _ = receiver.wait();
-    let arrivals = reader.join().unwrap();
-    // Numbers wrap at 256: match each arrival to the latest frame sent before it with that number.
-    let mut ms: Vec<f64> = arrivals
-        .iter()
-        .filter_map(|(n, at)| {
-            let k = (0..FRAMES).rev().find(|&k| k % 256 == *n && sent[k as usize] <= *at)?;
-            Some(at.duration_since(sent[k as usize]).as_secs_f64() * 1000.0)
-        })
-        .collect();
-    ms.sort_by(f64::total_cmp);
-    ms
+    let mut receiver = Command::new("gst-launch-1.0");
+    receiver.args(["-q", "pipewiresrc", "target-object=indra-bench", "!", "videoconvert", "!"]);
+    receiver.args(["video/x-raw,format=GRAY8", "!", "fdsink", "fd=1", "sync=false"]);
+    let source = std::cell::RefCell::new(Some(source));
+    measure(
+        receiver,
+        |rgba| source.borrow_mut().as_mut().expect("open").write(rgba).expect("the source takes the frame"),
+        || drop(source.borrow_mut().take().map(PipeWireOut::finish)),
+    )
 }
 
 fn main() {
-    for scheme in ["srt", "srt20", "udp", "rtmp"] {
+    // PipeWire needs a daemon (tools/bench-pipewire runs this bench with one).
+    let pipewire =
+        std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).join("pipewire-0").exists());
+    for scheme in ["srt", "srt20", "udp", "rtmp", "pipewire"].into_iter().filter(|s| *s != "pipewire" || pipewire) {
         let ms = latencies(scheme);
         if ms.is_empty() {
             println!("{scheme:<5} no frames arrived");

@@ -116,6 +116,16 @@ pub struct RunArgs {
     /// never waits for the network: frames the encoder cannot take are dropped and counted.
     #[arg(long, value_name = "URL")]
     pub stream: Option<String>,
+    /// Send the output as shown as an NDI source of this name from the start (OBS, Resolume,
+    /// TouchDesigner find it). Needs the NDI runtime, loaded at run time (see the README); the
+    /// show never waits for the network: frames the sender cannot take are dropped and counted.
+    #[arg(long, value_name = "NAME")]
+    pub ndi_out: Option<String>,
+    /// Offer the output as shown as a PipeWire video source of this name from the start (what
+    /// OBS, browsers and `pipewiresrc` read on Linux), through GStreamer's `pipewiresink`. The
+    /// show never waits: frames the source cannot take are dropped and counted.
+    #[arg(long, value_name = "NAME")]
+    pub pipewire_out: Option<String>,
 }
 
 /// Where OSC listens unless told otherwise: loopback, so nothing on the network can reach it.
@@ -152,6 +162,8 @@ impl Default for RunArgs {
             no_watch: false,
             record_video: None,
             stream: None,
+            ndi_out: None,
+            pipewire_out: None,
         }
     }
 }
@@ -188,6 +200,14 @@ pub struct RenderArgs {
     /// MPEG-TS (FLV for RTMP), through ffmpeg.
     #[arg(long, value_name = "URL", conflicts_with = "video")]
     pub stream: Option<String>,
+    /// Also send the frames as an NDI source of this name, in real time (each frame waits until
+    /// it is due at 1/dt frames per second), stamped with their frame numbers as timecodes.
+    #[arg(long, value_name = "NAME")]
+    pub ndi_out: Option<String>,
+    /// Also offer the frames as a PipeWire video source of this name, in real time (each frame
+    /// waits until it is due at 1/dt frames per second).
+    #[arg(long, value_name = "NAME")]
+    pub pipewire_out: Option<String>,
     /// Video codec: h264, h265, prores, vp9, av1, ffv1, hap, hap_alpha, hap_q (in .mov; clips
     /// indra and VJ tools play frame-exact), or an ffmpeg encoder name (default: the container's).
     #[arg(long, requires = "video")]
@@ -357,6 +377,8 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         watch: !args.no_watch,
         record_video: args.record_video.clone(),
         stream: args.stream.clone(),
+        ndi_out: args.ndi_out.clone(),
+        pipewire_out: args.pipewire_out.clone(),
     };
     let web = match &args.web {
         Some(addr) => {
@@ -474,6 +496,15 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
             FrameSink::Png { folder: args.out.clone(), stem }
         }
     };
+    // A render is faster than real time: the sender's clock paces it to the scene's rate.
+    let mut ndi = match &args.ndi_out {
+        Some(name) => Some(indra::media::ndi::NdiSender::start(name, size, fps, true)?),
+        None => None,
+    };
+    let mut pipewire = match &args.pipewire_out {
+        Some(name) => Some(indra::offscreen::PipeWireOut::start(name, size, fps, true)?),
+        None => None,
+    };
     let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
     eprintln!("rendering '{}' on {}", scene.name, device.adapter_label());
     let mut renderer =
@@ -495,6 +526,12 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     for _ in 0..args.frames {
         let frame = renderer.render_next().map_err(|e| e.to_string())?;
         sink.write(&frame)?;
+        if let Some(sender) = ndi.as_mut() {
+            sender.send(&frame.rgba, frame.time.frame)?;
+        }
+        if let Some(source) = pipewire.as_mut() {
+            source.write(&frame.rgba)?;
+        }
         // What a node tells the performer (a clip that cannot play, a bad image path) is said
         // once, as the window's overlay says it; the render goes on.
         for message in renderer.instance_mut().take_messages() {
@@ -514,6 +551,9 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
         }
         FrameSink::Png { folder, .. } => folder.display().to_string(),
     };
+    if let Some(source) = pipewire {
+        source.finish()?;
+    }
     eprintln!("wrote {} frame(s) to {place}", args.frames);
     Ok(())
 }
@@ -816,6 +856,18 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
             s.transient_bytes_allocated / 1024,
             s.compile_time.as_secs_f64() * 1e6
         );
+    }
+    Ok(())
+}
+
+/// `indra --list-ndi`: the NDI sources an `ndi` node can name.
+pub fn list_ndi() -> Result<(), String> {
+    let sources = indra::media::ndi::list_sources(std::time::Duration::from_secs(2))?;
+    if sources.is_empty() {
+        println!("no NDI sources seen within 2 s (senders on other machines: see the README's NDI section)");
+    }
+    for source in sources {
+        println!("{}  {}", source.name, source.url);
     }
     Ok(())
 }

@@ -28,6 +28,10 @@ struct Cli {
     /// List this machine's cameras (V4L2 devices) for a `camera` node's `device`, and exit.
     #[arg(long)]
     list_cameras: bool,
+    /// List the NDI sources seen on the network within two seconds, for an `ndi` node's
+    /// `source`, and exit (needs the NDI runtime: see the README's NDI section).
+    #[arg(long)]
+    list_ndi: bool,
 }
 
 /// Options that pick the GPU.
@@ -73,6 +77,7 @@ fn main() -> ExitCode {
     let gpu = indra::gpu::GpuOptions { backend: cli.gpu.backend, adapter: cli.gpu.adapter };
     let result = match cli.command {
         _ if cli.list_cameras => commands::list_cameras(),
+        _ if cli.list_ndi => commands::list_ndi(),
         None => commands::run(&assets, &gpu, &commands::RunArgs::default()),
         Some(Command::Run(args)) => commands::run(&assets, &gpu, &args),
         Some(Command::Render(args)) => commands::render(&assets, &gpu, &args),

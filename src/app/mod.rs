@@ -28,6 +28,10 @@ pub struct WindowOptions {
     pub record_video: Option<std::path::PathBuf>,
     /// Send the output to this network stream from the start (see `run --stream`).
     pub stream: Option<String>,
+    /// Send the output as this NDI source from the start (see `run --ndi-out`).
+    pub ndi_out: Option<String>,
+    /// Offer the output as this PipeWire video source from the start (see `run --pipewire-out`).
+    pub pipewire_out: Option<String>,
 }
 
 /// A window title showing `scene` (cut to a scene name's greatest length: the display server

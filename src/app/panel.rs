@@ -38,8 +38,8 @@ pub struct Overlay {
     pub morph_seconds: f32,
     /// The video recording's status line, while one runs.
     pub recording: Option<String>,
-    /// The network stream's status line (`run --stream`), while one runs.
-    pub streaming: Option<String>,
+    /// A status line per send (`run --stream`, `run --ndi-out`), while they run.
+    pub sending: Vec<String>,
     /// The record button was clicked (the window starts or stops the recording).
     pub record_clicked: bool,
     /// How the last take ended.
@@ -58,7 +58,7 @@ impl Default for Overlay {
             preset_name: "preset-1".into(),
             morph_seconds: 0.0,
             recording: None,
-            streaming: None,
+            sending: Vec::new(),
             record_clicked: false,
             last_take: None,
         }
@@ -142,7 +142,7 @@ fn record_panel(ui: &mut egui::Ui, overlay: &mut Overlay) {
     if let Some(status) = overlay.recording.as_ref().or(overlay.last_take.as_ref()) {
         ui.small(status);
     }
-    if let Some(status) = &overlay.streaming {
+    for status in &overlay.sending {
         ui.small(status);
     }
 }

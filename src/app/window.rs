@@ -20,7 +20,7 @@ use crate::gpu::{Blit, BlitTarget, DEFAULT_STALL_TIMEOUT, Gpu, GpuOptions};
 use crate::graph::GraphRuntime;
 use crate::live::{GpuGuard, GpuState, GpuTrouble, LiveReload};
 use crate::offscreen::capture::{DEFAULT_IN_FLIGHT, take_path};
-use crate::offscreen::{FinishingTake, LiveRecorder};
+use crate::offscreen::{FinishingTake, FrameOutlet, LiveRecorder, PipeWireOut, VideoWriter};
 use crate::params::ControlEvent;
 use crate::scene::{Player, Scene, SceneInstance};
 use crate::time::FixedClock;
@@ -55,8 +55,10 @@ struct Running {
     retry: Option<(GpuTrouble, Instant)>,
     /// Since when frames wait for a stalled one to finish.
     waiting_since: Option<Instant>,
-    /// The network stream (`run --stream`), from the start.
-    stream: Option<LiveRecorder>,
+    /// Where the output is sent from the start: the network stream (`run --stream`), the
+    /// PipeWire source (`run --pipewire-out`) and the NDI source (`run --ndi-out`).
+    /// Each with what it sends: `None` the output, `Some(n)` the scene's output `n + 1`.
+    sends: Vec<(Option<usize>, LiveRecorder)>,
     /// The video recording in progress.
     video: Option<LiveRecorder>,
     /// Takes stopped whose files ffmpeg is still closing, off the render thread.
@@ -169,7 +171,7 @@ impl WindowApp {
         };
         let hub = ControlHub::start(&self.control, instance.scene());
         let mut outputs = Vec::new();
-        for (i, spec) in instance.scene().outputs.iter().enumerate() {
+        for (i, spec) in instance.scene().outputs.iter().enumerate().filter(|(_, o)| !o.headless) {
             match OutputWindow::open(event_loop, &gpu, &instance.scene().name, i + 1, spec, instance.scene().size) {
                 Ok(output) => outputs.push(output),
                 Err(e) => overlay.report(e),
@@ -187,29 +189,63 @@ impl WindowApp {
         if self.options.record_video.is_some() {
             hub.record_requests.push(RecordRequest::Start(None));
         }
-        // The stream starts with the show; a receiver or ffmpeg that is missing is one message.
-        let stream = self.options.stream.as_ref().and_then(|url| {
+        // Sends start with the show; a receiver, ffmpeg, daemon or NDI runtime that is missing is
+        // one message and the show goes on.
+        let size = (config.width, config.height);
+        let fps = 1.0 / f64::from(clock.now().dt);
+        let mut sends = Vec::new();
+        let mut start_send = |what: Option<usize>,
+                              outlet: Result<Box<dyn FrameOutlet>, String>,
+                              started: String,
+                              failed: String| match outlet.and_then(|o| {
+            LiveRecorder::start_outlet(&gpu.device, size, o, DEFAULT_IN_FLIGHT).map_err(|e| e.to_string())
+        }) {
+            Ok(send) => {
+                log::info!("{started}");
+                sends.push((what, send));
+            }
+            Err(e) => overlay.report(format!("{failed}: {e}")),
+        };
+        if let Some(url) = &self.options.stream {
             let settings = crate::offscreen::VideoSettings {
                 path: url.into(),
-                size: (config.width, config.height),
-                fps: 1.0 / f64::from(clock.now().dt),
+                size,
+                fps,
                 codec: None,
                 quality: None,
                 audio: None,
                 stream: true,
                 pace: false,
             };
-            match LiveRecorder::start(&gpu.device, settings, DEFAULT_IN_FLIGHT) {
-                Ok(stream) => {
-                    log::info!("streaming to {url}");
-                    Some(stream)
-                }
-                Err(e) => {
-                    overlay.report(format!("cannot stream to {url}: {e}"));
-                    None
-                }
+            let writer = VideoWriter::start(settings).map(|w| Box::new(w) as Box<dyn FrameOutlet>);
+            start_send(
+                None,
+                writer.map_err(|e| e.to_string()),
+                format!("streaming to {url}"),
+                format!("cannot stream to {url}"),
+            );
+        }
+        // The output (`--pipewire-out`, `--ndi-out`), then each scene output that names sends.
+        let scene_outputs = instance.scene().outputs.iter().enumerate().map(|(i, o)| (Some(i), &o.pipewire, &o.ndi));
+        for (what, pipewire, ndi) in
+            [(None, &self.options.pipewire_out, &self.options.ndi_out)].into_iter().chain(scene_outputs)
+        {
+            let image = what.map_or_else(|| "the output".to_string(), |i| format!("output {}", i + 1));
+            if let Some(name) = pipewire {
+                let source = PipeWireOut::start(name, size, fps, false).map(|p| Box::new(p) as Box<dyn FrameOutlet>);
+                let said = format!("offering {image} as the PipeWire source '{name}'");
+                start_send(what, source, said, format!("cannot offer PipeWire '{name}'"));
             }
-        });
+            if let Some(name) = ndi {
+                let said = format!("sending {image} as the NDI source '{name}'");
+                start_send(
+                    what,
+                    crate::offscreen::ndi_outlet(name, size, fps),
+                    said,
+                    format!("cannot send NDI '{name}'"),
+                );
+            }
+        }
         Ok(Running {
             window,
             surface,
@@ -232,7 +268,7 @@ impl WindowApp {
             retry: None,
             waiting_since: None,
             video: None,
-            stream,
+            sends,
             finishing: Vec::new(),
             take_starts: std::collections::VecDeque::new(),
             outputs,
@@ -242,10 +278,10 @@ impl WindowApp {
 }
 
 /// The panel's line for a running take: file, length in show time, lost frames.
-/// The panel's line for the network stream: where, frames sent, frames the network lost us.
-fn stream_status(stream: &LiveRecorder) -> String {
-    let counts = stream.counts();
-    format!("⇢ {}  {} frame(s) sent, {} dropped", stream.path().display(), counts.queued, counts.dropped())
+/// The panel's line for a send (stream, NDI): where, frames sent, frames the network lost us.
+fn send_status(send: &LiveRecorder) -> String {
+    let counts = send.counts();
+    format!("⇢ {}  {} frame(s) sent, {} dropped", send.path().display(), counts.queued, counts.dropped())
 }
 
 fn recording_status(video: &LiveRecorder, dt: f32) -> String {
@@ -281,10 +317,10 @@ impl ApplicationHandler for WindowApp {
         if let Some(r) = self.running.as_mut() {
             r.stop_recording();
             r.wait_for_takes();
-            if let Some(stream) = r.stream.take() {
-                match stream.finish(&r.gpu.device) {
-                    Ok(report) => log::info!("stream ended: {report}"),
-                    Err(e) => log::warn!("the stream ended badly: {e}"),
+            for (_, send) in std::mem::take(&mut r.sends) {
+                match send.finish(&r.gpu.device) {
+                    Ok(report) => log::info!("send ended: {report}"),
+                    Err(e) => log::warn!("a send ended badly: {e}"),
                 }
             }
         }
@@ -455,8 +491,18 @@ impl Running {
                     &output.view,
                     BlitTarget { view: &target, format: self.config.format, size },
                 );
-                for video in self.video.iter_mut().chain(self.stream.as_mut()) {
-                    video.capture(&self.gpu.device, &mut encoder, &output.view, steps);
+                let shown = self.player.last_step().frame;
+                if let Some(video) = self.video.as_mut() {
+                    video.capture(&self.gpu.device, &mut encoder, &output.view, steps, shown);
+                }
+                for (what, send) in &mut self.sends {
+                    let image = match what {
+                        None => Some(&output.view),
+                        Some(n) => output.extras.get(*n).and_then(Option::as_ref).map(|(_, view)| view),
+                    };
+                    if let Some(view) = image {
+                        send.capture(&self.gpu.device, &mut encoder, view, steps, shown);
+                    }
                 }
                 for (i, window) in self.outputs.iter_mut().enumerate() {
                     let Some(Some((_, view))) = output.extras.get(window.number - 1) else { continue };
@@ -481,10 +527,11 @@ impl Running {
             video.poll(&self.gpu.device);
             self.overlay.recording = Some(recording_status(video, self.player.last_step().dt));
         }
-        if let Some(stream) = self.stream.as_mut() {
-            stream.after_submit();
-            stream.poll(&self.gpu.device);
-            self.overlay.streaming = Some(stream_status(stream));
+        self.overlay.sending.clear();
+        for (_, send) in &mut self.sends {
+            send.after_submit();
+            send.poll(&self.gpu.device);
+            self.overlay.sending.push(send_status(send));
         }
         // The frame must finish before it is shown: waiting here, within the watchdog's limit,
         // is what catches a stuck GPU on drivers whose present would otherwise block for good

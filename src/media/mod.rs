@@ -1,5 +1,5 @@
-//! Media in: video clips, numbered image sequences, stills and cameras, as pictures a node
-//! uploads. Pure CPU and processes — no GPU: HAP clips are read from their QuickTime sample tables and unpacked to
+//! Media in: video clips, numbered image sequences, stills, cameras and NDI sources, as pictures
+//! a node uploads (and NDI out, the same runtime's other half). Pure CPU and processes — no GPU: HAP clips are read from their QuickTime sample tables and unpacked to
 //! texture blocks ([`mov`], [`hap`]); every other codec and every camera comes through an
 //! `ffmpeg` process ([`ffmpeg`], [`camera`]); a worker decodes ahead of the show ([`prefetch`]);
 //! a [`playhead`] turns the fixed clock into a clip frame, so renders are exact. Tested against
@@ -10,6 +10,7 @@ pub mod clip;
 pub mod ffmpeg;
 pub mod hap;
 pub mod mov;
+pub mod ndi;
 pub mod playhead;
 pub mod prefetch;
 pub mod sequence;

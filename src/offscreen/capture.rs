@@ -1,6 +1,6 @@
 //! Recording the live show to a video without ever making it wait: each shown frame is copied
 //! into one of a few readback buffers (a ring), mapped asynchronously, and handed to an encoder
-//! thread that feeds ffmpeg. When every buffer is still in flight, or the encoder is behind, the
+//! thread that feeds its [`FrameOutlet`] — ffmpeg for a file or a network stream, an NDI sender. When every buffer is still in flight, or the encoder is behind, the
 //! frame is not recorded — and counted, so the performer is told how many were lost instead of
 //! finding a stutter in the file later.
 //!
@@ -75,6 +75,32 @@ impl std::fmt::Display for CaptureReport {
     }
 }
 
+/// Where a live recorder's frames go, on the recorder's own thread (so it may block).
+pub trait FrameOutlet: Send + 'static {
+    /// Takes one frame (tight RGBA rows, sRGB-encoded): show frame `frame`, held for `repeats`
+    /// steps.
+    fn take(&mut self, rgba: &[u8], repeats: u32, frame: u64) -> Result<(), VideoError>;
+    /// Ends the output (closes the file, withdraws the source); returns the frames written.
+    fn close(self: Box<Self>) -> Result<u64, VideoError>;
+    /// Where the frames go, for the panel and reports: a file, a URL, `NDI 'name'`.
+    fn destination(&self) -> std::path::PathBuf;
+}
+
+impl FrameOutlet for VideoWriter {
+    /// A video runs on the show's clock: the frame is written once per step it was shown.
+    fn take(&mut self, rgba: &[u8], repeats: u32, _frame: u64) -> Result<(), VideoError> {
+        (0..repeats).try_for_each(|_| self.write(rgba))
+    }
+
+    fn close(self: Box<Self>) -> Result<u64, VideoError> {
+        self.finish()
+    }
+
+    fn destination(&self) -> std::path::PathBuf {
+        self.settings().path.clone()
+    }
+}
+
 /// One readback buffer.
 struct Slot {
     buffer: wgpu::Buffer,
@@ -86,6 +112,8 @@ struct Slot {
 struct Pending {
     slot: usize,
     repeats: u32,
+    /// The show frame it is.
+    frame: u64,
     mapping: bool,
 }
 
@@ -98,7 +126,7 @@ pub struct LiveRecorder {
     slots: Vec<Slot>,
     free: Vec<usize>,
     pending: VecDeque<Pending>,
-    sender: Option<SyncSender<(Vec<u8>, u32)>>,
+    sender: Option<SyncSender<(Vec<u8>, u32, u64)>>,
     encoder: Option<JoinHandle<Result<u64, VideoError>>>,
     path: std::path::PathBuf,
     counts: CaptureCounts,
@@ -108,12 +136,22 @@ impl LiveRecorder {
     /// Starts ffmpeg and allocates `in_flight` readback buffers for frames of `settings.size`.
     pub fn start(device: &wgpu::Device, settings: VideoSettings, in_flight: usize) -> Result<Self, VideoError> {
         let size = settings.size;
-        let path = settings.path.clone();
-        let writer = VideoWriter::start(settings)?;
+        Self::start_outlet(device, size, Box::new(VideoWriter::start(settings)?), in_flight)
+    }
+
+    /// Starts a recorder whose frames of `size` go to `outlet`, with `in_flight` readback
+    /// buffers.
+    pub fn start_outlet(
+        device: &wgpu::Device,
+        size: (u32, u32),
+        outlet: Box<dyn FrameOutlet>,
+        in_flight: usize,
+    ) -> Result<Self, VideoError> {
+        let path = outlet.destination();
         let (sender, receiver) = std::sync::mpsc::sync_channel(ENCODER_QUEUE);
         let encoder = std::thread::Builder::new()
             .name("indra-video".into())
-            .spawn(move || encode(writer, receiver))
+            .spawn(move || encode(outlet, receiver))
             .map_err(|e| VideoError::Settings(format!("cannot start the encoder thread: {e}")))?;
         let target = crate::gpu::display_target(device, "capture_target", size);
         let padded_row = (size.0 * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
@@ -158,8 +196,8 @@ impl LiveRecorder {
         self.counts
     }
 
-    /// Records a copy of `source` (any float texture; sRGB-encoded like the window) into
-    /// `encoder`, to be written `repeats` times. Never waits: with no free buffer the frame is
+    /// Records a copy of `source` (any float texture; sRGB-encoded like the window), show frame
+    /// `frame`, into `encoder`, to be written `repeats` times. Never waits: with no free buffer the frame is
     /// counted as dropped. Call [`LiveRecorder::after_submit`] once the encoder is submitted.
     pub fn capture(
         &mut self,
@@ -167,6 +205,7 @@ impl LiveRecorder {
         encoder: &mut wgpu::CommandEncoder,
         source: &wgpu::TextureView,
         repeats: u32,
+        frame: u64,
     ) {
         if repeats == 0 {
             return;
@@ -190,7 +229,7 @@ impl LiveRecorder {
             },
             self.target.size(),
         );
-        self.pending.push_back(Pending { slot, repeats, mapping: false });
+        self.pending.push_back(Pending { slot, repeats, frame, mapping: false });
     }
 
     /// Asks for the maps of the frames captured since the last call (their copies are submitted).
@@ -214,7 +253,7 @@ impl LiveRecorder {
             if !front.mapping || state == WAITING {
                 break;
             }
-            let Pending { slot, repeats, .. } = self.pending.pop_front().expect("front exists");
+            let Pending { slot, repeats, frame: number, .. } = self.pending.pop_front().expect("front exists");
             let buffer = &self.slots[slot].buffer;
             let frame = (state == MAPPED).then(|| buffer.slice(..).get_mapped_range().ok()).flatten().map(|mapped| {
                 let tight = (self.size.0 * 4) as usize;
@@ -229,7 +268,7 @@ impl LiveRecorder {
             }
             self.free.push(slot);
             let sent = match (frame, &self.sender) {
-                (Some(rgba), Some(sender)) => match sender.try_send((rgba, repeats)) {
+                (Some(rgba), Some(sender)) => match sender.try_send((rgba, repeats, number)) {
                     Ok(()) => true,
                     Err(TrySendError::Full(_) | TrySendError::Disconnected(_)) => false,
                 },
@@ -334,24 +373,18 @@ fn folder_of(path: &std::path::Path) -> std::path::PathBuf {
     path.parent().filter(|p| !p.as_os_str().is_empty()).map_or_else(|| ".".into(), std::path::Path::to_path_buf)
 }
 
-/// The encoder thread: writes each frame `repeats` times, then finishes the file. After an error
-/// it keeps draining (so the show's sends never block) and returns the error at the end.
-fn encode(mut writer: VideoWriter, frames: Receiver<(Vec<u8>, u32)>) -> Result<u64, VideoError> {
+/// The encoder thread: hands each frame to the outlet, then closes it. After an error it keeps
+/// draining (so the show's sends never block) and returns the error at the end.
+fn encode(mut outlet: Box<dyn FrameOutlet>, frames: Receiver<(Vec<u8>, u32, u64)>) -> Result<u64, VideoError> {
     let mut failure = None;
-    for (rgba, repeats) in frames {
-        if failure.is_some() {
-            continue;
-        }
-        for _ in 0..repeats {
-            if let Err(e) = writer.write(&rgba) {
-                failure = Some(e);
-                break;
-            }
+    for (rgba, repeats, frame) in frames {
+        if failure.is_none() {
+            failure = outlet.take(&rgba, repeats, frame).err();
         }
     }
     match failure {
         Some(e) => Err(e),
-        None => writer.finish(),
+        None => outlet.close(),
     }
 }
 

@@ -2,11 +2,16 @@
 //! against golden references. Knows nothing of windows or UI.
 
 pub mod capture;
+mod frame_pipe;
 mod golden;
+mod ndi_out;
+mod pipewire_out;
 mod renderer;
 pub mod video;
 
-pub use capture::{CaptureCounts, CaptureReport, FinishingTake, LiveRecorder};
+pub use capture::{CaptureCounts, CaptureReport, FinishingTake, FrameOutlet, LiveRecorder};
 pub use golden::{FlipScore, GoldenCheck, flip_score};
+pub use ndi_out::ndi_outlet;
+pub use pipewire_out::{GST_LAUNCH_ENV, PipeWireOut};
 pub use renderer::{OffscreenRenderer, RenderError, RenderedFrame, write_png};
 pub use video::{VideoError, VideoSettings, VideoWriter};

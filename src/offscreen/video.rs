@@ -6,10 +6,10 @@
 //! yuv420p) in `.mp4` and `.mkv`, ProRes 422 HQ in `.mov`, VP9 in `.webm`. Odd sizes are padded by
 //! one black row or column (4:2:0 chroma needs even sides). Colours are tagged BT.709.
 
-use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Child, ChildStdin, Command, Stdio};
-use std::thread::JoinHandle;
+use std::process::{Command, Stdio};
+
+use super::frame_pipe::FramePipe;
 
 pub use crate::media::ffmpeg::FFMPEG_ENV;
 
@@ -68,10 +68,7 @@ pub enum VideoError {
 /// A running encoder; frames go in with [`VideoWriter::write`], [`VideoWriter::finish`] closes
 /// the file. Dropping it without `finish` kills ffmpeg (the file is then incomplete).
 pub struct VideoWriter {
-    child: Child,
-    stdin: Option<ChildStdin>,
-    /// Collects ffmpeg's standard error, so a failure can say what ffmpeg said.
-    stderr: Option<JoinHandle<String>>,
+    pipe: FramePipe,
     settings: VideoSettings,
     frames: u64,
 }
@@ -283,22 +280,9 @@ impl VideoWriter {
                 detail: format!("cannot create {}: {e}", folder.display()),
             })?;
         }
-        let mut child = Command::new(&program)
-            .args(&args)
-            .stdin(Stdio::piped())
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
+        let pipe = FramePipe::spawn(&program, &args)
             .map_err(|e| VideoError::NoFfmpeg(format!("{}: {e}", program.to_string_lossy())))?;
-        let stdin = child.stdin.take();
-        let stderr = child.stderr.take().map(|mut pipe| {
-            std::thread::spawn(move || {
-                let mut text = String::new();
-                let _ = pipe.read_to_string(&mut text);
-                text
-            })
-        });
-        Ok(Self { child, stdin, stderr, settings, frames: 0 })
+        Ok(Self { pipe, settings, frames: 0 })
     }
 
     /// Frames written so far.
@@ -321,45 +305,21 @@ impl VideoWriter {
                 rgba.len()
             )));
         }
-        let Some(stdin) = self.stdin.as_mut() else {
-            return Err(self.failure("the encoder was already closed".into()));
-        };
-        if let Err(e) = stdin.write_all(rgba) {
-            // ffmpeg quit (bad codec, full disk): its own words say why better than a broken pipe.
-            self.stdin = None;
-            let _ = self.child.wait();
-            return Err(self.failure(format!("it stopped taking frames ({e})")));
-        }
+        // ffmpeg quit (bad codec, full disk): its own words say why better than a broken pipe.
+        self.pipe.write(rgba).map_err(|detail| self.failure(detail))?;
         self.frames += 1;
         Ok(())
     }
 
     /// Closes the input and waits for ffmpeg to finish the file; returns the frames written.
     pub fn finish(mut self) -> Result<u64, VideoError> {
-        drop(self.stdin.take());
-        let status = self.child.wait().map_err(|e| self.failure(format!("cannot wait for it: {e}")))?;
-        if !status.success() {
-            return Err(self.failure(format!("it ended with {status}")));
-        }
+        self.pipe.finish().map_err(|detail| self.failure(detail))?;
         Ok(self.frames)
     }
 
-    /// An error carrying ffmpeg's last words (or `fallback` when it said nothing).
-    fn failure(&mut self, fallback: String) -> VideoError {
-        let said = self.stderr.take().and_then(|t| t.join().ok()).unwrap_or_default();
-        let lines: Vec<&str> = said.lines().filter(|l| !l.trim().is_empty()).collect();
-        let tail = lines[lines.len().saturating_sub(3)..].join(" / ");
-        let detail = if tail.is_empty() { fallback } else { format!("{fallback}: {tail}") };
+    /// An error naming the file, with ffmpeg's last words.
+    fn failure(&self, detail: String) -> VideoError {
         VideoError::Ffmpeg { path: self.settings.path.display().to_string(), detail }
-    }
-}
-
-impl Drop for VideoWriter {
-    fn drop(&mut self) {
-        if self.stdin.is_some() {
-            let _ = self.child.kill();
-            let _ = self.child.wait();
-        }
     }
 }
 

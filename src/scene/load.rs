@@ -71,6 +71,12 @@ pub struct SceneOutput {
     pub monitor: Option<usize>,
     /// Borderless fullscreen on that monitor.
     pub fullscreen: bool,
+    /// The NDI source its image is also sent as.
+    pub ndi: Option<String>,
+    /// The PipeWire video source its image is also offered as.
+    pub pipewire: Option<String>,
+    /// No window: the output only feeds its sends.
+    pub headless: bool,
 }
 
 /// A scene's OSC aliases and MIDI mappings, resolved.
@@ -195,28 +201,29 @@ impl Scene {
 
     /// Adds an output from the command line (`run --output-window`): `source=NODE` (default the
     /// scene's output), `warp=FILE.ron` (a warp node `output<n>` in between, with its corner
-    /// addresses), `monitor=N`, `fullscreen` — separated by commas, as a scene's `outputs` has.
+    /// addresses), `monitor=N`, `fullscreen`, `ndi=NAME`, `pipewire=NAME`, `headless` — separated
+    /// by commas, as a scene's `outputs` has.
     pub fn add_output(&mut self, spec: &str) -> Result<(), String> {
-        let mut source = None;
-        let mut warp = None;
-        let mut monitor = None;
-        let mut fullscreen = false;
+        let mut output = OutputFile::default();
         for part in spec.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-            match part.split_once('=').map(|(k, v)| (k.trim(), v.trim())) {
-                Some(("source", v)) => source = Some(v.to_string()),
-                Some(("warp", v)) => warp = Some(v.to_string()),
+            match part.split_once('=').map(|(k, v)| (k.trim(), v.trim().to_string())) {
+                Some(("source", v)) => output.source = Some(v),
+                Some(("warp", v)) => output.warp = Some(v),
                 Some(("monitor", v)) => {
-                    monitor = Some(v.parse::<usize>().map_err(|_| format!("monitor '{v}' is not a number"))?);
+                    output.monitor = Some(v.parse::<usize>().map_err(|_| format!("monitor '{v}' is not a number"))?);
                 }
-                None if part == "fullscreen" => fullscreen = true,
+                Some(("ndi", v)) => output.ndi = Some(v),
+                Some(("pipewire", v)) => output.pipewire = Some(v),
+                None if part == "fullscreen" => output.fullscreen = true,
+                None if part == "headless" => output.headless = true,
                 _ => {
                     return Err(format!(
-                        "'{part}' in output '{spec}': use source=NODE, warp=FILE.ron, monitor=N and fullscreen"
+                        "'{part}' in output '{spec}': use source=NODE, warp=FILE.ron, monitor=N, fullscreen, ndi=NAME, pipewire=NAME and headless"
                     ));
                 }
             }
         }
-        self.attach_output(&OutputFile { source, warp, monitor, fullscreen })
+        self.attach_output(&output)
     }
 
     /// Adds output `output` (from the scene file's `outputs` or the command line): resolves its
@@ -245,7 +252,17 @@ impl Scene {
             self.nodes.push(SceneNode { id, technique, params, inputs: vec![node], slots, hears_audio: false });
             node = self.nodes.len() - 1;
         }
-        self.outputs.push(SceneOutput { node, monitor: output.monitor, fullscreen: output.fullscreen });
+        if output.headless && output.ndi.is_none() && output.pipewire.is_none() {
+            return Err(format!("output {number} is headless and sends nowhere: give it ndi=NAME or pipewire=NAME"));
+        }
+        self.outputs.push(SceneOutput {
+            node,
+            monitor: output.monitor,
+            fullscreen: output.fullscreen,
+            ndi: output.ndi.clone(),
+            pipewire: output.pipewire.clone(),
+            headless: output.headless,
+        });
         self.osc_aliases.retain(|(a, _)| !a.starts_with("/indra/output/"));
         self.osc_aliases.extend(corner_aliases(&self.outputs, &self.nodes));
         Ok(())

@@ -84,6 +84,15 @@ pub struct OutputFile {
     /// Open borderless fullscreen on that monitor.
     #[serde(default)]
     pub fullscreen: bool,
+    /// Also send its image as an NDI source of this name (`run`).
+    #[serde(default)]
+    pub ndi: Option<String>,
+    /// Also offer its image as a PipeWire video source of this name (`run`).
+    #[serde(default)]
+    pub pipewire: Option<String>,
+    /// Open no window for it: the output only feeds its sends (`ndi`, `pipewire`).
+    #[serde(default)]
+    pub headless: bool,
 }
 
 /// How controllers reach parameters, besides the default `/indra/<node>/<param>` addresses.

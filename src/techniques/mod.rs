@@ -21,6 +21,7 @@ pub mod image_pass;
 pub mod isf;
 pub mod kleinian;
 pub mod mesh2d_draw;
+pub mod ndi;
 pub mod picture_pass;
 pub mod poisson;
 pub mod polygon_draw;
@@ -56,6 +57,7 @@ pub const REGISTRY: &[TechniqueInfo] = &[
     fader::INFO,
     video::INFO,
     camera::INFO,
+    ndi::INFO,
     isf::INFO,
 ];
 

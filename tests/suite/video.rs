@@ -195,7 +195,7 @@ fn a_live_recording_writes_each_shown_frame_for_every_step_it_advanced() {
         let texture = solid(&gpu, size, i as f32 / 10.0);
         let view = texture.create_view(&Default::default());
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        recorder.capture(&gpu.device, &mut encoder, &view, n);
+        recorder.capture(&gpu.device, &mut encoder, &view, n, 0);
         gpu.queue.submit([encoder.finish()]);
         recorder.after_submit();
         // The show waits for its own frame, never for the recorder.
@@ -258,7 +258,7 @@ fn frames_a_busy_readback_cannot_take_are_counted_not_lost_silently() {
     let view = texture.create_view(&Default::default());
     for _ in 0..10 {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        recorder.capture(&gpu.device, &mut encoder, &view, 1);
+        recorder.capture(&gpu.device, &mut encoder, &view, 1, 0);
         gpu.queue.submit([encoder.finish()]);
         recorder.after_submit();
     }

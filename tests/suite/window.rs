@@ -70,6 +70,17 @@ impl Show {
     /// Starts `indra run <scene> <args>` on `display`, with OSC on a free loopback port and its
     /// presets, learn file and log in `dir`. Returns the show and its OSC port.
     pub(crate) fn start(display: &VirtualDisplay, dir: &Path, scene: &str, args: &[&std::ffi::OsStr]) -> (Self, u16) {
+        Self::start_with_env(display, dir, scene, args, &[])
+    }
+
+    /// [`Show::start`] with more environment variables for the show.
+    pub(crate) fn start_with_env(
+        display: &VirtualDisplay,
+        dir: &Path,
+        scene: &str,
+        args: &[&std::ffi::OsStr],
+        env: &[(&str, &std::ffi::OsStr)],
+    ) -> (Self, u16) {
         let port = UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
         let log = dir.join("show.log");
         let child = Command::new(env!("CARGO_BIN_EXE_indra"))
@@ -84,6 +95,7 @@ impl Show {
             .env("DISPLAY", &display.display)
             .env_remove("WAYLAND_DISPLAY")
             .env("RUST_LOG", "info")
+            .envs(env.iter().copied())
             .stdout(Stdio::null())
             .stderr(std::fs::File::create(&log).unwrap())
             .spawn()
@@ -206,7 +218,7 @@ fn the_show_streams_over_srt_from_the_start_until_sigterm() {
     show.wait_for("streaming to");
     std::thread::sleep(Duration::from_secs(3));
     assert!(Command::new("kill").args(["-TERM", &show.child.id().to_string()]).status().unwrap().success());
-    let log = show.wait_for("stream ended");
+    let log = show.wait_for("send ended");
     let deadline = Instant::now() + Duration::from_secs(30);
     while receiver.try_wait().unwrap().is_none() && Instant::now() < deadline {
         std::thread::sleep(Duration::from_millis(100));
@@ -216,7 +228,7 @@ fn the_show_streams_over_srt_from_the_start_until_sigterm() {
     assert!(size > 0, "nothing arrived:\n{log}");
     let n = frames(&received);
     let sent: u64 = log
-        .split("stream ended: recorded ")
+        .split("send ended: recorded ")
         .nth(1)
         .and_then(|rest| rest.split(' ').next())
         .and_then(|n| n.parse().ok())
@@ -303,4 +315,80 @@ fn the_network_can_neither_name_files_outside_nor_freeze_the_show_with_them() {
     assert!(log.contains("take not started"), "{log}");
     let written = std::fs::read_dir(&takes).unwrap().count();
     assert!((1..=6).contains(&written), "{written} takes written:\n{log}");
+}
+
+/// `run --ndi-out`: the window's output reaches a cyndilib receiver (in a network namespace of
+/// its own) from the readback ring, stamped with its show frame, which matches that frame
+/// rendered off-screen; SIGTERM ends the show and the send cleanly.
+#[test]
+fn the_show_sends_its_output_as_ndi_and_each_frame_is_its_render() {
+    use crate::ndi::{mean_difference, out_dir, peer_python, png_rgb, run_peer};
+    let Some(python) = peer_python() else { return };
+    let display = VirtualDisplay::start();
+    let dir = out_dir("window");
+    let args =
+        ["--backend", "vulkan", "run", "kleinian", "--no-midi", "--no-watch", "--no-osc", "--ndi-out", "indra-out"];
+    let (report, log) =
+        run_peer(&python, "receive-live", &dir, &args, &[("DISPLAY", &display.display), ("RUST_LOG", "info")]);
+    assert_eq!(report["found"], true, "the receiver never saw the show's source: {log}");
+    assert!(log.contains("sending the output as the NDI source 'indra-out'"), "{log}");
+    assert!(log.contains("send ended: recorded"), "SIGTERM ends the send: {log}");
+    let frames = report["frames"].as_array().unwrap();
+    assert!(frames.len() >= 4, "{report}");
+    let f = &frames[frames.len() / 2];
+    let (w, h) = (f["size"][0].as_u64().unwrap(), f["size"][1].as_u64().unwrap());
+    let n = f["frame"].as_u64().unwrap();
+    let received = std::fs::read(f["file"].as_str().unwrap()).unwrap();
+    assert_eq!(received.len() as u64, w * h * 4);
+    // The same frames off-screen: the received one is frame n, not a neighbour.
+    let first = n.saturating_sub(2);
+    let png = dir.join("png");
+    let o = crate::common::indra(&[
+        "render",
+        "kleinian",
+        "--size",
+        &format!("{w}x{h}"),
+        "--start",
+        &first.to_string(),
+        "--frames",
+        "5",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", crate::common::text(&o));
+    let difference = |m: u64| mean_difference(&received, &png_rgb(&png.join(format!("kleinian_{m:05}.png"))));
+    let own = difference(n);
+    assert!(own < 6.0, "frame {n} arrived {own:.2} away from its render");
+    for m in (first..first + 5).filter(|&m| m != n) {
+        assert!(own < difference(m), "frame {n} ({own:.2}) is nearer frame {m}'s render ({:.2})", difference(m));
+    }
+}
+
+/// `run --pipewire-out`: the window's output is a PipeWire video source a GStreamer consumer reads
+/// while the show runs, and so is one node's image through a headless output (no window of its
+/// own); SIGTERM withdraws both cleanly.
+#[test]
+fn the_show_offers_its_output_and_a_node_as_pipewire_sources_until_sigterm() {
+    let Some(session) = crate::pipewire::PipeWireSession::start("window") else { return };
+    let display = VirtualDisplay::start();
+    let dir = scratch_dir("window-pipewire");
+    let env =
+        [("XDG_RUNTIME_DIR", session.runtime_dir.as_os_str()), ("DBUS_SESSION_BUS_ADDRESS", session.bus.as_ref())];
+    let args = ["--pipewire-out", "indra-window", "--output-window", "source=limit_set,headless,pipewire=indra-node"];
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_ref()).collect();
+    let (mut show, _) = Show::start_with_env(&display, &dir, "kleinian_star_glow", &args, &env);
+    show.wait_for("offering the output as the PipeWire source 'indra-window'");
+    let log = show.wait_for("offering output 1 as the PipeWire source 'indra-node'");
+    assert!(!log.contains("output 1: window"), "a headless output opens no window:\n{log}");
+    for node in ["indra-window", "indra-node"] {
+        let received = session.receive(node, 5, Instant::now() + Duration::from_secs(30));
+        assert!(!received.is_empty() && received.len() % 5 == 0, "{node}: {} bytes", received.len());
+        let frame = &received[..received.len() / 5];
+        assert!(frame.chunks_exact(4).any(|p| p != &frame[..4]), "{node}: the limit set, not a flat frame");
+    }
+    assert!(Command::new("kill").args(["-TERM", &show.child.id().to_string()]).status().unwrap().success());
+    show.wait_for("send ended");
+    let _ = show.child.wait();
+    let log = std::fs::read_to_string(&show.log).unwrap();
+    assert_eq!(log.matches("send ended: recorded").count(), 2, "{log}");
 }

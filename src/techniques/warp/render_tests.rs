@@ -347,17 +347,26 @@ fn mesh_points_move_where_the_pointer_puts_them_and_save_with_the_warp() {
 fn outputs_from_the_command_line_get_the_same_warp_nodes_and_addresses() {
     let mut scene = indra::scene::load_scene(&assets(), "projection_mapping").unwrap();
     scene.add_output("warp=warps/wall-right.ron, monitor=2, fullscreen").unwrap();
-    scene.add_output("source=limit_set").unwrap();
+    scene.add_output("source=limit_set, headless, ndi=clean feed, pipewire=clean").unwrap();
     assert_eq!(scene.outputs.len(), 2);
+    let sends = &scene.outputs[1];
+    assert_eq!(
+        (sends.ndi.as_deref(), sends.pipewire.as_deref(), sends.headless),
+        (Some("clean feed"), Some("clean"), true)
+    );
+    assert!(scene.outputs[0].ndi.is_none() && !scene.outputs[0].headless);
     let warped = &scene.nodes[scene.outputs[0].node];
     assert_eq!((warped.id.as_str(), warped.technique.name), ("output1", "warp"));
     assert_eq!((scene.outputs[0].monitor, scene.outputs[0].fullscreen), (Some(2), true));
     assert_eq!(scene.nodes[scene.outputs[1].node].id, "limit_set");
     let map = indra::control::AddressMap::new(&scene);
     assert!(map.route("/indra/output/1/corner/3").is_some() && map.route("/indra/output/2/corner/0").is_none());
-    for (bad, said) in
-        [("colour=red", "'colour=red'"), ("source=nowhere", "'nowhere'"), ("monitor=left", "not a number")]
-    {
+    for (bad, said) in [
+        ("colour=red", "'colour=red'"),
+        ("source=nowhere", "'nowhere'"),
+        ("monitor=left", "not a number"),
+        ("headless", "sends nowhere"),
+    ] {
         let e = scene.clone().add_output(bad).unwrap_err();
         assert!(e.contains(said), "{bad}: {e}");
     }
