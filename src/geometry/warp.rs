@@ -134,6 +134,18 @@ impl MeshWarp {
         None
     }
 
+    /// Whether it is the identity (every point where the regular grid has it).
+    pub fn is_identity(&self) -> bool {
+        self.points == Self::regular(self.columns, self.rows).points
+    }
+
+    /// The control points with the extrapolated ring around them that the surface reads:
+    /// `(columns + 2) × (rows + 2)`, row by row from the bottom, starting at (−1, −1).
+    pub fn extended_points(&self) -> Vec<[f32; 2]> {
+        let (c, r) = (i64::from(self.columns), i64::from(self.rows));
+        (-1..=r).flat_map(|j| (-1..=c).map(move |i| (i, j))).map(|(i, j)| self.point(i, j)).collect()
+    }
+
     /// Control point (i, j); one step outside the grid it is extrapolated linearly (2·edge −
     /// next), so the smooth surface reproduces a regular grid exactly, border cells included.
     fn point(&self, i: i64, j: i64) -> [f32; 2] {

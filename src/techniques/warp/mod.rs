@@ -8,17 +8,17 @@
 //! values and the mesh back. A file that cannot be read or parsed is one message, and the last
 //! good warp stays on the wall.
 
-use std::cell::RefCell;
 use std::path::PathBuf;
 
 use crate::assets::Assets;
 use crate::files::Loader;
 use crate::geometry::warp::{Corners, EdgeBlend, Homography, MAX_MESH_SIDE, MeshWarp, Region, WarpFile};
-use crate::gpu::{BindGroupCache, GrowableBuffer, RasterDesc, ShaderError, uniform_buffer, uniform_entry};
-use crate::graph::{FrameGraph, PassContext, RasterTargets, TextureHandle};
+use crate::gpu::ShaderError;
+use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue, Text};
 use crate::time::FrameTime;
 
+use super::image_pass::{self, ImageKernel, ImagePass};
 use super::{NodeSetup, Technique, TechniqueInfo};
 
 /// The registry entry.
@@ -42,7 +42,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 };
 
 /// Output format: linear HDR like every node.
-pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const FORMAT: wgpu::TextureFormat = image_pass::FORMAT;
 
 /// The example warps the bundled scenes use, by the path they give.
 const BUNDLED: [(&str, &str); 3] = [
@@ -54,8 +54,8 @@ const BUNDLED: [(&str, &str); 3] = [
 /// The largest warp file read: a 16 × 16 mesh with blend settings is a few kilobytes.
 const WARP_FILE_LIMIT: u64 = 1 << 20;
 
-/// Triangle rows and columns per mesh cell (a smooth mesh is curved inside a cell).
-const SUBDIVISIONS: u32 = 16;
+/// Pairs of control points the uniform block holds: the largest mesh with its extrapolated ring.
+const POINT_PAIRS: usize = ((MAX_MESH_SIDE as usize + 2) * (MAX_MESH_SIDE as usize + 2)).div_ceil(2);
 
 /// The corner parameters, in the order of the OSC aliases `/indra/output/<n>/corner/<i>`:
 /// clockwise from the top left.
@@ -126,40 +126,26 @@ pub fn params() -> Vec<ParamDecl> {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct WarpUniforms {
-    /// Unit square → view units, as three padded columns.
-    pub homography: [[f32; 4]; 3],
+    /// View units → the unit square after the mesh (the inverse corner pin), as three padded
+    /// columns.
+    pub inverse_pin: [[f32; 4]; 3],
     /// Blend widths: left, right, top, bottom.
     pub blend: [f32; 4],
     /// Ramp exponent, gamma, black lift, grid on (1) or off (0).
     pub shape: [f32; 4],
-    /// Mesh cells across and up.
+    /// Mesh cells across and up, 1 when the mesh is the identity, 1 smooth or 0 linear.
     pub grid: [f32; 4],
     /// The part of the source shown: min x, min y, max x, max y (v up).
     pub region: [f32; 4],
-}
-
-/// A mesh vertex: source coordinates and where the mesh warp moved them.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-struct Vertex {
-    uv: [f32; 2],
-    warped: [f32; 2],
+    /// The control points and their extrapolated ring (see `MeshWarp::extended_points`), two
+    /// to an entry.
+    pub points: [[f32; 4]; POINT_PAIRS],
 }
 
 /// A warp node.
 pub struct Warp {
-    pipeline: wgpu::RenderPipeline,
-    uniform_buffer: wgpu::Buffer,
-    uniform_group: wgpu::BindGroup,
-    source_layout: wgpu::BindGroupLayout,
-    sampler: wgpu::Sampler,
-    source_groups: RefCell<BindGroupCache<u64>>,
-    samples: u32,
-    vertices: GrowableBuffer,
-    indices: GrowableBuffer,
-    index_count: u32,
-    device: wgpu::Device,
-    queue: wgpu::Queue,
+    kernel: ImageKernel,
+    pass: ImagePass,
     /// Where warp files are looked up, and may be saved.
     assets: Assets,
     /// Warp files being read and parsed off the render thread.
@@ -188,72 +174,14 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
 }
 
 impl Warp {
-    /// Builds the pipeline from `warp.wgsl`.
+    /// Builds the kernel from `warp.wgsl`.
     pub fn new(setup: &NodeSetup<'_>) -> Result<Self, ShaderError> {
         let device = &setup.gpu.device;
-        let (origin, source) = setup.shader_source("warp.wgsl", &[("u", 0)])?;
-        let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
-        let uniform_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("warp_uniforms"),
-            entries: &[uniform_entry::<WarpUniforms>(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
-        });
-        let source_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("warp_source"),
-            entries: &crate::gpu::sampled_texture_entries(0, wgpu::ShaderStages::FRAGMENT),
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("warp"),
-            bind_group_layouts: &[Some(&uniform_layout), Some(&source_layout)],
-            immediate_size: 0,
-        });
-        let samples = setup.samples_for(&[FORMAT]);
-        let pipeline = crate::gpu::validated(device, &origin, || {
-            crate::gpu::raster_pipeline(
-                device,
-                &module,
-                &layout,
-                &RasterDesc {
-                    vertex: "vs_main",
-                    fragment: "fs_main",
-                    buffers: &[Some(wgpu::VertexBufferLayout {
-                        array_stride: size_of::<Vertex>() as u64,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &wgpu::vertex_attr_array![0 => Float32x2, 1 => Float32x2],
-                    })],
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    color: FORMAT,
-                    depth: None,
-                    additive: false,
-                    samples,
-                },
-            )
-        })?;
-        let uniform_buffer = uniform_buffer::<WarpUniforms>(device, "warp_uniforms");
-        let uniform_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("warp_uniforms"),
-            layout: &uniform_layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniform_buffer.as_entire_binding() }],
-        });
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("warp_sampler"),
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            ..Default::default()
-        });
-        use wgpu::BufferUsages as U;
-        let mut warp = Self {
-            pipeline,
-            uniform_buffer,
-            uniform_group,
-            source_layout,
-            sampler,
-            source_groups: RefCell::new(BindGroupCache::default()),
-            samples,
-            vertices: GrowableBuffer::new(device, "warp_vertices", U::VERTEX, 1024),
-            indices: GrowableBuffer::new(device, "warp_indices", U::INDEX, 1024),
-            index_count: 0,
-            device: device.clone(),
-            queue: setup.gpu.queue.clone(),
+        let (origin, source) = setup.shader_source("warp.wgsl", &image_pass::bindings(1))?;
+        let kernel = ImageKernel::new(device, (&origin, &source), "warp", 1, size_of::<WarpUniforms>() as u64)?;
+        Ok(Self {
+            pass: ImagePass::new(device, &kernel),
+            kernel,
             assets: setup.assets.clone(),
             loader: Loader::new(setup.assets.load_wait()),
             warp_files: Default::default(),
@@ -265,9 +193,7 @@ impl Warp {
             requested: None,
             loaded: Vec::new(),
             messages: Vec::new(),
-        };
-        warp.upload_mesh();
-        Ok(warp)
+        })
     }
 
     /// The mesh in use.
@@ -290,7 +216,6 @@ impl Warp {
                 self.warp_files.extend(file);
                 self.mesh = warp.mesh.clone().unwrap_or_else(|| MeshWarp::regular(2, 2));
                 self.applied_size = [self.mesh.columns, self.mesh.rows];
-                self.upload_mesh();
                 self.loaded = loaded_values(&warp);
                 let size = [self.mesh.columns as f32, self.mesh.rows as f32];
                 self.loaded.push(("mesh_size", ParamValue::Vec2(size)));
@@ -332,13 +257,11 @@ impl Warp {
     /// control point moved to a view position, through the inverse corner pin) when they change.
     fn edit_mesh(&mut self, settings: &Settings) {
         let size = settings.mesh_size.map(|v| (v.round() as u32).clamp(2, MAX_MESH_SIDE));
-        let mut changed = false;
         if size != self.applied_size {
             let regular = MeshWarp::regular(size[0], size[1]);
             let points = regular.points.iter().map(|p| self.mesh.evaluate(p[0], p[1])).collect();
             self.mesh = MeshWarp { points, interpolation: self.mesh.interpolation, ..regular };
             self.applied_size = size;
-            changed = true;
         }
         let point = settings.mesh_point;
         if point != self.applied_point {
@@ -349,66 +272,8 @@ impl Warp {
                 && index >= 0.0
             {
                 *slot = [at[0] as f32, at[1] as f32];
-                changed = true;
             }
         }
-        if changed {
-            self.upload_mesh();
-        }
-    }
-
-    /// Tessellates the mesh into the vertex and index buffers.
-    fn upload_mesh(&mut self) {
-        let (cols, rows) = ((self.mesh.columns - 1) * SUBDIVISIONS + 1, (self.mesh.rows - 1) * SUBDIVISIONS + 1);
-        let mut vertices = Vec::with_capacity((cols * rows) as usize);
-        for j in 0..rows {
-            for i in 0..cols {
-                let uv = [i as f32 / (cols - 1) as f32, j as f32 / (rows - 1) as f32];
-                vertices.push(Vertex { uv, warped: self.mesh.evaluate(uv[0], uv[1]) });
-            }
-        }
-        let mut indices = Vec::with_capacity(((cols - 1) * (rows - 1) * 6) as usize);
-        for j in 0..rows - 1 {
-            for i in 0..cols - 1 {
-                let a = j * cols + i;
-                indices.extend([a, a + 1, a + cols + 1, a, a + cols + 1, a + cols]);
-            }
-        }
-        self.vertices.write_all(&self.device, &self.queue, &vertices);
-        self.index_count = self.indices.write_all(&self.device, &self.queue, &indices);
-    }
-
-    fn source_group(&self, view: &wgpu::TextureView) -> wgpu::BindGroup {
-        self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("warp_source"),
-            layout: &self.source_layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(view) },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
-            ],
-        })
-    }
-
-    fn record(
-        &self,
-        ctx: &mut PassContext<'_>,
-        source: TextureHandle,
-        targets: &RasterTargets,
-        uniforms: &WarpUniforms,
-    ) {
-        ctx.queue.write_buffer(&self.uniform_buffer, 0, bytemuck::bytes_of(uniforms));
-        let group = self
-            .source_groups
-            .borrow_mut()
-            .get_or_create(ctx.texture_id(source), || self.source_group(ctx.view(source)))
-            .clone();
-        let mut pass = ctx.begin_draw(targets, wgpu::Color::BLACK);
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.uniform_group, &[]);
-        pass.set_bind_group(1, &group, &[]);
-        pass.set_vertex_buffer(0, self.vertices.buffer().slice(..));
-        pass.set_index_buffer(self.indices.buffer().slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..self.index_count, 0, 0..1);
     }
 }
 
@@ -497,12 +362,28 @@ pub fn warp_from(s: &Settings, mesh: Option<MeshWarp>) -> WarpFile {
 pub fn uniforms(settings: &Settings, mesh: &MeshWarp) -> WarpUniforms {
     let warp = warp_from(settings, None);
     let b = warp.blend;
+    // A degenerate pin (corners on one line) shows nothing: every pixel is beyond its horizon.
+    let inverse = warp.corners.homography().inverse();
+    let inverse_pin =
+        inverse.map_or([[0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0], [0.0, 0.0, -1.0, 0.0]], |h| h.to_wgsl_columns());
+    let mut points = [[0.0; 4]; POINT_PAIRS];
+    for (slot, pair) in points.iter_mut().zip(mesh.extended_points().chunks(2)) {
+        let second = pair.get(1).copied().unwrap_or_default();
+        *slot = [pair[0][0], pair[0][1], second[0], second[1]];
+    }
+    let smooth = mesh.interpolation == crate::geometry::warp::MeshInterpolation::Smooth;
     WarpUniforms {
-        homography: warp.corners.homography().to_wgsl_columns(),
+        inverse_pin,
         blend: [b.left, b.right, b.top, b.bottom],
         shape: [b.curve, b.gamma, warp.black_lift, if settings.grid { 1.0 } else { 0.0 }],
-        grid: [(mesh.columns - 1) as f32, (mesh.rows - 1) as f32, 0.0, 0.0],
+        grid: [
+            (mesh.columns - 1) as f32,
+            (mesh.rows - 1) as f32,
+            if mesh.is_identity() { 1.0 } else { 0.0 },
+            if smooth { 1.0 } else { 0.0 },
+        ],
         region: [warp.region.min[0], warp.region.min[1], warp.region.max[0], warp.region.max[1]],
+        points,
     }
 }
 
@@ -525,7 +406,6 @@ impl Technique for Warp {
             self.mesh = MeshWarp::regular(2, 2);
             self.applied_size = [2, 2];
             self.loaded.push(("mesh_size", ParamValue::Vec2([2.0, 2.0])));
-            self.upload_mesh();
         }
         self.requested = Some(path.clone());
         if settings.save {
@@ -565,15 +445,9 @@ impl Technique for Warp {
         _time: &FrameTime,
         inputs: &[TextureHandle],
     ) -> TextureHandle {
-        self.source_groups.get_mut().begin_frame();
-        let targets = graph.create_raster_targets("warp", FORMAT, None, self.samples);
-        let Some(&source) = inputs.first() else { return targets.color };
         let uniforms = uniforms(&Settings::read(params), &self.mesh);
-        let this = &*self;
-        graph.add_pass("warp/draw").read(source).draws_into(&targets).record(move |ctx| {
-            this.record(ctx, source, &targets, &uniforms);
-        });
-        targets.color
+        let Some(&source) = inputs.first() else { return image_pass::black(graph) };
+        self.pass.declare(graph, "warp", &self.kernel, uniforms, &[source])
     }
 }
 
