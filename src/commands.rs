@@ -775,6 +775,8 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     }
     renderer.restart_timings();
     let mut walls = Vec::with_capacity(args.frames.min(1 << 16) as usize);
+    // Stepping, recording and submitting a frame: the CPU's share of its wall time.
+    let mut cpu = Vec::with_capacity(walls.capacity());
     let mut switches = Vec::new();
     let mut last = Instant::now();
     let mut stats = None;
@@ -786,6 +788,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         }
         let (time, s) = renderer.render_only().map_err(|e| e.to_string())?;
         let recorded = Instant::now();
+        cpu.push((recorded - last).as_secs_f64() * 1e3);
         // Waiting each frame makes wall time the frame's full latency, not queue depth.
         let _ = renderer.gpu().device.poll(wgpu::PollType::wait_indefinitely());
         let now = Instant::now();
@@ -837,9 +840,14 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         if let Some(ms) = renderer.runtime().frame_gpu_median_ms() {
             say!("{:<28} {:>9.3} ms", "all passes (GPU)", ms);
         }
+        if let Some(ms) = renderer.runtime().frame_gpu_span_median_ms() {
+            say!("{:<28} {:>9.3} ms", "first pass to last (GPU)", ms);
+        }
     } else {
         say!("(this adapter has no TIMESTAMP_QUERY_INSIDE_ENCODERS: wall-clock only)");
     }
+    cpu.sort_by(f64::total_cmp);
+    say!("{:<28} {:>9.3} ms", "step + record (CPU median)", cpu.get(cpu.len() / 2).copied().unwrap_or(0.0));
     say!("{:<28} {:>9.3} ms  ({:.1} fps)", "frame wall time (median)", wall_median, 1e3 / wall_median.max(1e-9));
     if !switches.is_empty() {
         report_switches(&switches, &in_order, wall_median, cue_steps.unwrap_or(1));

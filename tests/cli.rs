@@ -151,6 +151,8 @@ fn bench_prints_pass_medians_and_frame_time() {
     assert!(t.contains("frame wall time (median)") && t.contains("set        limit_set.samples=2"), "{t}");
     assert!(t.contains("from frame 30"), "{t}");
     assert!(t.contains("kleinian/limit_set") || t.contains("wall-clock only"), "{t}");
+    assert!(t.contains("step + record (CPU median)"), "{t}");
+    assert!(t.contains("first pass to last (GPU)") || t.contains("wall-clock only"), "{t}");
 }
 
 #[test]

@@ -242,6 +242,12 @@ impl GraphRuntime {
         self.timer.as_ref().and_then(|t| t.frame_median_ms())
     }
 
+    /// Rolling median of the span from the first pass's start to the last pass's end per frame
+    /// (the pass time and the GPU's gaps between passes), milliseconds.
+    pub fn frame_gpu_span_median_ms(&self) -> Option<f64> {
+        self.timer.as_ref().and_then(|t| t.frame_span_median_ms())
+    }
+
     /// Waits for outstanding timestamp readbacks and folds them into the medians.
     pub fn drain_timings(&mut self, device: &wgpu::Device) {
         if let Some(t) = self.timer.as_mut() {

@@ -79,6 +79,9 @@ pub(crate) struct GpuTimer {
     period_ns: f64,
     medians: BTreeMap<String, RollingMedian>,
     frame_total: RollingMedian,
+    /// Per frame, the first pass's start to the last pass's end: the passes' time and the GPU's
+    /// gaps between them.
+    frame_span: RollingMedian,
     current: Option<usize>,
 }
 
@@ -117,6 +120,7 @@ impl GpuTimer {
             period_ns: f64::from(queue.get_timestamp_period()),
             medians: BTreeMap::new(),
             frame_total: RollingMedian::new(WINDOW),
+            frame_span: RollingMedian::new(WINDOW),
             current: None,
         }
     }
@@ -194,6 +198,11 @@ impl GpuTimer {
                 self.medians.entry(name.clone()).or_insert_with(|| RollingMedian::new(WINDOW)).push(ms);
             }
             self.frame_total.push(total);
+            let passes = stamps.len() / 2;
+            if passes > 0 {
+                let (first, last) = (stamps[0], stamps[2 * passes - 1]);
+                self.frame_span.push(last.wrapping_sub(first) as f64 * self.period_ns / 1e6);
+            }
         }
     }
 
@@ -212,10 +221,16 @@ impl GpuTimer {
         self.frame_total.median()
     }
 
+    /// Median of the span from the first pass's start to the last pass's end, milliseconds.
+    pub fn frame_span_median_ms(&self) -> Option<f64> {
+        self.frame_span.median()
+    }
+
     /// Forgets every sample so far (a benchmark starts measuring after its seek and warm-up).
     pub fn reset(&mut self) {
         self.medians.clear();
         self.frame_total = RollingMedian::new(WINDOW);
+        self.frame_span = RollingMedian::new(WINDOW);
     }
 
     /// Blocks until every in-flight slot is read (for `indra bench` at the end of a run).
