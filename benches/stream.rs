@@ -101,16 +101,7 @@ fn latencies(scheme: &str) -> Vec<f64> {
         receiver.args(["-f", "mpegts"]);
     }
     receiver.args(["-i", &listen, "-f", "rawvideo", "-pix_fmt", "gray", "-"]);
-    let settings = VideoSettings {
-        path: send.into(),
-        size: (SIDE, SIDE),
-        fps: FPS,
-        codec: None,
-        quality: None,
-        audio: None,
-        stream: true,
-        pace: false,
-    };
+    let settings = VideoSettings::stream(&send, (SIDE, SIDE), FPS, false);
     let writer = std::cell::RefCell::new(None::<VideoWriter>);
     measure(
         receiver,

@@ -461,17 +461,7 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     // ffmpeg starts before the GPU and the seek, so a missing one or a bad codec fails at once.
     let mut sink = match &args.video {
         None if args.stream.is_some() => {
-            let url = args.stream.clone().unwrap_or_default();
-            let settings = VideoSettings {
-                path: url.into(),
-                size,
-                fps,
-                codec: None,
-                quality: None,
-                audio: None,
-                stream: true,
-                pace: true,
-            };
+            let settings = VideoSettings::stream(args.stream.as_deref().unwrap_or_default(), size, fps, true);
             FrameSink::Video(VideoWriter::start(settings).map_err(|e| e.to_string())?)
         }
         Some(path) => {
@@ -496,15 +486,15 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
             FrameSink::Png { folder: args.out.clone(), stem }
         }
     };
-    // A render is faster than real time: the sender's clock paces it to the scene's rate.
-    let mut ndi = match &args.ndi_out {
-        Some(name) => Some(indra::media::ndi::NdiSender::start(name, size, fps, true)?),
-        None => None,
-    };
-    let mut pipewire = match &args.pipewire_out {
-        Some(name) => Some(indra::offscreen::PipeWireOut::start(name, size, fps, true)?),
-        None => None,
-    };
+    // Sends beside the frames written. A render is faster than real time: each send paces the
+    // frames to the scene's rate.
+    let mut sends: Vec<Box<dyn indra::offscreen::FrameOutlet>> = Vec::new();
+    if let Some(name) = &args.ndi_out {
+        sends.push(indra::offscreen::ndi_outlet(name, size, fps, true)?);
+    }
+    if let Some(name) = &args.pipewire_out {
+        sends.push(Box::new(indra::offscreen::PipeWireOut::start(name, size, fps, true)?));
+    }
     let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
     eprintln!("rendering '{}' on {}", scene.name, device.adapter_label());
     let mut renderer =
@@ -526,11 +516,8 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     for _ in 0..args.frames {
         let frame = renderer.render_next().map_err(|e| e.to_string())?;
         sink.write(&frame)?;
-        if let Some(sender) = ndi.as_mut() {
-            sender.send(&frame.rgba, frame.time.frame)?;
-        }
-        if let Some(source) = pipewire.as_mut() {
-            source.write(&frame.rgba)?;
+        for send in &mut sends {
+            send.take(&frame.rgba, 1, frame.time.frame).map_err(|e| e.to_string())?;
         }
         // What a node tells the performer (a clip that cannot play, a bad image path) is said
         // once, as the window's overlay says it; the render goes on.
@@ -551,8 +538,8 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
         }
         FrameSink::Png { folder, .. } => folder.display().to_string(),
     };
-    if let Some(source) = pipewire {
-        source.finish()?;
+    for send in sends {
+        send.close().map_err(|e| e.to_string())?;
     }
     eprintln!("wrote {} frame(s) to {place}", args.frames);
     Ok(())

@@ -207,16 +207,7 @@ impl WindowApp {
             Err(e) => overlay.report(format!("{failed}: {e}")),
         };
         if let Some(url) = &self.options.stream {
-            let settings = crate::offscreen::VideoSettings {
-                path: url.into(),
-                size,
-                fps,
-                codec: None,
-                quality: None,
-                audio: None,
-                stream: true,
-                pace: false,
-            };
+            let settings = crate::offscreen::VideoSettings::stream(url, size, fps, false);
             let writer = VideoWriter::start(settings).map(|w| Box::new(w) as Box<dyn FrameOutlet>);
             start_send(
                 None,
@@ -240,7 +231,7 @@ impl WindowApp {
                 let said = format!("sending {image} as the NDI source '{name}'");
                 start_send(
                     what,
-                    crate::offscreen::ndi_outlet(name, size, fps),
+                    crate::offscreen::ndi_outlet(name, size, fps, false),
                     said,
                     format!("cannot send NDI '{name}'"),
                 );

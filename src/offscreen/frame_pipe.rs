@@ -33,7 +33,7 @@ impl FramePipe {
         Ok(Self { child, stdin, stderr })
     }
 
-    /// Writes one frame; when the child has quit, says why in its own words (or `fallback`).
+    /// Writes one frame; when the child has quit, says why, in its own words where it said any.
     pub(crate) fn write(&mut self, frame: &[u8]) -> Result<(), String> {
         let Some(stdin) = self.stdin.as_mut() else {
             return Err(self.last_words("it was already closed"));

@@ -26,9 +26,10 @@ impl FrameOutlet for NdiOutlet {
     }
 }
 
-/// An outlet sending frames of `size` at `fps` as the NDI source `name`, for a live recorder.
-pub fn ndi_outlet(name: &str, size: (u32, u32), fps: f64) -> Result<Box<dyn FrameOutlet>, String> {
-    // Unclocked: the live show already runs in real time, and a clocked send would hold the
-    // recorder's thread and drop frames the network could take.
-    Ok(Box::new(NdiOutlet { sender: NdiSender::start(name, size, fps, false)? }))
+/// An outlet sending frames of `size` at `fps` as the NDI source `name`. With `paced` (a render,
+/// faster than real time) each frame waits until it is due; a live show, already in real time,
+/// sends unpaced — a clocked send would hold the recorder's thread and drop frames the network
+/// could take.
+pub fn ndi_outlet(name: &str, size: (u32, u32), fps: f64, paced: bool) -> Result<Box<dyn FrameOutlet>, String> {
+    Ok(Box::new(NdiOutlet { sender: NdiSender::start(name, size, fps, paced)? }))
 }

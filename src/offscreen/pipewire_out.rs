@@ -102,16 +102,6 @@ impl PipeWireOut {
         Ok(Self { pipe, name: name.to_string(), size, sent: 0 })
     }
 
-    /// The node's name.
-    pub fn name(&self) -> &str {
-        &self.name
-    }
-
-    /// Frames sent so far.
-    pub fn sent(&self) -> u64 {
-        self.sent
-    }
-
     /// Sends one frame of tight RGBA rows.
     pub fn write(&mut self, rgba: &[u8]) -> Result<(), String> {
         let (w, h) = self.size;

@@ -38,6 +38,14 @@ pub struct VideoSettings {
     pub pace: bool,
 }
 
+impl VideoSettings {
+    /// A network stream to `url` of frames of `size` at `fps`; with `pace`, ffmpeg paces frames
+    /// that come faster than real time (a render).
+    pub fn stream(url: &str, size: (u32, u32), fps: f64, pace: bool) -> Self {
+        Self { path: url.into(), size, fps, codec: None, quality: None, audio: None, stream: true, pace }
+    }
+}
+
 /// The URL schemes `--stream` sends to, with the container each carries.
 pub const STREAM_SCHEMES: &[(&str, &str)] = &[("srt", "mpegts"), ("udp", "mpegts"), ("rtmp", "flv"), ("rtmps", "flv")];
 

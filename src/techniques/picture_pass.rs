@@ -79,6 +79,12 @@ impl PicturePass {
         self.textures.upload(&self.device, &self.queue, picture, size)
     }
 
+    /// Makes RGBA8 `pixels` (sRGB, top row first) of `size` the picture shown, straight from a
+    /// live source's shared frame (no copy into a [`Picture`] first).
+    pub fn upload_rgba(&mut self, pixels: &[u8], size: (u32, u32)) -> Result<(), String> {
+        self.textures.upload_rgba(&self.device, &self.queue, pixels, size)
+    }
+
     /// Declares this frame's pass (named `name`): the picture fitted by `fit`, or a black image
     /// before any picture came.
     pub fn declare<'r>(&'r mut self, graph: &mut FrameGraph<'r>, name: &str, fit: Fit) -> TextureHandle {
@@ -162,11 +168,7 @@ impl FrameTextures {
     ) -> Result<(), String> {
         let (w, h) = size;
         match picture {
-            Picture::Rgba(pixels) => {
-                write_pixels(device, queue, &mut self.color, wgpu::TextureFormat::Rgba8Unorm, size, pixels)?;
-                self.layout =
-                    Some(Layout { channels: 1, separate_alpha: false, size, uv_scale: [1.0, 1.0], linear: false });
-            }
+            Picture::Rgba(pixels) => self.upload_rgba(device, queue, pixels, size)?,
             Picture::LinearHalf(texels) => {
                 let bytes: &[u8] = bytemuck::cast_slice(texels);
                 write_pixels(device, queue, &mut self.color, wgpu::TextureFormat::Rgba16Float, size, bytes)?;
@@ -188,6 +190,19 @@ impl FrameTextures {
                 self.layout = Some(Layout { channels, separate_alpha, size: (w, h), uv_scale, linear: false });
             }
         }
+        Ok(())
+    }
+
+    /// Uploads RGBA8 `pixels` of `size`.
+    pub fn upload_rgba(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        pixels: &[u8],
+        size: (u32, u32),
+    ) -> Result<(), String> {
+        write_pixels(device, queue, &mut self.color, wgpu::TextureFormat::Rgba8Unorm, size, pixels)?;
+        self.layout = Some(Layout { channels: 1, separate_alpha: false, size, uv_scale: [1.0, 1.0], linear: false });
         Ok(())
     }
 

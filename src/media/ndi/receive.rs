@@ -180,6 +180,36 @@ fn lock(state: &Mutex<FeedState>) -> std::sync::MutexGuard<'_, FeedState> {
     state.lock().unwrap_or_else(|e| e.into_inner())
 }
 
+/// How a feed finds its source: an address (`HOST:PORT`) is connected to directly, without
+/// discovery (a source across subnets, or a network without mDNS); a name is looked for.
+enum Lookup {
+    Address(CString),
+    Discovery(Finder),
+}
+
+impl Lookup {
+    fn new(runtime: &'static NdiRuntime, wanted: &str) -> Result<Self, String> {
+        match is_address(wanted).then(|| CString::new(wanted).ok()).flatten() {
+            Some(address) => Ok(Lookup::Address(address)),
+            None => Finder::new(runtime).map(Lookup::Discovery),
+        }
+    }
+
+    /// The source to connect to, if it is there (a name waits up to half a second for it). The
+    /// raw source's strings stay valid until the next call.
+    fn find(&self, wanted: &str) -> Option<(NdiSource, RawSource)> {
+        match self {
+            Lookup::Address(a) => {
+                let source = NdiSource { name: wanted.to_string(), url: wanted.to_string() };
+                Some((source, RawSource { name: a.as_ptr(), url_address: a.as_ptr() }))
+            }
+            Lookup::Discovery(finder) => {
+                finder.sources(Duration::from_millis(500)).into_iter().find(|(s, _)| names_source(wanted, &s.name))
+            }
+        }
+    }
+}
+
 /// A receiver for the life of a value.
 struct Receiver {
     runtime: &'static NdiRuntime,
@@ -196,27 +226,17 @@ impl Drop for Receiver {
 /// The feed's thread: find, connect, take frames until told to quit.
 fn receive(runtime: &'static NdiRuntime, state: &Mutex<FeedState>, wanted: &str) {
     let quit = || lock(state).quit;
-    let finder = match Finder::new(runtime) {
-        Ok(f) => f,
+    let lookup = match Lookup::new(runtime, wanted) {
+        Ok(lookup) => lookup,
         Err(e) => return lock(state).message = Some(e),
     };
     let receiver_name = CString::new("indra").expect("no NUL");
-    // An address is connected to directly, without discovery (a source across subnets, or a
-    // network without mDNS).
-    let address = is_address(wanted).then(|| CString::new(wanted).ok()).flatten();
-    let direct = address.as_ref().map(|a| RawSource { name: a.as_ptr(), url_address: a.as_ptr() });
     let mut receiver: Option<Receiver> = None;
     let mut last_frame = Instant::now();
     let mut number = 0u64;
     while !quit() {
         let Some(recv) = &receiver else {
-            let found = match &direct {
-                Some(raw) => Some((NdiSource { name: wanted.to_string(), url: wanted.to_string() }, *raw)),
-                None => {
-                    finder.sources(Duration::from_millis(500)).into_iter().find(|(s, _)| names_source(wanted, &s.name))
-                }
-            };
-            if let Some((source, raw)) = found {
+            if let Some((source, raw)) = lookup.find(wanted) {
                 let settings = RecvCreate {
                     source: raw,
                     color_format: COLOR_RGBX_RGBA,
@@ -224,7 +244,7 @@ fn receive(runtime: &'static NdiRuntime, state: &Mutex<FeedState>, wanted: &str)
                     allow_video_fields: false,
                     name: receiver_name.as_ptr(),
                 };
-                // SAFETY: the source's strings belong to the finder and are valid until its next
+                // SAFETY: the source's strings belong to the lookup and are valid until its next
                 // call; the SDK copies them here.
                 let instance = unsafe { runtime.recv_create(&settings) };
                 if instance.is_null() {

@@ -118,7 +118,6 @@ pub(super) mod slot {
     pub const FIND_DESTROY: usize = 6;
     pub const SEND_CREATE: usize = 8;
     pub const SEND_DESTROY: usize = 9;
-    pub const SEND_GET_NO_CONNECTIONS: usize = 17;
     pub const RECV_DESTROY: usize = 23;
     pub const FIND_WAIT_FOR_SOURCES: usize = 42;
     pub const FIND_GET_CURRENT_SOURCES: usize = 43;
@@ -185,7 +184,6 @@ impl NdiRuntime {
     );
     ndi_fn!(send_create, SEND_CREATE, fn(settings: *const SendCreate) -> *mut c_void);
     ndi_fn!(send_destroy, SEND_DESTROY, fn(send: *mut c_void));
-    ndi_fn!(send_connections, SEND_GET_NO_CONNECTIONS, fn(send: *mut c_void, timeout_ms: u32) -> i32);
     ndi_fn!(
         /// Sends a frame; with `clock_video` it waits until the frame is due.
         send_video, SEND_SEND_VIDEO_V2, fn(send: *mut c_void, frame: *const VideoFrame)
@@ -272,7 +270,6 @@ mod tests {
             (slot::FIND_DESTROY, "NDIlib_find_destroy"),
             (slot::SEND_CREATE, "NDIlib_send_create"),
             (slot::SEND_DESTROY, "NDIlib_send_destroy"),
-            (slot::SEND_GET_NO_CONNECTIONS, "NDIlib_send_get_no_connections"),
             (slot::RECV_DESTROY, "NDIlib_recv_destroy"),
             (slot::FIND_WAIT_FOR_SOURCES, "NDIlib_find_wait_for_sources"),
             (slot::FIND_GET_CURRENT_SOURCES, "NDIlib_find_get_current_sources"),

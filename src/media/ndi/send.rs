@@ -50,12 +50,6 @@ impl NdiSender {
         &self.name
     }
 
-    /// Receivers connected now.
-    pub fn connections(&self) -> u32 {
-        // SAFETY: a live instance; a zero timeout only reads the count.
-        unsafe { self.runtime.send_connections(self.instance, 0) }.max(0) as u32
-    }
-
     /// Frames sent so far.
     pub fn sent(&self) -> u64 {
         self.sent

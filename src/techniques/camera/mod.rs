@@ -14,7 +14,6 @@ mod render_tests;
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, TextureHandle};
 use crate::media::camera::{CameraSource, LiveFeed};
-use crate::media::clip::Picture;
 use crate::params::{ParamDecl, ParamSet, ParamValue, Text};
 use crate::time::FrameTime;
 
@@ -148,7 +147,7 @@ impl Technique for Camera {
             && number != self.shown
         {
             self.shown = number;
-            if let Err(e) = self.picture.upload(&Picture::Rgba(frame.to_vec()), feed.size()) {
+            if let Err(e) = self.picture.upload_rgba(&frame, feed.size()) {
                 self.messages.push(e);
             }
         }

@@ -11,7 +11,6 @@
 
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, TextureHandle};
-use crate::media::clip::Picture;
 use crate::media::ndi::NdiFeed;
 use crate::params::{ParamDecl, ParamSet, Text};
 use crate::time::FrameTime;
@@ -116,7 +115,7 @@ impl Technique for Ndi {
             && frame.number != self.shown
         {
             self.shown = frame.number;
-            if let Err(e) = self.picture.upload(&Picture::Rgba(frame.rgba.to_vec()), frame.size) {
+            if let Err(e) = self.picture.upload_rgba(&frame.rgba, frame.size) {
                 self.messages.push(e);
             }
         }
