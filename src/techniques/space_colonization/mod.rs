@@ -30,10 +30,11 @@
 //! (the sample's append/consume buffer, without the order a consume buffer would randomise).
 //!
 //! Book: [UGP4 ch.1] "GPU-Based Space Colonization Algorithm" (nakamura). Shaders:
-//! `space_colonization.wgsl`, `space_colonization_draw.wgsl`,
-//! `shaders/prefix_sum.wgsl`.
+//! `space_colonization.wgsl`, `space_colonization_draw.wgsl`, `space_colonization_raster.wgsl`
+//! (the tubes in compute), `shaders/prefix_sum.wgsl`, `shaders/msaa_samples.wgsl`.
 
 mod cloud;
+mod compute_draw;
 mod growth;
 mod model;
 mod params;
@@ -55,11 +56,11 @@ use render::{Extras, Renderer, Style};
 
 use crate::geometry::skinned::SkinnedMesh;
 use crate::gpu::ShaderError;
-use crate::graph::{FrameGraph, TextureHandle};
+use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
 use crate::params::ParamSet;
 use crate::time::FrameTime;
 
-use super::{NodeSetup, Technique, TechniqueInfo, linear_rgba};
+use super::{NodeSetup, Rasterizer, Technique, TechniqueInfo, linear_rgba};
 
 /// The registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -68,7 +69,13 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "branches grow towards a cloud of attractions, grid-accelerated on the GPU, drawn as lines or tubes",
     params,
     inputs: &[],
-    shaders: &["space_colonization.wgsl", "space_colonization_draw.wgsl", "prefix_sum.wgsl"],
+    shaders: &[
+        "space_colonization.wgsl",
+        "space_colonization_draw.wgsl",
+        "space_colonization_raster.wgsl",
+        "msaa_samples.wgsl",
+        "prefix_sum.wgsl",
+    ],
     create,
     check: None,
     stage: None,
@@ -129,6 +136,8 @@ pub struct SpaceColonization {
     models: Models,
     /// The model the cloud was sampled from (it poses the nodes), if any.
     mesh: Option<Arc<SkinnedMesh>>,
+    /// Whether the last frame's tubes were drawn in compute.
+    drew_in_compute: bool,
 }
 
 /// The models a node reads: loaded off the render thread, the last one kept by path (a restart
@@ -188,6 +197,7 @@ impl SpaceColonization {
             messages,
             models,
             mesh,
+            drew_in_compute: false,
         })
     }
 
@@ -397,11 +407,12 @@ impl Technique for SpaceColonization {
         let (attractions, nodes) = self.read();
         let alive = attractions.iter().filter(|a| a.alive != 0).count();
         vec![format!(
-            "{} nodes of {} slots, {} of {} attractions alive",
+            "{} nodes of {} slots, {} of {} attractions alive, drawn by {}",
             nodes.len(),
             self.capacity(),
             alive,
-            attractions.len()
+            attractions.len(),
+            if self.drew_in_compute { "compute (exact capsules)" } else { "the raster pipeline" }
         )]
     }
 
@@ -457,6 +468,14 @@ impl Technique for SpaceColonization {
         let b = linear_rgba(params.background);
         let clear = wgpu::Color { r: f64::from(b[0]), g: f64::from(b[1]), b: f64::from(b[2]), a: 1.0 };
         let style = if params.view == View::Lines { Style::Lines } else { Style::Tubes };
+        // Tubes alone go to the compute draw; lines, the floor and the model's glow blend or
+        // depth-test with the pipeline's own targets.
+        let in_compute =
+            style == Style::Tubes && !extras.floor && !extras.mesh && params.rasterizer == Rasterizer::Compute && {
+                let u = compute_draw::RasterUniforms::new(view_proj, eye, (w, h), samples, self.state.capacity, b);
+                self.renderer.prepare_compute(&self.queue, &u)
+            };
+        self.drew_in_compute = in_compute;
 
         let this: &'r SpaceColonization = self;
         let state = &this.state;
@@ -490,6 +509,30 @@ impl Technique for SpaceColonization {
                 state.record_pose(&mut pass, &this.kernels);
             },
         );
+        if in_compute {
+            let (buffer, id) = this.renderer.compute_visibility().expect("prepared");
+            let visibility = graph.import_buffer("space_colonization/visibility", &buffer, id);
+            let image = graph.create_texture("space_colonization/image", TextureDesc::full(FORMAT));
+            graph
+                .add_pass("space_colonization/raster")
+                .read_buffer(posed)
+                .read_buffer(nodes)
+                .read_buffer(args)
+                .write_buffer(visibility)
+                .record(move |ctx| this.renderer.record_compute_raster(ctx.encoder, state));
+            graph
+                .add_pass("space_colonization/resolve")
+                .read_buffer(posed)
+                .read_buffer(nodes)
+                .read_buffer(visibility)
+                .write(image)
+                .record(move |ctx| {
+                    // Views are shared handles: a clone frees the context for the encoder.
+                    let (view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
+                    this.renderer.record_compute_resolve(ctx.encoder, state, (&view, id));
+                });
+            return image;
+        }
         graph
             .add_pass("space_colonization/draw")
             .read_buffer(posed)

@@ -2,7 +2,7 @@
 //! blocks built from them.
 
 use crate::params::{InputRole, ParamDecl, ParamValue, Text};
-use crate::techniques::Msaa;
+use crate::techniques::{Msaa, Rasterizer};
 
 /// Most grid cells (the cell grows past the reach before the grid grows past this).
 pub const MAX_CELLS: u32 = 1 << 21;
@@ -112,6 +112,10 @@ crate::technique_params! {
         fov: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(40.0), Some((5.0, 120.0)), doc).with_unit("°"),
         /// multisampling (the scene's msaa, 4 samples by default) keeps thin branches steady
         msaa: Msaa = |n, doc| ParamDecl::choice(n, Msaa::OPTIONS, 1, doc),
+        /// how tubes are drawn — compute: exact capsules found per sample in a visibility buffer
+        /// (where the adapter has 64-bit atomics; the floor and the model's glow stay on the
+        /// pipeline); pipeline: eight-sided tubes through the hardware rasterizer
+        rasterizer: Rasterizer = |n, doc| ParamDecl::choice(n, Rasterizer::OPTIONS, 0, doc),
         /// start the growth again (R in the window)
         reset: bool = |n, doc| ParamDecl::trigger(n, doc).with_role(InputRole::Key('r')),
     }

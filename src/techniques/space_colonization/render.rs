@@ -1,6 +1,10 @@
 //! Drawing the forest: instanced lines or capsules, one instance per edge, sized by the indirect
-//! arguments the growth step wrote (free slots cost nothing), multisampled and resolved.
+//! arguments the growth step wrote (free slots cost nothing), multisampled and resolved — or the
+//! tubes as exact capsules in compute (`compute_draw`), where the adapter has 64-bit atomics.
 
+use std::cell::RefCell;
+
+use super::compute_draw::{self, ComputeDraw, RasterUniforms};
 use super::growth::{GrowthState, LINE_ARGS, TUBE_ARGS};
 use super::params::ViewUniforms;
 use crate::gpu::{BindGroupCache, RasterDesc, ShaderError, raster_pipeline};
@@ -66,24 +70,30 @@ pub struct Renderer {
     /// Samples per pixel with `msaa` on (the scene's, as the adapter allows).
     pub samples: u32,
     groups: BindGroupCache<(u64, u64)>,
+    /// The tubes' compute draw, where the adapter has 64-bit atomics (it keeps bind groups as
+    /// it records, from the shared borrow the frame graph's passes get).
+    compute: Option<RefCell<ComputeDraw>>,
 }
 
 impl Renderer {
     /// Builds the pipelines from `space_colonization_draw.wgsl` for `format`.
     pub fn new(setup: &NodeSetup<'_>, format: wgpu::TextureFormat) -> Result<Self, ShaderError> {
         let device = &setup.gpu.device;
-        let (origin, source) = setup.shader_source("space_colonization_draw.wgsl", &DRAW_BINDINGS)?;
-        let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
-        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let shader = setup.joined_shader_source("space_colonization_draw.wgsl", &DRAW_BINDINGS)?;
+        let origin = shader.origin().to_string();
+        let (module, _) = crate::gpu::compile_wgsl(device, &origin, &shader.source).map_err(|e| shader.relocate(e))?;
+        // Group 0 serves both draws: the vertex and fragment stages, and the compute kernels.
+        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE;
+        let readers = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("sc_draw_layout"),
             entries: &[
                 crate::gpu::uniform_entry::<ViewUniforms>(0, stages),
-                crate::gpu::storage_entry(1, wgpu::ShaderStages::VERTEX, true),
-                crate::gpu::storage_entry(2, wgpu::ShaderStages::VERTEX, true),
-                crate::gpu::storage_entry(3, wgpu::ShaderStages::VERTEX, true),
-                crate::gpu::storage_entry(4, wgpu::ShaderStages::VERTEX, true),
-                crate::gpu::storage_entry(5, wgpu::ShaderStages::VERTEX, true),
+                crate::gpu::storage_entry(1, readers, true),
+                crate::gpu::storage_entry(2, readers, true),
+                crate::gpu::storage_entry(3, readers, true),
+                crate::gpu::storage_entry(4, readers, true),
+                crate::gpu::storage_entry(5, readers, true),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -124,6 +134,12 @@ impl Renderer {
         let pipelines = crate::gpu::validated(device, &origin, || {
             [Style::Lines, Style::Tubes, Style::Floor, Style::Mesh].map(|s| [pipeline(s, 1), pipeline(s, samples)])
         })?;
+        let compute = if device.features().contains(compute_draw::FEATURES) {
+            let shader = setup.joined_shader_source("space_colonization_raster.wgsl", &DRAW_BINDINGS)?;
+            Some(RefCell::new(ComputeDraw::new(device, &shader, &layout)?))
+        } else {
+            None
+        };
         let index_data = tube_indices();
         use wgpu::util::DeviceExt;
         let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -139,6 +155,7 @@ impl Renderer {
             index_count: index_data.len() as u32,
             samples,
             groups: BindGroupCache::default(),
+            compute,
         })
     }
 
@@ -161,6 +178,39 @@ impl Renderer {
                 ],
             })
         });
+    }
+
+    /// Readies the compute draw for a frame with `u`; false where there is none (no 64-bit
+    /// atomics) or its visibility buffer would exceed the device's limits.
+    pub fn prepare_compute(&mut self, queue: &wgpu::Queue, u: &RasterUniforms) -> bool {
+        self.compute.as_mut().is_some_and(|c| c.get_mut().prepare(queue, u))
+    }
+
+    /// The compute draw's visibility buffer and its graph id (after [`Self::prepare_compute`]).
+    pub fn compute_visibility(&self) -> Option<(wgpu::Buffer, u64)> {
+        let compute = self.compute.as_ref()?.borrow();
+        compute.visibility().map(|(buffer, id)| (buffer.clone(), id))
+    }
+
+    /// Records the compute draw's coverage of every grown edge.
+    pub fn record_compute_raster(&self, encoder: &mut wgpu::CommandEncoder, state: &GrowthState) {
+        let (Some(compute), Some(group)) = (&self.compute, self.groups.get(&(state.posed.id, state.nodes.id))) else {
+            return;
+        };
+        compute.borrow_mut().record_raster(encoder, group, (&state.args.buffer, state.args.id));
+    }
+
+    /// Records the compute draw's shading into `image` (its view and graph id).
+    pub fn record_compute_resolve(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        state: &GrowthState,
+        image: (&wgpu::TextureView, u64),
+    ) {
+        let (Some(compute), Some(group)) = (&self.compute, self.groups.get(&(state.posed.id, state.nodes.id))) else {
+            return;
+        };
+        compute.borrow_mut().record_resolve(encoder, group, image);
     }
 
     /// Records the draw of every grown edge into `targets` (resolved if multisampled).

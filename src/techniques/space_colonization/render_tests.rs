@@ -335,3 +335,96 @@ fn golden_space_colonization_1m_at_ci_size() {
 fn golden_space_colonization_skinned() {
     golden("space_colonization_skinned", &[40, 160], &["growth.voxels=48"]);
 }
+
+/// Frame `frame` of `scene` at `size` with `sets`, drawn in compute and by the raster pipeline.
+fn both_draws(scene: &str, size: (u32, u32), frame: u64, sets: &[&str]) -> [Vec<u8>; 2] {
+    ["compute", "pipeline"].map(|rasterizer| {
+        let mut s = load_scene(&common::assets(), scene).unwrap();
+        for set in sets.iter().copied().chain([format!("growth.rasterizer={rasterizer}").as_str()]) {
+            s.set_from_str(set).unwrap_or_else(|e| panic!("{set}: {e}"));
+        }
+        common::render_scene(s, size, frame).rgba
+    })
+}
+
+/// A scene, its size and frame, its settings and the largest mean FLIP allowed.
+type Comparison<'a> = (&'a str, (u32, u32), u64, &'a [&'a str], f32);
+
+#[test]
+fn the_compute_tubes_match_the_pipeline_tubes() {
+    // The bound for the level of detail: mean FLIP ≤ 0.05 against the full render, where
+    // tubes are a few pixels across (the scenes as they are seen); odd sizes, lit and by normal,
+    // one sample and four. Close up, the pipeline's eight facets show as stripes along each tube
+    // that the exact capsule does not have (0.15); with the camera inside the forest the near
+    // plane cuts tubes open, and the pipeline's open base and facets show inside (0.25; 0.58
+    // when such edges were dropped).
+    let cases: &[Comparison] = &[
+        ("space_colonization_tubes", (203, 117), 60, &[], 0.05),
+        ("space_colonization_tubes", (203, 117), 60, &["growth.msaa=off"], 0.05),
+        ("space_colonization_1m", (150, 101), 40, &["growth.side=24"], 0.05),
+        ("space_colonization_tubes", (240, 136), 90, &["growth.fov=12.0"], 0.15),
+        (
+            "space_colonization_tubes",
+            (160, 96),
+            90,
+            &["growth.camera_position=[0.0, 0.0, -3.0]", "growth.fov=60.0"],
+            0.25,
+        ),
+    ];
+    for (scene, size, frame, sets, bound) in cases {
+        let [compute, pipeline] = both_draws(scene, *size, *frame, sets);
+        assert!(compute != pipeline, "{scene} {sets:?}: the two draws should be different code");
+        let background = pipeline[..4].to_vec();
+        let drawn = pipeline.chunks(4).filter(|p| *p != background.as_slice()).count();
+        assert!(drawn > (size.0 * size.1 / 10) as usize, "{scene} {sets:?}: only {drawn} pixels drawn");
+        let (score, _) = indra::offscreen::flip_score(&pipeline, &compute, *size, 0.99);
+        assert!(score.mean <= *bound, "{scene} {sets:?}: mean FLIP {} (bound {bound})", score.mean);
+    }
+}
+
+#[test]
+fn culling_by_footprint_drops_no_sample() {
+    // The raster kernels walk only the pixels inside each capsule's outline on screen and skip
+    // a pixel whose centre ray passes the capsule by more than a pixel: conservative tests, so
+    // the image must be the same bytes as testing every sample of every pixel in the box — here
+    // at the far ends of the camera's range (a 120° view, the camera inside the forest) — and
+    // the same whichever kernel (inline, medium, large) an edge went to.
+    use indra::assets::{Asset, AssetKind};
+    let assets = common::assets();
+    let shader = assets.load(AssetKind::Shader, "space_colonization_raster.wgsl").unwrap();
+    let outline = "    if f.whole {\n        return box.xz;";
+    let near_miss = "    if dot(to_axis, to_axis) - along * along > reach * reach {";
+    assert!(shader.source.contains(outline) && shader.source.contains(near_miss), "the culling tests moved");
+    let exhaustive = shader
+        .source
+        .replace(outline, "    if true || f.whole {\n        return box.xz;")
+        .replace(near_miss, "    if false && dot(to_axis, to_axis) - along * along > reach * reach {");
+    // The medium edges' kernel runs only for a forest of 2^18 slots and more (too slow to grow
+    // here): a third copy sends every edge over 4×4 px to it.
+    let classify = "    if pixels > max(r.large_pixels, INLINE_PIXELS) {";
+    assert!(shader.source.contains(classify), "the classification moved");
+    let medium = shader.source.replace(classify, "    if pixels > 1000000 {");
+    let medium = assets.with_shader(Asset { source: medium, ..shader.clone() });
+    let every_sample = assets.with_shader(Asset { source: exhaustive, ..shader });
+    let cases: &[(&str, u64, &[&str])] = &[
+        ("space_colonization_tubes", 90, &[]),
+        ("space_colonization_tubes", 90, &["growth.fov=120.0", "growth.camera_position=[0.5, 0.3, -2.0]"]),
+        ("space_colonization_tubes", 90, &["growth.camera_position=[0.0, 0.2, -0.6]", "growth.fov=90.0"]),
+        ("space_colonization_tubes", 90, &["growth.fov=8.0", "growth.msaa=off"]),
+        ("space_colonization_1m", 40, &["growth.side=24", "growth.fov=25.0"]),
+    ];
+    let size = (171, 97);
+    for (scene, frame, sets) in cases {
+        let [culled, by_medium, exhaustive] = [&assets, &medium, &every_sample].map(|assets| {
+            let mut s = load_scene(assets, scene).unwrap();
+            for set in *sets {
+                s.set_from_str(set).unwrap();
+            }
+            let mut r = OffscreenRenderer::new(common::gpu(), assets, s, Some(size), None, None).unwrap();
+            r.seek(*frame).unwrap();
+            r.render_next().unwrap().rgba
+        });
+        assert!(culled == exhaustive, "{scene} {sets:?}: culling changed the image");
+        assert!(by_medium == exhaustive, "{scene} {sets:?}: the medium edges' kernel changed the image");
+    }
+}

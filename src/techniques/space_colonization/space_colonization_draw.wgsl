@@ -3,7 +3,9 @@
 // look). Tubes: an instanced capsule — a round ring of SIDES vertices at each end and a
 // hemispherical cap on the growing tip — in world space, coloured by the normal as in the book,
 // or lit (Blinn-Phong) with tips that glow while they grow. Positions come from `posed` (world
-// space, w = t), written by the growth shader's `pose` kernel.
+// space, w = t), written by the growth shader's `pose` kernel. The tube's shading is shared with
+// the compute draw (space_colonization_raster.wgsl), which builds on this file.
+// extends: msaa_samples.wgsl
 
 struct View {
     view_proj: mat4x4<f32>,
@@ -123,19 +125,22 @@ fn vs_tube(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32
 
 @fragment
 fn fs_tube(in: TubeOut) -> @location(0) vec4<f32> {
-    let n = normalize(in.normal);
+    return vec4<f32>(tube_colour(normalize(in.normal), in.world, in.t), 1.0);
+}
+
+// The colour of a tube's surface at `world` with unit normal `n`, on an edge grown to `t`.
+fn tube_colour(n: vec3<f32>, world: vec3<f32>, t: f32) -> vec3<f32> {
     if view.lit == 0u {
-        return vec4<f32>(view.color.rgb * (n * 0.5 + 0.5), 1.0);
+        return view.color.rgb * (n * 0.5 + 0.5);
     }
     let l = normalize(view.light.xyz);
-    let to_eye = normalize(view.camera.xyz - in.world);
+    let to_eye = normalize(view.camera.xyz - world);
     let h = normalize(l + to_eye);
     let diffuse = max(dot(n, l), 0.0);
     let specular = pow(max(dot(n, h), 0.0), 48.0) * 0.35;
     // The book's emissive tips: 1 at t = 0 fading to 0 at t = 1.
-    let glow = (1.0 - smoothstep(0.0, 1.0, in.t)) * view.light.w;
-    let rgb = view.color.rgb * (0.18 + 0.82 * diffuse) + vec3<f32>(specular) + view.color.rgb * glow;
-    return vec4<f32>(rgb, 1.0);
+    let glow = (1.0 - smoothstep(0.0, 1.0, t)) * view.light.w;
+    return view.color.rgb * (0.18 + 0.82 * diffuse) + vec3<f32>(specular) + view.color.rgb * glow;
 }
 
 // ---- the floor: a lit square at y = 0 ----

@@ -7,6 +7,7 @@
 use crate::gpu::{BindGroupCache, ComputeKernel, JoinedSource, ShaderError, storage_entry as storage};
 
 use super::FORMAT;
+use crate::techniques::visibility::VisibilityBuffer;
 
 /// Features the compute draw needs.
 pub const FEATURES: wgpu::Features = wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
@@ -40,14 +41,6 @@ struct Corners {
     cached: bool,
 }
 
-/// The visibility buffer for one output size and sample count.
-struct Visibility {
-    key: (u32, u32, u32),
-    buffer: wgpu::Buffer,
-    /// Its id in the frame graph.
-    id: u64,
-}
-
 /// The kernels and buffers of the compute draw.
 pub struct ComputeRaster {
     device: wgpu::Device,
@@ -61,7 +54,7 @@ pub struct ComputeRaster {
     big_triangles: wgpu::Buffer,
     /// The queue's dispatch arguments and length (x, y, z, count).
     big_args: wgpu::Buffer,
-    visibility: Option<Visibility>,
+    visibility: Option<VisibilityBuffer>,
     corners: Option<Corners>,
     /// Group 2 of the raster kernels (with and without the queue's arguments, which the second
     /// reads as its dispatch); made with the visibility buffer.
@@ -165,23 +158,13 @@ impl ComputeRaster {
     /// writes the uniforms; false when the visibility buffer would exceed the device's limits
     /// (the caller draws with the pipeline then).
     pub fn prepare(&mut self, queue: &wgpu::Queue, size: (u32, u32), samples: u32, grid: u32) -> bool {
-        let key = (size.0, size.1, samples);
+        match VisibilityBuffer::ensure(&mut self.visibility, &self.device, "tessellation_visibility", size, samples) {
+            None => return false,
+            Some(true) => self.forget_groups(),
+            Some(false) => {}
+        }
         let limits = self.device.limits();
         let largest = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
-        if self.visibility.as_ref().is_none_or(|v| v.key != key) {
-            let bytes = u64::from(size.0) * u64::from(size.1) * u64::from(samples) * 8;
-            if bytes > largest {
-                return false;
-            }
-            let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("tessellation_visibility"),
-                size: bytes.max(8),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            self.visibility = Some(Visibility { key, buffer, id: crate::graph::next_resource_id() });
-            self.forget_groups();
-        }
         if self.corners.as_ref().is_none_or(|c| c.grid != grid) {
             // At most level 64 (4,096 triangles) in each of the 2 grid² patches.
             let bytes = 2 * u64::from(grid * grid) * 4096 * CORNER_BYTES;
@@ -287,7 +270,7 @@ impl ComputeRaster {
             label: Some("tessellation/resolve"),
             timestamp_writes: None,
         });
-        let (width, height, _) = visibility.key;
+        let (width, height, _) = visibility.key();
         self.resolve.dispatch(&mut pass, &[b.uniforms, b.mesh, group], [width, height, 1]);
     }
 }

@@ -4,6 +4,7 @@
 use glam::{Mat4, Vec3, Vec4};
 
 use crate::params::{ParamDecl, ParamSet, ParamValue};
+pub use crate::techniques::Rasterizer;
 use crate::techniques::{Msaa, srgb_to_linear};
 
 /// The base plane's side, world units (Unity's Plane).
@@ -18,16 +19,6 @@ crate::param_enum! {
         Wireframe = "wireframe",
         /// The tessellation level as colour.
         Level = "level",
-    }
-}
-
-crate::param_enum! {
-    /// How the surface is drawn.
-    pub enum Rasterizer {
-        /// A visibility buffer filled in compute, where the adapter allows.
-        Compute = "compute",
-        /// The hardware rasterizer.
-        Pipeline = "pipeline",
     }
 }
 

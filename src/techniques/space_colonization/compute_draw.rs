@@ -1,0 +1,308 @@
+//! The tubes drawn in compute (`space_colonization_raster.wgsl`): exact capsules found by a ray
+//! per sample into a visibility buffer, then shaded once per pixel and edge. Where the raster
+//! path is narrow (the H100/H200) this replaces the instanced eight-sided tubes; the pipeline
+//! stays for lines, for the floor and the model's glow, and for adapters without 64-bit atomics.
+
+use crate::gpu::{BindGroupCache, ComputeKernel, JoinedSource, ShaderError, storage_entry as storage};
+use crate::techniques::visibility::VisibilityBuffer;
+
+use super::FORMAT;
+
+/// A whole buffer at `binding`.
+fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
+}
+
+/// Features the compute draw needs.
+pub const FEATURES: wgpu::Features = wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
+
+/// `Raster` in the shader.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct RasterUniforms {
+    /// The ray through pixel position p (y down) is `ray_origin + ray_x p.x + ray_y p.y`, not
+    /// normalised; `ray_origin[3]`: the widest angle one pixel spans (at the image's centre).
+    pub ray_origin: [f32; 4],
+    /// The ray's change per pixel to the right.
+    pub ray_x: [f32; 4],
+    /// The ray's change per pixel down.
+    pub ray_y: [f32; 4],
+    /// The view axis (unit).
+    pub forward: [f32; 4],
+    /// Linear background colour.
+    pub background: [f32; 4],
+    /// Image size in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel (the draw's multisampling).
+    pub samples: u32,
+    /// Edge slots (threads dispatched).
+    pub capacity: u32,
+    /// Boxes of more pixels go to the large edges' queue (a workgroup each), fewer to the medium
+    /// edges' (a thread each).
+    pub large_pixels: i32,
+    _pad: [u32; 3],
+}
+
+/// Edge slots that fill an H200 one thread each (132 SMs × 2,048 threads, rounded up): with fewer
+/// edges, one thread per medium edge leaves the GPU idle and a workgroup per edge wins (measured:
+/// `space_colonization_tubes`, 10⁴ edges at 1080p, 0.30 against 0.59 ms).
+const EDGES_FOR_THREADS: u32 = 1 << 18;
+
+impl RasterUniforms {
+    /// The uniforms for a `size` image seen by `view_proj` from `eye` (a perspective camera),
+    /// with `samples` per pixel, `capacity` edge slots and `background` (linear).
+    pub fn new(
+        view_proj: glam::Mat4,
+        eye: glam::Vec3,
+        size: (u32, u32),
+        samples: u32,
+        capacity: u32,
+        background: [f32; 4],
+    ) -> Self {
+        // In f64: the far plane is 10⁴ near planes away, and the rays are its points' differences.
+        let inverse = view_proj.as_dmat4().inverse();
+        let (width, height) = (f64::from(size.0.max(1)), f64::from(size.1.max(1)));
+        let ray = |x: f64, y: f64| {
+            let far = inverse * glam::DVec4::new(x / width * 2.0 - 1.0, 1.0 - y / height * 2.0, 1.0, 1.0);
+            far.truncate() / far.w - eye.as_dvec3()
+        };
+        let origin = ray(0.0, 0.0);
+        let (ray_x, ray_y) = (ray(1.0, 0.0) - origin, ray(0.0, 1.0) - origin);
+        let centre = origin + ray_x * (width / 2.0) + ray_y * (height / 2.0);
+        let angle = ray_x.length().max(ray_y.length()) / centre.length();
+        let v = |v: glam::DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
+        Self {
+            ray_origin: v(origin, angle),
+            ray_x: v(ray_x, 0.0),
+            ray_y: v(ray_y, 0.0),
+            forward: v(centre.normalize(), 0.0),
+            background,
+            width: size.0,
+            height: size.1,
+            samples,
+            capacity,
+            large_pixels: if capacity >= EDGES_FOR_THREADS { 256 } else { 0 },
+            _pad: [0; 3],
+        }
+    }
+}
+
+/// The kernels and the visibility buffer of the compute draw.
+pub struct ComputeDraw {
+    device: wgpu::Device,
+    raster: ComputeKernel,
+    raster_medium: ComputeKernel,
+    raster_big: ComputeKernel,
+    resolve: ComputeKernel,
+    raster_layout: wgpu::BindGroupLayout,
+    big_layout: wgpu::BindGroupLayout,
+    resolve_layout: wgpu::BindGroupLayout,
+    uniforms: wgpu::Buffer,
+    visibility: Option<VisibilityBuffer>,
+    /// Edge slots this frame (the raster's threads).
+    capacity: u32,
+    /// The queue of medium and large edges (two counts, then up to `capacity` edges), by its
+    /// capacity.
+    big_queue: Option<(u32, wgpu::Buffer)>,
+    /// The queue kernels' dispatches: (x, 1, 1) for the medium edges at byte 0, the large at 16.
+    big_args: wgpu::Buffer,
+    /// Group 1 of the raster and of the queue kernel, by the growth's argument buffer id.
+    raster_groups: BindGroupCache<u64, [wgpu::BindGroup; 2]>,
+    /// Group 1 of the resolve, by the output texture id.
+    resolve_groups: BindGroupCache<u64>,
+}
+
+impl ComputeDraw {
+    /// Builds the kernels from `space_colonization_raster.wgsl` (joined after the draw shader);
+    /// `view_layout` is group 0 as the pipeline draw binds it.
+    pub fn new(
+        device: &wgpu::Device,
+        shader: &JoinedSource,
+        view_layout: &wgpu::BindGroupLayout,
+    ) -> Result<Self, ShaderError> {
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let uniforms_entry = crate::gpu::uniform_entry::<RasterUniforms>(0, compute);
+        let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
+        };
+        let raster_layout = layout(
+            "sc_raster_layout",
+            &[
+                uniforms_entry,
+                storage(1, compute, false),
+                storage(2, compute, true),
+                storage(5, compute, false),
+                storage(6, compute, false),
+            ],
+        );
+        // The queue's kernel reads big_args as its dispatch, so it may not bind them too.
+        let big_layout =
+            layout("sc_raster_big_layout", &[uniforms_entry, storage(1, compute, false), storage(8, compute, true)]);
+        let output = wgpu::BindGroupLayoutEntry {
+            binding: 4,
+            visibility: compute,
+            ty: wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format: FORMAT,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
+            count: None,
+        };
+        let resolve_layout = layout("sc_resolve_layout", &[uniforms_entry, storage(3, compute, true), output]);
+        let kernel = |entry, group: &wgpu::BindGroupLayout| {
+            ComputeKernel::new(device, shader.origin(), &shader.source, entry, &[view_layout, group])
+                .map_err(|e| shader.relocate(e))
+        };
+        Ok(Self {
+            device: device.clone(),
+            raster: kernel("raster", &raster_layout)?,
+            raster_medium: kernel("raster_medium", &big_layout)?,
+            raster_big: kernel("raster_big", &big_layout)?,
+            resolve: kernel("resolve", &resolve_layout)?,
+            raster_layout,
+            big_layout,
+            resolve_layout,
+            uniforms: crate::gpu::uniform_buffer::<RasterUniforms>(device, "sc_raster_uniforms"),
+            visibility: None,
+            capacity: 0,
+            big_queue: None,
+            big_args: wgpu::util::DeviceExt::create_buffer_init(
+                device,
+                &wgpu::util::BufferInitDescriptor {
+                    label: Some("sc_big_args"),
+                    contents: bytemuck::cast_slice(&[0u32, 1, 1, 0, 0, 1, 1, 0]),
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+                },
+            ),
+            raster_groups: BindGroupCache::default(),
+            resolve_groups: BindGroupCache::default(),
+        })
+    }
+
+    /// Readies the visibility buffer for `u`'s size and samples and writes the uniforms; false
+    /// when the buffer would exceed the device's limits (the caller draws with the pipeline).
+    pub fn prepare(&mut self, queue: &wgpu::Queue, u: &RasterUniforms) -> bool {
+        let made = VisibilityBuffer::ensure(
+            &mut self.visibility,
+            &self.device,
+            "sc_visibility",
+            (u.width, u.height),
+            u.samples,
+        );
+        let Some(mut made) = made else { return false };
+        if self.big_queue.as_ref().is_none_or(|(capacity, _)| *capacity < u.capacity) {
+            let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("sc_big_queue"),
+                size: (u64::from(u.capacity) + 2) * 4,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            self.big_queue = Some((u.capacity, buffer));
+            made = true;
+        }
+        if made {
+            self.raster_groups = BindGroupCache::default();
+            self.resolve_groups = BindGroupCache::default();
+        }
+        self.raster_groups.begin_frame();
+        self.resolve_groups.begin_frame();
+        self.capacity = u.capacity;
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(u));
+        true
+    }
+
+    /// The visibility buffer and its graph id (after a successful [`Self::prepare`]).
+    pub fn visibility(&self) -> Option<(&wgpu::Buffer, u64)> {
+        self.visibility.as_ref().map(|v| (&v.buffer, v.id))
+    }
+
+    /// Records the coverage: the visibility buffer cleared, then one thread per edge slot
+    /// (`view` is group 0; `args` the growth's indirect arguments, holding the grown count).
+    pub fn record_raster(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &wgpu::BindGroup,
+        args: (&wgpu::Buffer, u64),
+    ) {
+        let (Some(visibility), Some((_, queue))) = (&self.visibility, &self.big_queue) else { return };
+        let (device, uniforms, big_args) = (&self.device, &self.uniforms, &self.big_args);
+        let (raster_layout, big_layout) = (&self.raster_layout, &self.big_layout);
+        let groups = self.raster_groups.get_or_create(args.1, || {
+            let group = |layout, entries: &[wgpu::BindGroupEntry]| {
+                device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("sc_raster_group"), layout, entries })
+            };
+            let v = &visibility.buffer;
+            [
+                group(
+                    raster_layout,
+                    &[entry(0, uniforms), entry(1, v), entry(2, args.0), entry(5, queue), entry(6, big_args)],
+                ),
+                group(big_layout, &[entry(0, uniforms), entry(1, v), entry(8, queue)]),
+            ]
+        });
+        encoder.clear_buffer(&visibility.buffer, 0, None);
+        encoder.clear_buffer(queue, 0, Some(8));
+        encoder.clear_buffer(big_args, 0, Some(4));
+        encoder.clear_buffer(big_args, 16, Some(4));
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("space_colonization/raster"),
+            timestamp_writes: None,
+        });
+        // Rows of at most 65,535 workgroups; the shader numbers threads across them.
+        let slots = self.capacity.max(1);
+        let row = 65535 * 256;
+        self.raster.dispatch(&mut pass, &[view, &groups[0]], [slots.min(row), slots.div_ceil(row), 1]);
+        pass.set_bind_group(0, view, &[]);
+        pass.set_bind_group(1, &groups[1], &[]);
+        for (kernel, offset) in [(&self.raster_medium, 0), (&self.raster_big, 16)] {
+            pass.set_pipeline(&kernel.pipeline);
+            pass.dispatch_workgroups_indirect(big_args, offset);
+        }
+    }
+
+    /// Records the shading of every pixel into `image` (its view and graph id).
+    pub fn record_resolve(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &wgpu::BindGroup,
+        image: (&wgpu::TextureView, u64),
+    ) {
+        let Some(visibility) = &self.visibility else { return };
+        let (device, layout, uniforms) = (&self.device, &self.resolve_layout, &self.uniforms);
+        let group = self.resolve_groups.get_or_create(image.1, || {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("sc_resolve_group"),
+                layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: visibility.buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(image.0) },
+                ],
+            })
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("space_colonization/resolve"),
+            timestamp_writes: None,
+        });
+        let (width, height, _) = visibility.key();
+        self.resolve.dispatch(&mut pass, &[view, group], [width, height, 1]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_uniform_block_and_the_argument_word_match_the_wgsl() {
+        let source = [
+            include_str!("../../../shaders/msaa_samples.wgsl"),
+            include_str!("space_colonization_draw.wgsl"),
+            include_str!("space_colonization_raster.wgsl"),
+        ]
+        .join("\n");
+        assert_eq!(crate::gpu::wgsl_struct_size(&source, "Raster"), Some(size_of::<super::RasterUniforms>() as u32));
+        let word = super::super::growth::TUBE_ARGS / 4 + 1;
+        assert!(source.contains(&format!("const TUBE_INSTANCES: u32 = {word}u;")), "TUBE_INSTANCES must be {word}");
+    }
+}

@@ -1,0 +1,440 @@
+// Chapter 1's tubes drawn in compute, for GPUs whose raster path is narrow (the H100/H200: a
+// million eight-sided tubes are 64 million triangles, 79 ms at 1080p through it). Each edge is an
+// exact capsule — the segment from its parent to its growing tip, swept by the tube's radius —
+// found by a ray per sample instead of a mesh: at the sizes the forest is seen (a branch a pixel
+// or two across) the eight-sided mesh was its own level of detail, paying 64 triangles for a few
+// pixels.
+// extends: space_colonization_draw.wgsl
+//   raster   one thread per edge: the capsule's box on screen, then for each sample of each
+//            pixel in it (the standard sample locations) the ray from the camera; a hit keeps the
+//            nearest edge with one 64-bit atomicMax of (inverted distance, edge + 1) — the same
+//            result in any order, so renders are deterministic. Only the pixels inside the
+//            capsule's outline on screen are walked, and a pixel whose centre ray passes the
+//            capsule by more than a pixel is skipped. Edges whose box exceeds 4×4 px go to a
+//            queue instead (one thread would walk it alone while its warp waits).
+//   raster_medium  one thread per queued edge of up to 256 px (where edges are many enough to
+//                  fill the GPU one thread each): warps of like sizes.
+//   raster_big     one 8×8 workgroup per larger queued edge, walking its outline.
+//   resolve  one thread per pixel: each distinct edge among its samples is shaded once at the
+//            pixel centre (as multisampling shades once per pixel and primitive) and weighted by
+//            the samples it holds; empty samples are the background.
+// Hits nearer than the camera's near plane are dropped, as the pipeline clips them.
+
+struct Raster {
+    // The ray through pixel position p (y down) is ray_origin + ray_x p.x + ray_y p.y (a
+    // perspective camera's rays are affine in the pixel position), not normalised; ray_origin.w:
+    // the widest angle a pixel spans (at the image's centre).
+    ray_origin: vec4<f32>,
+    ray_x: vec4<f32>,
+    ray_y: vec4<f32>,
+    // The view axis (unit).
+    forward: vec4<f32>,
+    background: vec4<f32>,
+    width: u32,
+    height: u32,
+    samples: u32,
+    // Edge slots: threads past the grown count return at once.
+    capacity: u32,
+    // Boxes of more pixels go to the large edges' queue (one workgroup each).
+    large_pixels: i32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+@group(1) @binding(0) var<uniform> r: Raster;
+@group(1) @binding(1) var<storage, read_write> visibility: array<atomic<u64>>;
+// The growth step's indirect arguments: the tubes' instance count is word `TUBE_INSTANCES`.
+@group(1) @binding(2) var<storage, read> draw_args: array<u32>;
+@group(1) @binding(3) var<storage, read> visibility_in: array<u64>;
+@group(1) @binding(4) var image: texture_storage_2d<rgba16float, write>;
+// The queue: words 0 and 1 count the medium and the large edges; medium edges follow from
+// word 2, large ones come from the end (together no more than the edges).
+@group(1) @binding(5) var<storage, read_write> big_queue: array<atomic<u32>>;
+// The queue kernels' dispatches, (x, 1, 1) for the medium at word 0 and for the large at word 4:
+// enough workgroups for the counts (at most 65,535, which then loop), zeroed before each frame.
+@group(1) @binding(6) var<storage, read_write> big_args: array<atomic<u32>>;
+@group(1) @binding(8) var<storage, read> big_queue_in: array<u32>;
+
+// Must match `TUBE_ARGS` / 4 + 1 in growth.rs: the instance count of the indexed tube draw.
+const TUBE_INSTANCES: u32 = 8u;
+// The projection's near plane (params.rs `view_proj`).
+const NEAR: f32 = 0.05;
+// Boxes of more pixels than this go to the queue, as medium edges (one thread each) or, past
+// the uniforms' large_pixels, large ones (a workgroup each): an edge walked inline keeps its
+// warp waiting.
+const INLINE_PIXELS: i32 = 16;
+// The queue's first edge word (words 0 and 1 count its medium and large edges).
+const QUEUE_START: u32 = 2u;
+
+// The unit ray from the camera through pixel position p (y down).
+fn pixel_ray(p: vec2<f32>) -> vec3<f32> {
+    return normalize(r.ray_origin.xyz + r.ray_x.xyz * p.x + r.ray_y.xyz * p.y);
+}
+
+// Where the unit ray (o, d) enters and leaves the capsule a–b of radius `radius`, as distances
+// along it (-1 where it misses). The ray starts again near the capsule before the quadratics, so
+// that their terms are of the capsule's size and not the camera's distance (no cancellation in
+// f32).
+fn capsule_span(o: vec3<f32>, d: vec3<f32>, a: vec3<f32>, b: vec3<f32>, radius: f32) -> vec2<f32> {
+    let start = max(dot(a - o, d) - length(b - a) - 2.0 * radius, 0.0);
+    let ro = o + d * start;
+    let ba = b - a;
+    let oa = ro - a;
+    let baba = dot(ba, ba);
+    let bard = dot(ba, d);
+    let baoa = dot(ba, oa);
+    let qa = baba - bard * bard;
+    let qb = baba * dot(d, oa) - baoa * bard;
+    let qc = baba * dot(oa, oa) - baoa * baoa - radius * radius * baba;
+    let h = qb * qb - qa * qc;
+    var span = vec2<f32>(1e30, -1e30);
+    if qa > 0.0 && h >= 0.0 {
+        // The side: kept where the hit lies between the end caps.
+        let ts = (vec2<f32>(-qb) + vec2<f32>(-1.0, 1.0) * sqrt(h)) / qa;
+        let along = vec2<f32>(baoa) + ts * bard;
+        let inside = (along > vec2<f32>(0.0)) & (along < vec2<f32>(baba));
+        span = select(span, ts, inside);
+    }
+    // The round ends (the whole capsule when the edge has no length yet).
+    for (var end = 0u; end < 2u; end++) {
+        let oc = ro - select(a, b, end == 1u);
+        let sb = dot(d, oc);
+        let sh = sb * sb - (dot(oc, oc) - radius * radius);
+        if sh >= 0.0 {
+            span = vec2<f32>(min(span.x, -sb - sqrt(sh)), max(span.y, -sb + sqrt(sh)));
+        }
+    }
+    return select(vec2<f32>(-1.0), span + start, span.y >= span.x);
+}
+
+// The distance to the capsule's surface that the pipeline would show on this ray: where it
+// enters, or — where that is nearer than the near plane, which clips it — where it leaves (the
+// inside of a tube the near plane cuts open); -1 if none.
+fn visible_hit(d: vec3<f32>, span: vec2<f32>) -> f32 {
+    if span.x > 0.0 && beyond_near(d, span.x) {
+        return span.x;
+    }
+    return select(-1.0, span.y, span.y > 0.0 && beyond_near(d, span.y));
+}
+
+// Pixel coordinates (y down) of a clip-space point in front of the camera.
+fn to_pixels(clip: vec4<f32>) -> vec2<f32> {
+    let ndc = clip.xy / clip.w;
+    return vec2<f32>((ndc.x * 0.5 + 0.5) * f32(r.width), (0.5 - ndc.y * 0.5) * f32(r.height));
+}
+
+// The pixels from lo to hi (pixel coordinates), clipped to the image: (x0, y0, x1, y1).
+fn pixel_box(lo: vec2<f32>, hi: vec2<f32>) -> vec4<i32> {
+    let size = vec2<f32>(f32(r.width), f32(r.height));
+    let first = vec2<i32>(floor(clamp(lo, vec2<f32>(0.0), size)));
+    let last = vec2<i32>(floor(clamp(hi, vec2<f32>(-1.0), size - 1.0)));
+    return vec4<i32>(first, last);
+}
+
+// The capsule's box in pixels (x0, y0, x1, y1), clipped to the image (empty, x0 > x1, when off
+// screen): the projection of its world box's part in front of the near plane — the corners in
+// front and the points where the box's edges cross the plane.
+fn capsule_box(a: vec3<f32>, b: vec3<f32>, radius: f32) -> vec4<i32> {
+    let lo = min(a, b) - vec3<f32>(radius);
+    let hi = max(a, b) + vec3<f32>(radius);
+    var box_lo = vec2<f32>(1e30);
+    var box_hi = vec2<f32>(-1e30);
+    for (var c = 0u; c < 8u; c++) {
+        let corner = select(lo, hi, vec3<bool>((c & 1u) != 0u, (c & 2u) != 0u, (c & 4u) != 0u));
+        let clip = view.view_proj * vec4<f32>(corner, 1.0);
+        if clip.w >= NEAR {
+            let px = to_pixels(clip);
+            box_lo = min(box_lo, px);
+            box_hi = max(box_hi, px);
+            continue;
+        }
+        // Behind the plane: where each box edge from this corner to one in front crosses it.
+        for (var axis = 0u; axis < 3u; axis++) {
+            let other_corner = select(lo, hi, vec3<bool>(
+                ((c ^ (1u << axis)) & 1u) != 0u,
+                ((c ^ (1u << axis)) & 2u) != 0u,
+                ((c ^ (1u << axis)) & 4u) != 0u,
+            ));
+            let other = view.view_proj * vec4<f32>(other_corner, 1.0);
+            if other.w > NEAR {
+                let px = to_pixels(mix(clip, other, (NEAR - clip.w) / (other.w - clip.w)));
+                box_lo = min(box_lo, px);
+                box_hi = max(box_hi, px);
+            }
+        }
+    }
+    return pixel_box(box_lo - 0.5, box_hi + 0.5);
+}
+
+// Whether a hit at distance t along unit ray d from the camera lies beyond the near plane (the
+// pipeline clips what is nearer).
+fn beyond_near(d: vec3<f32>, t: f32) -> bool {
+    let m = view.view_proj;
+    let p = view.camera.xyz + d * t;
+    return m[0].w * p.x + m[1].w * p.y + m[2].w * p.z + m[3].w >= NEAR;
+}
+
+// An edge ready for coverage: its end points and its key.
+struct Cover {
+    e: Edge,
+    key: u64,
+}
+
+fn cover_setup(instance: u32) -> Cover {
+    return Cover(edge(instance), u64(instance + 1u));
+}
+
+// The point of the edge's axis nearest the unit ray (o, d).
+fn axis_point_nearest(e: Edge, o: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
+    let ba = e.to_pos - e.from_pos;
+    let w = o - e.from_pos;
+    let bd = dot(ba, d);
+    let s = clamp((dot(ba, w) - bd * dot(d, w)) / max(dot(ba, ba) - bd * bd, 1e-30), 0.0, 1.0);
+    return e.from_pos + ba * s;
+}
+
+// Tests every sample of pixel (x, y) against the edge — after one test at the pixel's centre:
+// where the capsule's axis lies farther from the centre ray than its radius and a pixel's width
+// (at the capsule's far end), no sample of the pixel can see it.
+fn cover_pixel(c: Cover, x: i32, y: i32) {
+    let o = view.camera.xyz;
+    let centre = pixel_ray(vec2<f32>(f32(x), f32(y)) + 0.5);
+    let to_axis = axis_point_nearest(c.e, o, centre) - o;
+    let along = dot(to_axis, centre);
+    // Sample rays part from the centre ray by under a pixel's angle: at most this far at the
+    // capsule's far end.
+    let farthest = max(dot(c.e.from_pos - o, centre), dot(c.e.to_pos - o, centre)) + view.thickness;
+    let reach = view.thickness + max(farthest, 0.0) * r.ray_origin.w;
+    if dot(to_axis, to_axis) - along * along > reach * reach {
+        return;
+    }
+    let base = (u32(y) * r.width + u32(x)) * r.samples;
+    for (var k = 0u; k < r.samples; k++) {
+        let at = vec2<f32>(f32(x), f32(y)) + 0.5 + vec2<f32>(sample_offset(r.samples, k)) / 16.0;
+        let d = pixel_ray(at);
+        let t = visible_hit(d, capsule_span(o, d, c.e.from_pos, c.e.to_pos, view.thickness));
+        let inverted = ~bitcast<u32>(t);
+        if t > 0.0 {
+            atomicMax(&visibility[base + k], (u64(inverted) << 32u) | c.key);
+        }
+    }
+}
+
+// The capsule's outline on screen, conservatively: a 2D capsule (stadium) around the projected
+// axis p0–p1, `radius` px wide — the world radius at the nearer end's distance and angle off the
+// view axis (a plane image stretches what lies off-axis by up to 1 / cos² of the angle), plus
+// the reach of a pixel's samples. `whole` when an end lies too near the camera to say: the box's
+// rows are walked whole.
+struct Footprint {
+    p0: vec2<f32>,
+    p1: vec2<f32>,
+    radius: f32,
+    whole: bool,
+}
+
+fn footprint(c: Cover) -> Footprint {
+    let o = view.camera.xyz;
+    var f = Footprint(vec2<f32>(0.0), vec2<f32>(0.0), 0.0, false);
+    var radius = 0.0;
+    for (var end = 0u; end < 2u; end++) {
+        let p = select(c.e.from_pos, c.e.to_pos, end == 1u);
+        let clip = view.view_proj * vec4<f32>(p, 1.0);
+        let distance = length(p - o);
+        let cosine = dot(p - o, r.forward.xyz) / max(distance, 1e-30);
+        if clip.w < NEAR + view.thickness || distance <= view.thickness || cosine <= 0.1 {
+            f.whole = true;
+            return f;
+        }
+        let px = to_pixels(clip);
+        if end == 0u {
+            f.p0 = px;
+        } else {
+            f.p1 = px;
+        }
+        // The angle the radius subtends (a sphere seen from `distance`), in pixels.
+        let angle = asin(min(view.thickness / distance, 1.0));
+        radius = max(radius, angle / (r.ray_origin.w * cosine * cosine));
+    }
+    f.radius = radius * 1.25 + 1.0;
+    return f;
+}
+
+// The pixels to walk, as a box (x0, y0, x1, y1) clipped to the image: the footprint's, or the
+// projected world box's where the footprint cannot say.
+fn cover_box(c: Cover, f: Footprint) -> vec4<i32> {
+    if f.whole {
+        return capsule_box(c.e.from_pos, c.e.to_pos, view.thickness);
+    }
+    return pixel_box(min(f.p0, f.p1) - f.radius - 0.5, max(f.p0, f.p1) + f.radius - 0.5);
+}
+
+// The pixels of row y whose centres lie in the footprint, as [first, last] within the box.
+fn footprint_row(f: Footprint, box: vec4<i32>, y: i32) -> vec2<i32> {
+    if f.whole {
+        return box.xz;
+    }
+    let cy = f32(y) + 0.5;
+    let rr = f.radius * f.radius;
+    var lo = 1e30;
+    var hi = -1e30;
+    // The round ends.
+    for (var end = 0u; end < 2u; end++) {
+        let p = select(f.p0, f.p1, end == 1u);
+        let dy = cy - p.y;
+        if dy * dy <= rr {
+            let half = sqrt(rr - dy * dy);
+            lo = min(lo, p.x - half);
+            hi = max(hi, p.x + half);
+        }
+    }
+    // The band along the axis: |n·(P − p0)| ≤ radius and 0 ≤ u·(P − p0) ≤ length, each linear in x.
+    let axis = f.p1 - f.p0;
+    let length = sqrt(dot(axis, axis));
+    if length > 1e-6 {
+        let u = axis / length;
+        let n = vec2<f32>(-u.y, u.x);
+        var band = vec2<f32>(-1e30, 1e30);
+        let limits = array<vec2<f32>, 2>(vec2<f32>(-f.radius, f.radius), vec2<f32>(0.0, length));
+        let slopes = vec2<f32>(n.x, u.x);
+        let offsets = vec2<f32>(n.y, u.y) * (cy - f.p0.y) - slopes * f.p0.x;
+        for (var i = 0u; i < 2u; i++) {
+            let limit = limits[i];
+            if abs(slopes[i]) > 1e-9 {
+                let a = (limit.x - offsets[i]) / slopes[i];
+                let b = (limit.y - offsets[i]) / slopes[i];
+                band = vec2<f32>(max(band.x, min(a, b)), min(band.y, max(a, b)));
+            } else if offsets[i] < limit.x || offsets[i] > limit.y {
+                band = vec2<f32>(1e30, -1e30);
+            }
+        }
+        if band.x <= band.y {
+            lo = min(lo, band.x);
+            hi = max(hi, band.y);
+        }
+    }
+    // Pixel x has its centre at x + 0.5.
+    let first = max(i32(ceil(clamp(lo, -1e9, 1e9) - 0.5)), box.x);
+    let last = min(i32(floor(clamp(hi, -1e9, 1e9) - 0.5)), box.z);
+    return vec2<i32>(first, last);
+}
+
+@compute @workgroup_size(256)
+fn raster(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let instance = id.y * groups.x * 256u + id.x;
+    if instance >= min(draw_args[TUBE_INSTANCES], r.capacity) {
+        return;
+    }
+    let c = cover_setup(instance);
+    let f = footprint(c);
+    let box = cover_box(c, f);
+    let pixels = (box.z - box.x + 1) * (box.w - box.y + 1);
+    if pixels > max(r.large_pixels, INLINE_PIXELS) {
+        // Large edges from the queue's end, one workgroup each.
+        let slot = atomicAdd(&big_queue[1], 1u);
+        atomicStore(&big_queue[arrayLength(&big_queue) - 1u - slot], instance);
+        atomicMax(&big_args[4], min(slot + 1u, 65535u));
+        return;
+    }
+    if pixels > INLINE_PIXELS {
+        // Medium edges from its start, one thread each, in warps of like sizes.
+        let slot = atomicAdd(&big_queue[0], 1u);
+        atomicStore(&big_queue[QUEUE_START + slot], instance);
+        atomicMax(&big_args[0], min(slot / 64u + 1u, 65535u));
+        return;
+    }
+    cover_walk(c, f, box, vec2<i32>(0), 1);
+}
+
+// Walks the pixels of edge `instance` inside its outline on screen, every `step`-th row and
+// column from `first` (one thread: 0 and 1).
+fn cover_edge(instance: u32, first: vec2<i32>, step: i32) {
+    let c = cover_setup(instance);
+    let f = footprint(c);
+    cover_walk(c, f, cover_box(c, f), first, step);
+}
+
+fn cover_walk(c: Cover, f: Footprint, box: vec4<i32>, first: vec2<i32>, step: i32) {
+    for (var y = box.y + first.y; y <= box.w; y += step) {
+        let span = footprint_row(f, box, y);
+        for (var x = span.x + first.x; x <= span.y; x += step) {
+            cover_pixel(c, x, y);
+        }
+    }
+}
+
+@compute @workgroup_size(64)
+fn raster_medium(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    for (var q = id.x; q < big_queue_in[0]; q += groups.x * 64u) {
+        cover_edge(big_queue_in[QUEUE_START + q], vec2<i32>(0), 1);
+    }
+}
+
+@compute @workgroup_size(8, 8)
+fn raster_big(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_id) lid: vec3<u32>,
+) {
+    for (var q = group.x; q < big_queue_in[1]; q += groups.x) {
+        cover_edge(big_queue_in[arrayLength(&big_queue_in) - 1u - q], vec2<i32>(lid.xy), 8);
+    }
+}
+
+// The colour of edge `instance` seen through the pixel centre `p`: at the ray's hit, or — for an
+// edge that holds samples of the pixel but not its centre — at its silhouette, the point of the
+// capsule nearest the ray.
+fn shade_edge(instance: u32, p: vec2<f32>) -> vec3<f32> {
+    let e = edge(instance);
+    let o = view.camera.xyz;
+    let d = pixel_ray(p);
+    let t = visible_hit(d, capsule_span(o, d, e.from_pos, e.to_pos, view.thickness));
+    let ba = e.to_pos - e.from_pos;
+    let baba = max(dot(ba, ba), 1e-30);
+    var on_ray = o + d * t;
+    if t <= 0.0 {
+        on_ray = o + d * max(dot(axis_point_nearest(e, o, d) - o, d), 0.0);
+    }
+    let along = clamp(dot(on_ray - e.from_pos, ba) / baba, 0.0, 1.0);
+    let centre = e.from_pos + ba * along;
+    var n = on_ray - centre;
+    n = select(-d, normalize(n), dot(n, n) > 1e-30);
+    return tube_colour(n, centre + n * view.thickness, e.t);
+}
+
+// The edge key (1 + instance, 0: none) of sample word i.
+fn key_at(i: u32) -> u32 {
+    return u32(visibility_in[i] & 0xFFFFFFFFlu);
+}
+
+@compute @workgroup_size(8, 8)
+fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= r.width || id.y >= r.height {
+        return;
+    }
+    let base = (id.y * r.width + id.x) * r.samples;
+    let centre = vec2<f32>(id.xy) + 0.5;
+    // Each distinct edge among the samples is shaded once and weighted by its samples; the keys
+    // are read again rather than kept in a per-invocation array (slow local memory).
+    var sum = vec3<f32>(0.0);
+    for (var k = 0u; k < r.samples; k++) {
+        let key = key_at(base + k);
+        var first = true;
+        for (var j = 0u; j < k; j++) {
+            first = first && key_at(base + j) != key;
+        }
+        if !first {
+            continue;
+        }
+        var count = 1u;
+        for (var j = k + 1u; j < r.samples; j++) {
+            count += u32(key_at(base + j) == key);
+        }
+        var colour = r.background.rgb;
+        if key != 0u {
+            colour = shade_edge(key - 1u, centre);
+        }
+        sum += colour * f32(count);
+    }
+    textureStore(image, id.xy, vec4<f32>(sum / f32(r.samples), 1.0));
+}

@@ -1,0 +1,49 @@
+//! The visibility buffer of a draw done in compute: one 64-bit word per sample of the image,
+//! (inverted depth, primitive + 1), filled with `atomicMax` so the nearest primitive wins in any
+//! order, then shaded per pixel: the store of the compute draws (tessellation, space colonization).
+
+/// A visibility buffer for one image size and sample count.
+pub struct VisibilityBuffer {
+    /// (width, height, samples) it was made for.
+    key: (u32, u32, u32),
+    /// The words, zeroed before each frame's coverage.
+    pub buffer: wgpu::Buffer,
+    /// Its id in the frame graph.
+    pub id: u64,
+}
+
+impl VisibilityBuffer {
+    /// Keeps `slot` for `size` × `samples`, making it anew when the size changed: `Some(true)`
+    /// when made (bind groups holding the old one must be dropped), `None` when it would exceed
+    /// the device's buffer limits (the caller draws with the pipeline then).
+    pub fn ensure(
+        slot: &mut Option<Self>,
+        device: &wgpu::Device,
+        label: &str,
+        size: (u32, u32),
+        samples: u32,
+    ) -> Option<bool> {
+        let key = (size.0, size.1, samples);
+        if slot.as_ref().is_some_and(|v| v.key == key) {
+            return Some(false);
+        }
+        let limits = device.limits();
+        let bytes = u64::from(size.0) * u64::from(size.1) * u64::from(samples) * 8;
+        if bytes > limits.max_storage_buffer_binding_size.min(limits.max_buffer_size) {
+            return None;
+        }
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: bytes.max(8),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        *slot = Some(Self { key, buffer, id: crate::graph::next_resource_id() });
+        Some(true)
+    }
+
+    /// (width, height, samples).
+    pub fn key(&self) -> (u32, u32, u32) {
+        self.key
+    }
+}
