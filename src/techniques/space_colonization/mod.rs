@@ -496,7 +496,8 @@ impl Technique for SpaceColonization {
                 });
                 state.record(&mut pass, &this.kernels, &ops);
             });
-        let targets = graph.create_raster_targets("space_colonization", FORMAT, Some(render::DEPTH), samples);
+        let depth = extras.need_depth(style).then_some(render::DEPTH);
+        let targets = graph.create_raster_targets("space_colonization", FORMAT, depth, samples);
         if graph.is_simulation_only() {
             return targets.color;
         }

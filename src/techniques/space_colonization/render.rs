@@ -58,10 +58,19 @@ pub struct Extras {
     pub mesh: bool,
 }
 
+impl Extras {
+    /// Whether a frame of `style` with these extras needs a depth buffer: lines alone add up
+    /// whatever their depth, and at 4K a multisampled depth buffer costs ~2.4 ms to clear on the
+    /// H200 (examples/raster_floor).
+    pub fn need_depth(self, style: Style) -> bool {
+        style != Style::Lines || self.floor || self.mesh
+    }
+}
+
 /// The draw pipelines (lines, tubes, floor and model, at 1 sample and the scene's).
 pub struct Renderer {
-    /// [lines, tubes, floor, mesh] × [1 sample, `samples`].
-    pipelines: [[wgpu::RenderPipeline; 2]; 4],
+    /// [lines, tubes, floor, mesh, lines without a depth buffer] × [1 sample, `samples`].
+    pipelines: [[wgpu::RenderPipeline; 2]; 5],
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
     indices: wgpu::Buffer,
@@ -102,7 +111,7 @@ impl Renderer {
             immediate_size: 0,
         });
         let samples = setup.samples_for(&[format, DEPTH]);
-        let pipeline = |style: Style, samples| {
+        let pipeline = |style: Style, samples, with_depth: bool| {
             let (vertex, fragment, topology, depth, additive) = match style {
                 // Lines add up regardless of depth, as the book draws them.
                 Style::Lines => {
@@ -125,14 +134,21 @@ impl Renderer {
                 buffers: &[],
                 topology,
                 color: format,
-                depth: Some((DEPTH, depth)),
+                depth: with_depth.then_some((DEPTH, depth)),
                 additive,
                 samples,
             };
             raster_pipeline(device, &module, &pipeline_layout, &desc)
         };
         let pipelines = crate::gpu::validated(device, &origin, || {
-            [Style::Lines, Style::Tubes, Style::Floor, Style::Mesh].map(|s| [pipeline(s, 1), pipeline(s, samples)])
+            [
+                (Style::Lines, true),
+                (Style::Tubes, true),
+                (Style::Floor, true),
+                (Style::Mesh, true),
+                (Style::Lines, false),
+            ]
+            .map(|(s, depth)| [pipeline(s, 1, depth), pipeline(s, samples, depth)])
         })?;
         let compute = if device.features().contains(compute_draw::FEATURES) {
             let shader = setup.joined_shader_source("space_colonization_raster.wgsl", &DRAW_BINDINGS)?;
@@ -233,7 +249,7 @@ impl Renderer {
         }
         match style {
             Style::Lines => {
-                pass.set_pipeline(&self.pipelines[0][samples]);
+                pass.set_pipeline(&self.pipelines[if targets.depth.is_some() { 0 } else { 4 }][samples]);
                 pass.draw_indirect(&state.args.buffer, LINE_ARGS);
             }
             Style::Tubes => {
