@@ -34,6 +34,21 @@ pub fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bo
     }
 }
 
+/// A bind-group layout entry for a compute kernel's output image at `binding`: a write-only 2-D
+/// storage texture of `format`.
+pub fn output_image_entry(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    }
+}
+
 /// A bind-group layout entry for a filterable 2-D float texture at `binding` (a node's image).
 pub fn texture_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {

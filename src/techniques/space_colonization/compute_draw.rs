@@ -140,16 +140,7 @@ impl ComputeDraw {
         // The queue's kernel reads big_args as its dispatch, so it may not bind them too.
         let big_layout =
             layout("sc_raster_big_layout", &[uniforms_entry, storage(1, compute, false), storage(8, compute, true)]);
-        let output = wgpu::BindGroupLayoutEntry {
-            binding: 4,
-            visibility: compute,
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format: FORMAT,
-                view_dimension: wgpu::TextureViewDimension::D2,
-            },
-            count: None,
-        };
+        let output = crate::gpu::output_image_entry(4, FORMAT);
         let resolve_layout = layout("sc_resolve_layout", &[uniforms_entry, storage(3, compute, true), output]);
         let kernel = |entry, group: &wgpu::BindGroupLayout| {
             ComputeKernel::new(device, shader.origin(), &shader.source, entry, &[view_layout, group])

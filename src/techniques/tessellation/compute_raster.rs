@@ -100,16 +100,7 @@ impl ComputeRaster {
         // The queue's kernel reads big_args as its dispatch, so it may not bind them too.
         let big_layout =
             group_layout("tessellation_raster_big_layout", &[storage(1, compute, false), storage(2, compute, false)]);
-        let output = wgpu::BindGroupLayoutEntry {
-            binding: 5,
-            visibility: compute,
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format: FORMAT,
-                view_dimension: wgpu::TextureViewDimension::D2,
-            },
-            count: None,
-        };
+        let output = crate::gpu::output_image_entry(5, FORMAT);
         let resolve_layout = group_layout(
             "tessellation_resolve_layout",
             &[storage(4, compute, true), storage(7, compute, true), output],
