@@ -98,7 +98,8 @@ impl Blit {
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("display_encode"), timestamp_writes: None });
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups(size.0.div_ceil(8), size.1.div_ceil(8), 1);
+        // `cs_main`'s workgroup is 16×16.
+        pass.dispatch_workgroups(size.0.div_ceil(16), size.1.div_ceil(16), 1);
     }
 
     /// Records a pass that draws `source` over the whole of `target`.

@@ -167,8 +167,9 @@ fn level_single(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Final composite at output size: the source (tex_a, texel-exact) with the glow (tex_b, bilinear
-// upsampled).
-@compute @workgroup_size(8, 8, 1)
+// upsampled). 16×16 invocations: at 4K on the H200 the pass took 0.089 ms in 8×8 groups and
+// 0.046 in 16×16 (32×8: 0.049, 16×8: 0.056), the same bytes.
+@compute @workgroup_size(16, 16, 1)
 fn composite(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any(id.xy >= u.dst_size)) {
         return;
