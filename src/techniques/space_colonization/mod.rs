@@ -496,10 +496,8 @@ impl Technique for SpaceColonization {
                 });
                 state.record(&mut pass, &this.kernels, &ops);
             });
-        let depth = extras.need_depth(style).then_some(render::DEPTH);
-        let targets = graph.create_raster_targets("space_colonization", FORMAT, depth, samples);
         if graph.is_simulation_only() {
-            return targets.color;
+            return graph.create_texture("space_colonization/image", TextureDesc::full(FORMAT));
         }
         graph.add_pass("space_colonization/pose").read_buffer(nodes).read_buffer(args).write_buffer(posed).record(
             move |ctx| {
@@ -534,6 +532,9 @@ impl Technique for SpaceColonization {
                 });
             return image;
         }
+        // The pipeline's targets only where it draws: the compute draw needs none of them.
+        let depth = extras.need_depth(style).then_some(render::DEPTH);
+        let targets = graph.create_raster_targets("space_colonization", FORMAT, depth, samples);
         graph
             .add_pass("space_colonization/draw")
             .read_buffer(posed)
