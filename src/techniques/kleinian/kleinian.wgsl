@@ -31,40 +31,72 @@ fn wrap(x: f32, width: f32, left: f32) -> f32 {
     return shifted - width * floor(shifted / width) + left;
 }
 
-// Möbius map a: z -> conj(z) / |z|^2 + (-v, u).
-fn trans_a(z: vec2<f32>, t: vec2<f32>) -> vec2<f32> {
-    return vec2<f32>(z.x, -z.y) / dot(z, z) + vec2<f32>(-t.y, t.x);
+// Loop invariants of the escape-time test, derived once per sample from t = u + iv.
+struct Slice {
+    u: f32,
+    v: f32,
+    shear: f32,        // v / u: Line 1's slope factor
+    rotation: vec2<f32>, // (-v, u): the centre of the 180° turn (doubled) and a's translation
+    bend: f32,         // sign(v) (2u - 1.95) / 4: the separation line's amplitude
+    decay: f32,        // -(7.2 - (1.95 - u) 15): the separation line's exponent per unit of |d|
+    band_low: f32,     // u/2 - |bend|: the separation line never runs below this height
+    band_high: f32,    // u/2 + |bend|: ... nor above this one
+};
+
+fn slice_of(t: vec2<f32>) -> Slice {
+    let u = t.x;
+    let v = t.y;
+    let bend = sign(v) * (2.0 * u - 1.95) / 4.0;
+    let decay = -(7.2 - (1.95 - u) * 15.0);
+    // With a growing exponent (u < 1.47) the line is unbounded: no band, always evaluate it.
+    let bounded = decay <= 0.0;
+    let band_low = select(-3.4e38, u * 0.5 - abs(bend), bounded);
+    let band_high = select(3.4e38, u * 0.5 + abs(bend), bounded);
+    return Slice(u, v, v / u, vec2<f32>(-v, u), bend, decay, band_low, band_high);
+}
+
+// Step 3's test: is z above Leys' empirical separation line (Line 3)?
+fn above_separation(z: vec2<f32>, s: Slice) -> bool {
+    // With a decaying exponent the line stays within u/2 ± |bend| (a few thousandths of u for
+    // the book's t); rounding is monotonic, so the computed line stays inside the computed band
+    // and the exp is only paid inside it. The answer is the same bit for bit.
+    if (z.y >= s.band_high) {
+        return true;
+    }
+    if (z.y < s.band_low) {
+        return false;
+    }
+    let d = z.x + s.v * 0.5;
+    return z.y >= s.u * 0.5 + s.bend * sign(d) * (1.0 - exp(s.decay * abs(d)));
 }
 
 // True when z lies in one of the disks bounded by the limit set (drawn in the hit colour).
 fn in_limit_set(start: vec2<f32>, t: vec2<f32>, iterations: u32) -> bool {
-    let u = t.x;
-    let v = t.y;
+    let s = slice_of(t);
     var z = start;
     // Algorithm step 1: the limit set lies in the strip 0 <= y <= u.
-    if (z.y < 0.0 || z.y > u) {
+    if (z.y < 0.0 || z.y > s.u) {
         return false;
     }
     var lz = z + vec2<f32>(1.0, 1.0);
     var llz = z - vec2<f32>(1.0, 1.0);
     for (var i = 0u; i < iterations; i = i + 1u) {
         // Step 2: into the central parallelogram between Lines 1 and 2 (shear by signed v).
-        let shear = v / u * z.y;
+        let shear = s.shear * z.y;
         z.x = wrap(z.x + shear, 2.0, -1.0) - shear;
-        // Step 3: above Line 3, reflect through (-v/2, u/2). Leys' empirical separation line.
-        let d = z.x + v * 0.5;
-        let separation = u * 0.5
-            + sign(v) * (2.0 * u - 1.95) / 4.0 * sign(d) * (1.0 - exp(-(7.2 - (1.95 - u) * 15.0) * abs(d)));
-        if (z.y >= separation) {
-            z = vec2<f32>(-v, u) - z;
+        // Step 3: above Line 3, reflect through (-v/2, u/2).
+        if (above_separation(z, s)) {
+            z = s.rotation - z;
         }
         // Step 4: transformation a; step 5: below y = 0 means inside the largest disk.
-        z = trans_a(z, t);
+        z = vec2<f32>(z.x, -z.y) / dot(z, z) + s.rotation;
         if (z.y < 0.0) {
             return true;
         }
         // Step 6: a 2-cycle across Line 3 means the point never escapes: not in the set.
-        if (length(z - llz) < 1e-6) {
+        // (Squared distance against 1e-6 squared: the same test without a square root.)
+        let cycle = z - llz;
+        if (dot(cycle, cycle) < 1e-12) {
             return false;
         }
         llz = lz;

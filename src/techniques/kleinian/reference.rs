@@ -36,7 +36,8 @@ pub fn classify(start: [f32; 2], t: [f32; 2], iterations: u32) -> (bool, u32) {
         if y < 0.0 {
             return (true, i + 1);
         }
-        if ((x - llz[0]).powi(2) + (y - llz[1]).powi(2)).sqrt() < 1e-6 {
+        // |z - z''| < 1e-6, squared as in the shader.
+        if (x - llz[0]).powi(2) + (y - llz[1]).powi(2) < 1e-12 {
             return (false, i + 1);
         }
         llz = lz;

@@ -113,3 +113,32 @@ fn gpu_agrees_with_the_cpu_algorithm() {
         assert!(same > 0.995, "t = {t:?}: GPU and CPU agree on only {same:.4} of pixels");
     }
 }
+
+#[test]
+fn the_separation_band_changes_no_pixel() {
+    // Step 3 skips Leys' separation line (and its exp) outside the band u/2 ± |bend| the line
+    // cannot leave. A copy of the shader that always evaluates the line must give the same
+    // bytes: at the book's t, at the classic set (bend 0), at an exponent that grows instead
+    // of decaying (u < 1.47: no band), and at the far ends of t's range.
+    use indra::assets::{Asset, AssetKind};
+    use indra::offscreen::OffscreenRenderer;
+    use indra::scene::parse_scene;
+    let assets = crate::common::assets();
+    let shader = assets.load(AssetKind::Shader, "kleinian.wgsl").unwrap();
+    let band = "let bounded = decay <= 0.0;";
+    assert!(shader.source.contains(band), "the band moved");
+    let always = assets.with_shader(Asset { source: shader.source.replace(band, "let bounded = false;"), ..shader });
+    for t in [[1.98795f32, 0.005859f32], [1.94, 0.02], [2.0, 0.0], [1.3, 0.4], [2.5, -2.5], [2.5, 2.5], [1.9, -0.3]] {
+        let src = CLASSIC_BINARY
+            .replace("\"t\": (2.0, 0.0)", &format!("\"t\": ({}, {})", t[0], t[1]))
+            .replace("\"samples\": 1", "\"samples\": 4");
+        let [banded, exact] = [&assets, &always].map(|assets| {
+            let scene = parse_scene("band test", &src).unwrap();
+            let mut r =
+                OffscreenRenderer::new(crate::common::gpu(), assets, scene, Some((160, 96)), None, None).unwrap();
+            r.render_next().unwrap().rgba
+        });
+        assert!(banded == exact, "t = {t:?}: the band changed the image");
+        assert!(banded.chunks(4).any(|p| p[0] > 128) || t[0] < 1.5, "t = {t:?}: nothing drawn, nothing tested");
+    }
+}
