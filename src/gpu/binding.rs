@@ -77,6 +77,11 @@ pub fn sampled_texture_entries(binding: u32, visibility: wgpu::ShaderStages) -> 
     ]
 }
 
+/// A bind-group entry binding all of `buffer` at `binding`.
+pub fn buffer_entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
+}
+
 /// A buffer for one uniform block of `T`, written with `queue.write_buffer`.
 pub fn uniform_buffer<T>(device: &wgpu::Device, label: &str) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {

@@ -14,8 +14,8 @@ mod shader;
 mod watchdog;
 
 pub use binding::{
-    check_bindings, output_image_entry, sampled_texture_entries, storage_entry, texture_entry, uniform_buffer,
-    uniform_entry, wgsl_struct_size,
+    buffer_entry, check_bindings, output_image_entry, sampled_texture_entries, storage_entry, texture_entry,
+    uniform_buffer, uniform_entry, wgsl_struct_size,
 };
 pub use blit::{Blit, BlitTarget, DISPLAY_FORMAT, display_target};
 pub use cache::{BindGroupCache, DEFAULT_MAX_AGE};

@@ -1,6 +1,7 @@
 //! The visibility buffer of a draw done in compute: one 64-bit word per sample of the image,
 //! (inverted depth, primitive + 1), filled with `atomicMax` so the nearest primitive wins in any
-//! order, then shaded per pixel: the store of the compute draws (tessellation, space colonization).
+//! order, then shaded per pixel: the store of the compute draws (tessellation, space colonization,
+//! Poisson).
 
 /// A visibility buffer for one image size and sample count.
 pub struct VisibilityBuffer {

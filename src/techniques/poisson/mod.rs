@@ -3,15 +3,19 @@
 //! (first samples deep blue, through magenta, newest yellow). Sampling is [`crate::geometry::poisson`] on the CPU;
 //! each fixed step runs `steps_per_step` sampler steps and only new samples are uploaded.
 //! Changing dimensions, radius, attempts, extent or seed restarts the run (so does `restart`).
-//! Shader: `poisson.wgsl` (instanced quads: discs, or sphere impostors).
+//! Shaders: `poisson.wgsl` (instanced quads: discs, or sphere impostors), `poisson_raster.wgsl`
+//! (the same discs drawn in compute, `compute_draw`), `shaders/msaa_samples.wgsl`.
+
+mod compute_draw;
 
 use crate::geometry::poisson::{PoissonDisk, PoissonSettings, Step};
 use crate::gpu::ShaderError;
-use crate::graph::{FrameGraph, TextureHandle};
+use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
 use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
+use std::cell::RefCell;
 
-use super::{NodeSetup, Technique, TechniqueInfo};
+use super::{NodeSetup, Rasterizer, Technique, TechniqueInfo};
 
 /// The registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -20,7 +24,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "Bridson Poisson disk samples in 2-D or 3-D, growing step by step",
     params,
     inputs: &[],
-    shaders: &["poisson.wgsl", "msaa_samples.wgsl"],
+    shaders: &["poisson.wgsl", "poisson_raster.wgsl", "msaa_samples.wgsl"],
     create,
     check: Some(check_settings),
     stage: None,
@@ -61,6 +65,9 @@ crate::technique_params! {
         /// 3-D camera orbit
         orbit_speed: f32 =
             |n, doc| ParamDecl::new(n, ParamValue::Float(10.0), Some((-360.0, 360.0)), doc).with_unit("°/s"),
+        /// how discs are drawn — compute: found per sample in a visibility buffer (where the
+        /// adapter has 64-bit atomics); pipeline: instanced quads through the hardware rasterizer
+        rasterizer: Rasterizer = |n, doc| ParamDecl::choice(n, Rasterizer::OPTIONS, 0, doc),
         /// start sampling again from one seed point (R in the window)
         restart: bool = |n, doc| ParamDecl::trigger(n, doc).with_role(InputRole::Key('r')),
     }
@@ -254,6 +261,9 @@ pub struct Poisson {
     next_frame: u64,
     pending: Vec<[f32; 4]>,
     device: wgpu::Device,
+    /// The compute draw, where the adapter has 64-bit atomics (a cell: its passes keep bind
+    /// groups while the graph holds the node shared).
+    compute: Option<RefCell<compute_draw::ComputeDraw>>,
 }
 
 /// Bytes of one instance: position and insertion index.
@@ -287,8 +297,14 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
             },
         )
     })?;
-    let instances =
-        crate::gpu::GrowableBuffer::new(device, "poisson_instances", wgpu::BufferUsages::VERTEX, 4096 * INSTANCE);
+    let compute = if device.features().contains(compute_draw::FEATURES) {
+        let shader = setup.joined_shader_source("poisson_raster.wgsl", &[("u", 0)])?;
+        Some(RefCell::new(compute_draw::ComputeDraw::new(device, &shader, &block.buffer)?))
+    } else {
+        None
+    };
+    let usage = wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::STORAGE;
+    let instances = crate::gpu::GrowableBuffer::new(device, "poisson_instances", usage, 4096 * INSTANCE);
     // The scene's run starts at frame 0; later runs start in the frame that asks for them.
     let key = RunKey::of(&Settings::read(setup.params));
     let (fitted, message) = key.clone().within_budget();
@@ -305,6 +321,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         next_frame: 0,
         pending: Vec::new(),
         device: device.clone(),
+        compute,
     }))
 }
 
@@ -353,7 +370,8 @@ impl Technique for Poisson {
         let key = self.fitted.clone();
         let sampler = &self.sampler;
         let count = sampler.len();
-        if self.instances.reserve(&self.device, count as u64 * INSTANCE) {
+        let new_buffer = self.instances.reserve(&self.device, count as u64 * INSTANCE);
+        if new_buffer {
             // A new buffer: everything is uploaded again.
             self.uploaded = 0;
         }
@@ -362,16 +380,20 @@ impl Technique for Poisson {
         sampler.instances_from(first_new, &key, &mut self.pending);
         self.uploaded = count;
 
-        let targets = graph.create_raster_targets("poisson", FORMAT, Some(DEPTH), self.samples);
-        let (w, h) = graph.texture_size(targets.color);
+        let (w, h) = graph.output_size();
         let uniforms = camera(&key, &settings, time, w as f32 / h as f32, count, self.samples);
+        let in_compute = settings.rasterizer == Rasterizer::Compute
+            && self
+                .compute
+                .as_mut()
+                .is_some_and(|c| c.get_mut().prepare((w, h), self.samples, count as u32, new_buffer));
+        if in_compute {
+            return self.add_compute_passes(graph, uniforms, first_new, count as u32);
+        }
+        let targets = graph.create_raster_targets("poisson", FORMAT, Some(DEPTH), self.samples);
         let this: &'r Poisson = self;
         graph.add_pass("poisson/draw").draws_into(&targets).record(move |ctx| {
-            ctx.queue.write_buffer(&this.block.buffer, 0, bytemuck::bytes_of(&uniforms));
-            if !this.pending.is_empty() {
-                let offset = first_new as u64 * INSTANCE;
-                ctx.queue.write_buffer(this.instances.buffer(), offset, bytemuck::cast_slice(&this.pending));
-            }
+            this.upload(ctx.queue, &uniforms, first_new);
             let mut pass = ctx.begin_draw(&targets, wgpu::Color::BLACK);
             pass.set_pipeline(&this.pipeline);
             pass.set_bind_group(0, &this.block.bind_group, &[]);
@@ -379,6 +401,44 @@ impl Technique for Poisson {
             pass.draw(0..6, 0..count as u32);
         });
         targets.color
+    }
+}
+
+impl Poisson {
+    /// Writes this frame's uniforms and the samples new since `first_new`.
+    fn upload(&self, queue: &wgpu::Queue, uniforms: &PoissonUniforms, first_new: usize) {
+        queue.write_buffer(&self.block.buffer, 0, bytemuck::bytes_of(uniforms));
+        if !self.pending.is_empty() {
+            let offset = first_new as u64 * INSTANCE;
+            queue.write_buffer(self.instances.buffer(), offset, bytemuck::cast_slice(&self.pending));
+        }
+    }
+
+    /// The discs drawn in compute (after a successful `prepare`): coverage into the visibility
+    /// buffer, then shading into a new image.
+    fn add_compute_passes<'r>(
+        &'r mut self,
+        graph: &mut FrameGraph<'r>,
+        uniforms: PoissonUniforms,
+        first_new: usize,
+        count: u32,
+    ) -> TextureHandle {
+        let this: &'r Poisson = self;
+        let compute = this.compute.as_ref().expect("prepared");
+        let (buffer, id) = compute.borrow().visibility().map(|(b, id)| (b.clone(), id)).expect("prepared");
+        let visibility = graph.import_buffer("poisson/visibility", &buffer, id);
+        let image = graph.create_texture("poisson/image", TextureDesc::full(FORMAT));
+        let raster = compute_draw::RasterUniforms::new(graph.output_size(), count);
+        graph.add_pass("poisson/raster").write_buffer(visibility).record(move |ctx| {
+            this.upload(ctx.queue, &uniforms, first_new);
+            compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &raster, this.instances.buffer());
+        });
+        graph.add_pass("poisson/resolve").read_buffer(visibility).write(image).record(move |ctx| {
+            // Views are shared handles: a clone frees the context for the encoder.
+            let (view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
+            compute.borrow_mut().record_resolve(ctx.encoder, this.instances.buffer(), (&view, id));
+        });
+        image
     }
 }
 

@@ -35,8 +35,13 @@ fn vs_main(@builtin(vertex_index) index: u32, @location(0) sample: vec4<f32>) ->
     var out: VertexOut;
     out.clip = u.view_proj * vec4<f32>(world, 1.0);
     out.corner = c;
-    out.order = sample.w / max(u.count - 1.0, 1.0);
+    out.order = order_of(sample.w);
     return out;
+}
+
+// A sample's place in the insertion order, 0 (first) to 1 (newest), from its index.
+fn order_of(index: f32) -> f32 {
+    return index / max(u.count - 1.0, 1.0);
 }
 
 // Deep blue → magenta → yellow (sRGB anchors), returned in linear light.
@@ -74,14 +79,19 @@ fn fs_main(in: VertexOut) -> FragmentOut {
     if (coverage == 0u) {
         discard;
     }
-    // The pixel centre may lie just outside a disc some of whose samples it covers.
-    let d2 = min(dot(in.corner, in.corner), 1.0);
-    var color = ramp(in.order);
+    return FragmentOut(vec4<f32>(disc_colour(in.corner, in.order), 1.0), coverage);
+}
+
+// The colour of the disc (or sphere) of insertion order `order` shaded at quad position
+// `corner`: the pixel centre, which may lie just outside a disc some of whose samples it covers.
+fn disc_colour(corner: vec2<f32>, order: f32) -> vec3<f32> {
+    let d2 = min(dot(corner, corner), 1.0);
+    var color = ramp(order);
     if (u.spheres == 1u) {
         // Sphere normal in camera space from the quad position; light from upper left, front.
-        let normal = vec3<f32>(in.corner, -sqrt(1.0 - d2));
+        let normal = vec3<f32>(corner, -sqrt(1.0 - d2));
         let light = normalize(vec3<f32>(-0.5, 0.7, -0.6));
         color = color * (0.15 + 0.85 * max(dot(normal, light), 0.0));
     }
-    return FragmentOut(vec4<f32>(color, 1.0), coverage);
+    return color;
 }

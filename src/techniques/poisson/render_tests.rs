@@ -73,3 +73,39 @@ fn a_live_radius_change_restarts_the_run() {
     let fresh = play(&mut renderer("poisson_2d", &["poisson.radius=8"]), 40);
     assert!(changed == fresh, "a restarted run differs from a fresh one");
 }
+
+/// A scene, its frame, its settings, its multisampling and its size.
+type Comparison = (&'static str, u64, &'static [&'static str], u32, (u32, u32));
+
+#[test]
+fn the_compute_draw_matches_the_pipeline() {
+    // The discs drawn in compute against the instanced quads through the hardware rasterizer:
+    // discs that overlap (draw scale 2: the first drawn wins a tie of depths, as the pipeline's
+    // depth test keeps it), spheres that hide each other, one sample per pixel, discs large
+    // enough for the workgroup kernel (odd size, 4 px to 60 px across) and tiny ones.
+    let cases: &[Comparison] = &[
+        ("poisson_2d", 150, &[], 4, (203, 117)),
+        ("poisson_2d", 150, &["poisson.draw_scale=2.0"], 4, (203, 117)),
+        ("poisson_2d", 60, &["poisson.draw_scale=2.0", "poisson.radius=30.0"], 4, (331, 190)),
+        ("poisson_2d", 150, &["poisson.draw_scale=0.3"], 1, (203, 117)),
+        ("poisson_3d", 120, &["poisson.draw_scale=2.0"], 4, (203, 117)),
+        ("poisson_3d", 120, &[], 1, (331, 190)),
+    ];
+    for (scene, frame, sets, msaa, size) in cases {
+        let [compute, pipeline] = ["compute", "pipeline"].map(|rasterizer| {
+            let mut s = load_scene(&common::assets(), scene).unwrap();
+            s.msaa = *msaa;
+            for set in *sets {
+                s.set_from_str(set).unwrap();
+            }
+            s.set_from_str(&format!("poisson.rasterizer={rasterizer}")).unwrap();
+            let mut r = OffscreenRenderer::new(common::gpu(), &common::assets(), s, Some(*size), None, None).unwrap();
+            r.seek(*frame).unwrap();
+            r.render_next().unwrap().rgba
+        });
+        let lit = compute.chunks(4).filter(|p| p[0] as u32 + p[1] as u32 + p[2] as u32 > 60).count();
+        assert!(lit > 50, "{scene} {sets:?}: only {lit} lit pixels, nothing to compare");
+        let (score, _) = indra::offscreen::flip_score(&pipeline, &compute, *size, 0.99);
+        assert!(score.mean < 0.005, "{scene} {sets:?} msaa {msaa}: mean FLIP {} against the pipeline", score.mean);
+    }
+}

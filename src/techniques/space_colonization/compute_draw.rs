@@ -3,15 +3,12 @@
 //! path is narrow (the H100/H200) this replaces the instanced eight-sided tubes; the pipeline
 //! stays for lines, for the floor and the model's glow, and for adapters without 64-bit atomics.
 
-use crate::gpu::{BindGroupCache, ComputeKernel, JoinedSource, ShaderError, storage_entry as storage};
+use crate::gpu::{
+    BindGroupCache, ComputeKernel, JoinedSource, ShaderError, buffer_entry as entry, storage_entry as storage,
+};
 use crate::techniques::visibility::VisibilityBuffer;
 
 use super::FORMAT;
-
-/// A whole buffer at `binding`.
-fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
-}
 
 /// Features the compute draw needs.
 pub const FEATURES: wgpu::Features = wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
