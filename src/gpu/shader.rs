@@ -129,6 +129,16 @@ impl JoinedSource {
         Ok(Self::new(&files))
     }
 
+    /// `base` (origin, text) joined before these files: a shared file whose functions and the
+    /// technique's call each other (WGSL declarations may come in any order).
+    pub fn after(&self, base: (&str, &str)) -> Self {
+        let mut joined = Self::new(&[(base.0.to_string(), base.1.to_string())]);
+        let offset = joined.source.lines().count() as u32;
+        joined.source.push_str(&self.source);
+        joined.parts.extend(self.parts.iter().map(|(origin, first)| (origin.clone(), first + offset)));
+        joined
+    }
+
     /// Parses and validates the joined text, errors located in their own file.
     pub fn validate(&self) -> Result<naga::Module, ShaderError> {
         validate_wgsl(self.origin(), &self.source).map_err(|e| self.relocate(e))

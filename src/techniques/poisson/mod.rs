@@ -4,9 +4,8 @@
 //! each fixed step runs `steps_per_step` sampler steps and only new samples are uploaded.
 //! Changing dimensions, radius, attempts, extent or seed restarts the run (so does `restart`).
 //! Shaders: `poisson.wgsl` (instanced quads: discs, or sphere impostors), `poisson_raster.wgsl`
-//! (the same discs drawn in compute, `compute_draw`), `shaders/msaa_samples.wgsl`.
-
-mod compute_draw;
+//! (the same discs drawn in compute through `shaders/splat_draw.wgsl`),
+//! `shaders/msaa_samples.wgsl`.
 
 use crate::geometry::poisson::{PoissonDisk, PoissonSettings, Step};
 use crate::gpu::ShaderError;
@@ -15,6 +14,7 @@ use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 use std::cell::RefCell;
 
+use super::splat_draw::{self, SplatDraw, SplatUniforms};
 use super::{NodeSetup, Rasterizer, Technique, TechniqueInfo};
 
 /// The registry entry.
@@ -24,7 +24,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "Bridson Poisson disk samples in 2-D or 3-D, growing step by step",
     params,
     inputs: &[],
-    shaders: &["poisson.wgsl", "poisson_raster.wgsl", "msaa_samples.wgsl"],
+    shaders: &["poisson.wgsl", "poisson_raster.wgsl", "splat_draw.wgsl", "msaa_samples.wgsl"],
     create,
     check: Some(check_settings),
     stage: None,
@@ -263,7 +263,7 @@ pub struct Poisson {
     device: wgpu::Device,
     /// The compute draw, where the adapter has 64-bit atomics (a cell: its passes keep bind
     /// groups while the graph holds the node shared).
-    compute: Option<RefCell<compute_draw::ComputeDraw>>,
+    compute: Option<RefCell<SplatDraw>>,
 }
 
 /// Bytes of one instance: position and insertion index.
@@ -297,9 +297,9 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
             },
         )
     })?;
-    let compute = if device.features().contains(compute_draw::FEATURES) {
-        let shader = setup.joined_shader_source("poisson_raster.wgsl", &[("u", 0)])?;
-        Some(RefCell::new(compute_draw::ComputeDraw::new(device, &shader, &block.buffer)?))
+    let compute = if device.features().contains(splat_draw::FEATURES) {
+        let draw = SplatDraw::new::<PoissonUniforms>(setup, "poisson_raster.wgsl", &[("u", 0)], &block.buffer)?;
+        Some(RefCell::new(draw))
     } else {
         None
     };
@@ -428,7 +428,7 @@ impl Poisson {
         let (buffer, id) = compute.borrow().visibility().map(|(b, id)| (b.clone(), id)).expect("prepared");
         let visibility = graph.import_buffer("poisson/visibility", &buffer, id);
         let image = graph.create_texture("poisson/image", TextureDesc::full(FORMAT));
-        let raster = compute_draw::RasterUniforms::new(graph.output_size(), count);
+        let raster = SplatUniforms::new(graph.output_size(), count, uniforms.samples, [0.0, 0.0, 0.0, 1.0]);
         graph.add_pass("poisson/raster").write_buffer(visibility).record(move |ctx| {
             this.upload(ctx.queue, &uniforms, first_new);
             compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &raster, this.instances.buffer());
