@@ -1,22 +1,20 @@
-// A draw in compute of primitives that each cover a box of pixels on screen (Poisson's discs),
-// for GPUs whose raster path is narrow (the H100/H200: a 4× multisampled 4K
-// target with depth costs ~8 ms to clear and resolve before anything is drawn). Joined before the
-// technique's shaders (`techniques/splat_draw.rs`), which provide:
-//   fn primitive_pixels(index: u32) -> i32                the pixels in primitive `index`'s box
-//                                                         (0: it draws nothing)
-//   fn cover(index: u32, first: i32, step: i32)           tests pixels first, first + step, … of
-//                                                         that box, calling `keep` per sample hit
-//   fn shade(key: u32, centre: vec2<f32>) -> vec3<f32>    the colour of the primitive `key` names,
-//                                                         at a pixel centre
-//   @group(1) @binding(1) the primitives
-// and group 0 (the technique's own uniforms).
-//   raster      one thread per primitive covers a box of up to INLINE_PIXELS itself; larger
-//               ones are queued for a workgroup each (`raster_big`, dispatched indirectly).
-//   resolve     one thread per pixel: each sample's primitive shaded at the pixel centre (once
-//               per run of equal keys), stored at the multisampled target's precision (half
-//               floats) and averaged as the multisample resolve does.
-// Each sample keeps the nearest primitive with one 64-bit atomicMax of (depth key, key): the same
-// image whatever order the threads run in. Key 0 is the background.
+// A draw in compute of primitives that each cover a box of pixels on screen (Poisson's discs,
+// the cube field's cubes), for GPUs whose raster path is narrow (the H100/H200: a 4×
+// multisampled 4K target with depth costs ~8 ms to clear and resolve before anything is drawn).
+// The bindings and the steps the technique's kernels share (`techniques/splat_draw.rs` binds
+// and dispatches them); the technique's raster shader extends this file and its own, binds its
+// primitives at group 1 binding 1, and has three entry points:
+//   raster      one thread per primitive (`splat_index`): a box of up to INLINE_PIXELS it
+//               covers itself (`covers_inline`), larger ones are queued;
+//   raster_big  dispatched from the queue (`big_job`, `job_span`): a workgroup per CHUNK_PIXELS
+//               of a queued primitive's box, up to MAX_CHUNKS, so that a primitive as large as
+//               the image still spreads over the GPU while small ones launch few workgroups;
+//   resolve     one thread per pixel: each sample's primitive (`sample_key`) shaded at the pixel
+//               centre once per run of equal keys, stored at the multisampled target's precision
+//               (`as_stored`) and averaged as the multisample resolve does (`store_pixel`).
+// Each sample keeps the nearest primitive with one 64-bit atomicMax of (depth key, key)
+// (`keep`): the same image whatever order the threads run in. Key 0 is the background.
+// extends: msaa_samples.wgsl
 
 struct Splat {
     width: u32,        // image size in pixels
@@ -32,13 +30,75 @@ struct Splat {
 @group(1) @binding(4) var image: texture_storage_2d<rgba16float, write>;
 // The large primitives' queue: its length, then primitive indices (one slot per primitive).
 @group(1) @binding(5) var<storage, read_write> big_queue: array<atomic<u32>>;
-// The large primitives' dispatch (x, y, 1).
+// The large primitives' dispatch (queued, chunks of the largest, rows of 65,535 queued).
 @group(1) @binding(6) var<storage, read_write> big_args: array<atomic<u32>>;
 @group(1) @binding(7) var<storage, read> big_queue_in: array<u32>;
 
 // Boxes of at most this many pixels are covered by their primitive's own thread.
 const INLINE_PIXELS: i32 = 64;
+// Threads of a `raster_big` workgroup; the pixels of a box each workgroup covers, and the most
+// workgroups one primitive gets (each takes a larger share beyond).
 const BIG_THREADS: i32 = 64;
+const CHUNK_PIXELS: i32 = 1024;
+const MAX_CHUNKS: i32 = 64;
+
+// The workgroups of `raster_big` a box of `pixels` gets.
+fn chunks_of(pixels: i32) -> i32 {
+    return clamp((pixels + CHUNK_PIXELS - 1) / CHUNK_PIXELS, 1, MAX_CHUNKS);
+}
+
+// The primitive of thread `id` of `raster` (rows of at most 65,535 workgroups of 64).
+fn splat_index(id: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return id.x + id.y * groups.x * 64u;
+}
+
+// Whether primitive `index`, whose box holds `pixels`, is covered by this thread; if not, it
+// goes to the queue of `raster_big`.
+fn covers_inline(index: u32, pixels: i32) -> bool {
+    if pixels <= INLINE_PIXELS {
+        return true;
+    }
+    let slot = atomicAdd(&big_queue[0], 1u);
+    atomicStore(&big_queue[1u + slot], index);
+    atomicMax(&big_args[0], min(slot + 1u, 65535u));
+    atomicMax(&big_args[1], u32(chunks_of(pixels)));
+    atomicMax(&big_args[2], slot / 65535u + 1u);
+    return false;
+}
+
+// One `raster_big` thread: primitive `index` (the primitive count when none), which of its
+// chunks, which lane.
+struct BigJob {
+    index: u32,
+    chunk: i32,
+    lane: i32,
+};
+
+fn big_job(group: vec3<u32>, groups: vec3<u32>, lane: u32) -> BigJob {
+    let slot = group.x + group.z * groups.x;
+    if slot >= big_queue_in[0] {
+        return BigJob(splat.count, 0, 0);
+    }
+    return BigJob(big_queue_in[1u + slot], i32(group.y), i32(lane));
+}
+
+// Pixels first, first + step, … below end of a box.
+struct Span {
+    first: i32,
+    step: i32,
+    end: i32,
+};
+
+// The pixels of a box of `pixels` that `job`'s thread covers.
+fn job_span(job: BigJob, pixels: i32) -> Span {
+    let chunks = chunks_of(pixels);
+    if job.chunk >= chunks {
+        return Span(0, 1, 0);
+    }
+    let share = (pixels + chunks - 1) / chunks;
+    let first = job.chunk * share;
+    return Span(first + job.lane, BIG_THREADS, min(first + share, pixels));
+}
 
 // Sample s of `pixel` in pixels (y down).
 fn sample_position(pixel: vec2<i32>, s: u32) -> vec2<f32> {
@@ -56,35 +116,9 @@ fn box_pixel(lo: vec2<i32>, width: i32, k: i32) -> vec2<i32> {
     return lo + vec2<i32>(k % width, k / width);
 }
 
-@compute @workgroup_size(64)
-fn raster(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    // Rows of at most 65,535 workgroups.
-    let index = id.x + id.y * groups.x * 64u;
-    if index >= splat.count {
-        return;
-    }
-    let pixels = primitive_pixels(index);
-    if pixels <= INLINE_PIXELS {
-        cover(index, 0, 1);
-        return;
-    }
-    let slot = atomicAdd(&big_queue[0], 1u);
-    atomicStore(&big_queue[1u + slot], index);
-    atomicMax(&big_args[0], min(slot + 1u, 65535u));
-    atomicMax(&big_args[1], slot / 65535u + 1u);
-}
-
-@compute @workgroup_size(64)
-fn raster_big(
-    @builtin(workgroup_id) group: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) lane: u32,
-) {
-    let slot = group.x + group.y * groups.x;
-    if slot >= big_queue_in[0] {
-        return;
-    }
-    cover(big_queue_in[1u + slot], i32(lane), BIG_THREADS);
+// The key sample s of `pixel` kept (0: the background).
+fn sample_key(pixel: vec2<u32>, s: u32) -> u32 {
+    return u32(visibility_in[(pixel.y * splat.width + pixel.x) * splat.samples + s] & 0xFFFFFFFFlu);
 }
 
 // A colour as the multisampled target stores it (half floats).
@@ -92,26 +126,7 @@ fn as_stored(c: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(unpack2x16float(pack2x16float(c.rg)), unpack2x16float(pack2x16float(c.bb)).x);
 }
 
-@compute @workgroup_size(16, 16)
-fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= splat.width || id.y >= splat.height {
-        return;
-    }
-    let base = (id.y * splat.width + id.x) * splat.samples;
-    let centre = vec2<f32>(id.xy) + 0.5;
-    var last = 0u;
-    var colour = as_stored(splat.background.rgb);
-    var sum = vec3<f32>(0.0);
-    for (var s = 0u; s < splat.samples; s++) {
-        let key = u32(visibility_in[base + s] & 0xFFFFFFFFlu);
-        if key != last {
-            last = key;
-            colour = as_stored(splat.background.rgb);
-            if key != 0u {
-                colour = as_stored(shade(key, centre));
-            }
-        }
-        sum += colour;
-    }
-    textureStore(image, id.xy, vec4<f32>(sum / f32(splat.samples), 1.0));
+// Stores the mean of a pixel's samples, `sum`.
+fn store_pixel(pixel: vec2<u32>, sum: vec3<f32>) {
+    textureStore(image, pixel, vec4<f32>(sum / f32(splat.samples), 1.0));
 }

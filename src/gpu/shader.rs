@@ -111,32 +111,17 @@ impl JoinedSource {
     }
 
     /// `source` (read from `origin`) after the files it builds on, named by `// extends: NAME`
-    /// lines at its top (each may extend another), base first; `load` reads a file by name as
-    /// `(origin, source)`. A shader without such a line stands alone.
+    /// lines at its top (one or more; each base may extend others), bases first, each file once;
+    /// `load` reads a file by name as `(origin, source)`. A shader without such a line stands
+    /// alone.
     pub fn with_bases(
         origin: &str,
         source: &str,
         load: impl Fn(&str) -> Result<(String, String), String>,
     ) -> Result<Self, String> {
-        let mut files = vec![(origin.to_string(), source.to_string())];
-        while let Some(base) = extended_file(&files[0].1) {
-            if files.len() > 4 || files.iter().any(|(o, _)| o.ends_with(base)) {
-                return Err(format!("{origin}: `// extends: {base}` goes round in a circle"));
-            }
-            let loaded = load(base).map_err(|e| format!("{}: extends {base}: {e}", files[0].0))?;
-            files.insert(0, loaded);
-        }
+        let mut files = Vec::new();
+        add_with_bases(&mut files, &mut vec![origin.to_string()], (origin.to_string(), source.to_string()), &load)?;
         Ok(Self::new(&files))
-    }
-
-    /// `base` (origin, text) joined before these files: a shared file whose functions and the
-    /// technique's call each other (WGSL declarations may come in any order).
-    pub fn after(&self, base: (&str, &str)) -> Self {
-        let mut joined = Self::new(&[(base.0.to_string(), base.1.to_string())]);
-        let offset = joined.source.lines().count() as u32;
-        joined.source.push_str(&self.source);
-        joined.parts.extend(self.parts.iter().map(|(origin, first)| (origin.clone(), first + offset)));
-        joined
     }
 
     /// Parses and validates the joined text, errors located in their own file.
@@ -159,13 +144,41 @@ impl JoinedSource {
     }
 }
 
-/// The file a shader builds on: `NAME` of a `// extends: NAME` line among its leading comments.
-fn extended_file(source: &str) -> Option<&str> {
+/// Files deeper than this are taken for a circle.
+const MAX_EXTENDS_DEPTH: usize = 6;
+
+/// Appends `file` to `files` after its bases (depth first, each file once); `path` is the chain
+/// of files being added, to tell a circle.
+fn add_with_bases(
+    files: &mut Vec<(String, String)>,
+    path: &mut Vec<String>,
+    file: (String, String),
+    load: &impl Fn(&str) -> Result<(String, String), String>,
+) -> Result<(), String> {
+    for base in extended_files(&file.1) {
+        if files.iter().any(|(o, _)| o.ends_with(base)) {
+            continue;
+        }
+        if path.len() > MAX_EXTENDS_DEPTH || path.iter().any(|o| o.ends_with(base)) {
+            return Err(format!("{}: `// extends: {base}` goes round in a circle", path[0]));
+        }
+        let loaded = load(base).map_err(|e| format!("{}: extends {base}: {e}", file.0))?;
+        path.push(loaded.0.clone());
+        add_with_bases(files, path, loaded, load)?;
+        path.pop();
+    }
+    files.push(file);
+    Ok(())
+}
+
+/// The files a shader builds on: `NAME` of each `// extends: NAME` line among its leading
+/// comments.
+fn extended_files(source: &str) -> impl Iterator<Item = &str> {
     source
         .lines()
         .map(str::trim)
         .take_while(|l| l.is_empty() || l.starts_with("//"))
-        .find_map(|l| l.strip_prefix("// extends:"))
+        .filter_map(|l| l.strip_prefix("// extends:"))
         .map(str::trim)
 }
 
@@ -212,6 +225,27 @@ mod tests {
         let missing = JoinedSource::with_bases("top.wgsl", &top.replace("base.wgsl", "gone.wgsl"), files);
         assert!(missing.unwrap_err().contains("extends gone.wgsl: no gone.wgsl"));
         assert!(JoinedSource::with_bases("top.wgsl", "fn alone() {}", files).unwrap().validate().is_ok());
+    }
+
+    #[test]
+    fn two_bases_that_share_a_base_join_it_once() {
+        let files = |name: &str| -> Result<(String, String), String> {
+            let text = match name {
+                "one.wgsl" => "fn one() -> f32 {\n    return 1.0;\n}\n",
+                "left.wgsl" => "// extends: one.wgsl\nfn left() -> f32 {\n    return one();\n}\n",
+                "right.wgsl" => "// extends: one.wgsl\nfn right() -> f32 {\n    return one();\n}\n",
+                "round.wgsl" => "// extends: round.wgsl\n",
+                other => return Err(format!("no {other}")),
+            };
+            Ok((name.to_string(), text.to_string()))
+        };
+        let top =
+            "// extends: left.wgsl\n// extends: right.wgsl\nfn both() -> f32 {\n    return left() + right();\n}\n";
+        let joined = JoinedSource::with_bases("top.wgsl", top, files).unwrap();
+        assert!(joined.validate().is_ok(), "{:?}", joined.validate());
+        assert_eq!(joined.source.matches("fn one()").count(), 1);
+        let circle = JoinedSource::with_bases("top.wgsl", "// extends: round.wgsl\n", files);
+        assert!(circle.unwrap_err().contains("goes round in a circle"));
     }
 
     #[test]

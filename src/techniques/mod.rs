@@ -207,26 +207,11 @@ impl NodeSetup<'_> {
         file: &str,
         bindings: &[(&str, u32)],
     ) -> Result<crate::gpu::JoinedSource, ShaderError> {
-        self.joined_after(None, file, bindings)
-    }
-
-    /// [`Self::joined_shader_source`] with the shared file `base` joined first (its functions
-    /// and the technique's call each other), checked as one.
-    pub fn joined_after(
-        &self,
-        base: Option<&str>,
-        file: &str,
-        bindings: &[(&str, u32)],
-    ) -> Result<crate::gpu::JoinedSource, ShaderError> {
         let (origin, source) = self.load_shader(file)?;
-        let mut joined = crate::gpu::JoinedSource::with_bases(&origin, &source, |base| {
+        let joined = crate::gpu::JoinedSource::with_bases(&origin, &source, |base| {
             self.load_shader(base).map_err(|e| e.message)
         })
         .map_err(|message| ShaderError { origin: origin.clone(), line: 1, column: 1, message })?;
-        if let Some(base) = base {
-            let (base_origin, base_source) = self.load_shader(base)?;
-            joined = joined.after((&base_origin, &base_source));
-        }
         crate::gpu::check_bindings(joined.origin(), &joined.source, bindings).map_err(|e| joined.relocate(e))?;
         Ok(joined)
     }

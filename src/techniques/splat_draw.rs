@@ -1,8 +1,8 @@
-//! A draw in compute of primitives that each cover a box of pixels on screen
-//! (`shaders/splat_draw.wgsl` runs the kernels; the technique's raster shader says what a
-//! primitive covers and how it is shaded): coverage per sample into a visibility buffer, then
+//! A draw in compute of primitives that each cover a box of pixels on screen (the steps shared
+//! in `shaders/splat_draw.wgsl`; the technique's raster shader extends it with what a primitive
+//! covers and how it is shaded): coverage per sample into a visibility buffer, then
 //! shading once per pixel and primitive. Where the raster path is narrow (the H100/H200) this
-//! replaces instanced quads (Poisson's discs); the pipeline
+//! replaces instanced quads and meshes (Poisson's discs, the cube field's cubes); the pipeline
 //! stays for adapters without 64-bit atomics.
 
 use crate::gpu::{BindGroupCache, ComputeKernel, ShaderError, buffer_entry as entry, storage_entry as storage};
@@ -11,9 +11,6 @@ use crate::techniques::visibility::VisibilityBuffer;
 
 /// Features the compute draw needs.
 pub const FEATURES: wgpu::Features = wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
-
-/// The shared kernels' file.
-pub const SHADER: &str = "splat_draw.wgsl";
 
 /// `Splat` in the shader.
 #[repr(C)]
@@ -61,7 +58,7 @@ pub struct SplatDraw {
     visibility: Option<VisibilityBuffer>,
     /// The large primitives' queue (its length, then one slot each), by its capacity.
     big_queue: Option<(u32, wgpu::Buffer)>,
-    /// The large primitives' dispatch (x, y, 1), written by the raster.
+    /// The large primitives' dispatch (queued, chunks of the largest, rows), written by the raster.
     big_args: wgpu::Buffer,
     /// Group 1 by kernel (`RASTER`, `RASTER_BIG`, `RESOLVE`) and output texture id (0 for the
     /// raster kernels); dropped when a buffer they bind is made anew.
@@ -70,7 +67,7 @@ pub struct SplatDraw {
 
 impl SplatDraw {
     /// Builds the kernels from the technique's raster shader `file` (with the files it extends,
-    /// each group-0 binding of `bindings` checked) joined after `splat_draw.wgsl`; `view` is the
+    /// `splat_draw.wgsl` among them; each group-0 binding of `bindings` checked); `view` is the
     /// node's uniform block of `T` (group 0).
     pub fn new<T>(
         setup: &NodeSetup<'_>,
@@ -79,7 +76,7 @@ impl SplatDraw {
         view: &wgpu::Buffer,
     ) -> Result<Self, ShaderError> {
         let device = &setup.gpu.device;
-        let shader = setup.joined_after(Some(SHADER), file, bindings)?;
+        let shader = setup.joined_shader_source(file, bindings)?;
         let compute = wgpu::ShaderStages::COMPUTE;
         let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
@@ -120,7 +117,7 @@ impl SplatDraw {
                 device,
                 &wgpu::util::BufferInitDescriptor {
                     label: Some("splat_big_args"),
-                    contents: bytemuck::cast_slice(&[0u32, 0, 1]),
+                    contents: bytemuck::cast_slice(&[0u32, 0, 0]),
                     usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
                 },
             ),
@@ -189,7 +186,7 @@ impl SplatDraw {
         };
         encoder.clear_buffer(v, 0, None);
         encoder.clear_buffer(big_queue, 0, Some(4));
-        encoder.clear_buffer(args, 0, Some(8));
+        encoder.clear_buffer(args, 0, Some(12));
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("splat/raster"), timestamp_writes: None });
         let threads = u.count.max(1);

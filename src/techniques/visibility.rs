@@ -48,3 +48,35 @@ impl VisibilityBuffer {
         self.key
     }
 }
+
+/// The rays of a perspective camera at `eye` seen through `view_proj` over a `size` image: the
+/// ray through pixel position p (y down) is `origin + x p.x + y p.y`, not normalised (rays are
+/// affine in the pixel position). In f64: the far plane may be 10⁴ near planes away, and the
+/// rays are its points' differences.
+pub struct PixelRays {
+    /// The ray through the image's top-left corner.
+    pub origin: glam::DVec3,
+    /// The ray's change per pixel to the right.
+    pub x: glam::DVec3,
+    /// The ray's change per pixel down.
+    pub y: glam::DVec3,
+}
+
+impl PixelRays {
+    /// The rays of `view_proj` from `eye` over `size` pixels.
+    pub fn new(view_proj: glam::Mat4, eye: glam::Vec3, size: (u32, u32)) -> Self {
+        let inverse = view_proj.as_dmat4().inverse();
+        let (width, height) = (f64::from(size.0.max(1)), f64::from(size.1.max(1)));
+        let ray = |x: f64, y: f64| {
+            let far = inverse * glam::DVec4::new(x / width * 2.0 - 1.0, 1.0 - y / height * 2.0, 1.0, 1.0);
+            far.truncate() / far.w - eye.as_dvec3()
+        };
+        let origin = ray(0.0, 0.0);
+        Self { origin, x: ray(1.0, 0.0) - origin, y: ray(0.0, 1.0) - origin }
+    }
+
+    /// `v` in f32 with `w` appended, as uniforms carry it.
+    pub fn vec4(v: glam::DVec3, w: f64) -> [f32; 4] {
+        [v.x as f32, v.y as f32, v.z as f32, w as f32]
+    }
+}

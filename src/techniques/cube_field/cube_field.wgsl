@@ -12,6 +12,11 @@ struct CubeFieldUniforms {
     specular: f32,             // specular strength (HDR peaks ~ specular x light)
     shininess: f32,            // Blinn-Phong exponent
     _pad: f32,
+    // The compute draw's camera rays: through pixel position p (y down) runs
+    // ray_origin + ray_x p.x + ray_y p.y from the camera at the origin.
+    ray_origin: vec4<f32>,
+    ray_x: vec4<f32>,
+    ray_y: vec4<f32>,
 };
 
 struct Instance {
@@ -62,13 +67,17 @@ fn vs_main(@builtin(vertex_index) index: u32, instance: Instance) -> VertexOut {
 
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
-    let n = normalize(in.normal);
+    return vec4<f32>(face_colour(in.normal), 1.0);
+}
+
+// The colour of a face with (world) normal `normal`.
+fn face_colour(normal: vec3<f32>) -> vec3<f32> {
+    let n = normalize(normal);
     let l = u.light_dir.xyz;
     // The camera looks down +z from the origin; for small cubes far away the view vector is ~ -z.
     let v = vec3<f32>(0.0, 0.0, -1.0);
     let h = normalize(l + v);
     let diffuse = max(dot(n, l), 0.0);
     let spec = select(0.0, pow(max(dot(n, h), 0.0), u.shininess), diffuse > 0.0);
-    let color = u.albedo.rgb * (u.ambient + diffuse * u.light_color.rgb) + u.specular * spec * u.light_color.rgb;
-    return vec4<f32>(color, 1.0);
+    return u.albedo.rgb * (u.ambient + diffuse * u.light_color.rgb) + u.specular * spec * u.light_color.rgb;
 }

@@ -4,18 +4,24 @@
 //!
 //! Book: [UGP4 ch.4] sample scene (a Unity particle system; seed-reference §4). Here the particles
 //! are a pure function of time and seed (no simulation state), so any frame renders alone and
-//! identically. Shader: `cube_field.wgsl`.
+//! identically. Shaders: `cube_field.wgsl`, and `cube_field_raster.wgsl` for the cubes drawn in
+//! compute through `shaders/splat_draw.wgsl`.
 
 mod particles;
+#[cfg(test)]
+mod render_tests;
 
 use crate::gpu::ShaderError;
-use crate::graph::{FrameGraph, TextureHandle};
+use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
+use std::cell::RefCell;
 
 pub use particles::{CubeInstance, MAX_CUBES, cubes_at};
 
-use super::{NodeSetup, Technique, TechniqueInfo, srgb_to_linear};
+use super::splat_draw::{self, SplatDraw, SplatUniforms};
+use super::visibility::PixelRays;
+use super::{NodeSetup, Rasterizer, Technique, TechniqueInfo, srgb_to_linear};
 
 /// The registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -24,7 +30,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "instanced spinning cubes with HDR specular glints",
     params,
     inputs: &[],
-    shaders: &["cube_field.wgsl"],
+    shaders: &["cube_field.wgsl", "cube_field_raster.wgsl", "splat_draw.wgsl", "msaa_samples.wgsl"],
     create,
     check: None,
     stage: None,
@@ -65,6 +71,10 @@ crate::technique_params! {
         shininess: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(128.0), Some((1.0, 512.0)), doc),
         /// cube colour
         color: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([1.0, 1.0, 1.0, 1.0]), None, doc),
+        /// how cubes are drawn — compute: found by a ray per sample into a visibility buffer
+        /// (where the adapter has 64-bit atomics); pipeline: 12 triangles each through the
+        /// hardware rasterizer
+        rasterizer: Rasterizer = |n, doc| ParamDecl::choice(n, Rasterizer::OPTIONS, 0, doc),
     }
 }
 
@@ -93,17 +103,25 @@ pub struct CubeFieldUniforms {
     pub shininess: f32,
     /// Padding.
     pub _pad: f32,
+    /// The compute draw's ray through the image's top-left corner (from the camera at the origin).
+    pub ray_origin: [f32; 4],
+    /// The ray's change per pixel to the right.
+    pub ray_x: [f32; 4],
+    /// The ray's change per pixel down.
+    pub ray_y: [f32; 4],
 }
 
 impl CubeFieldUniforms {
     /// Camera at the origin looking down +z, y up, wgpu's [0, 1] depth.
-    pub fn from_params(p: &Settings, aspect: f32) -> Self {
+    pub fn from_params(p: &Settings, size: (u32, u32)) -> Self {
+        let aspect = size.0 as f32 / size.1.max(1) as f32;
         // wgpu's clip space is DirectX's: z in [0, 1], y up.
         let proj = glam::camera::lh::proj::directx::perspective(p.fov.to_radians(), aspect, 0.1, 100.0);
         let view = glam::camera::lh::view::look_to_mat4(glam::Vec3::ZERO, glam::Vec3::Z, glam::Vec3::Y);
         let light = glam::Vec3::from(p.light_dir).normalize_or(glam::Vec3::NEG_Z);
         let c = p.color;
         let i = p.light_intensity;
+        let rays = PixelRays::new(proj * view, glam::Vec3::ZERO, size);
         Self {
             view_proj: (proj * view).to_cols_array_2d(),
             light_dir: [light.x, light.y, light.z, 0.0],
@@ -113,6 +131,9 @@ impl CubeFieldUniforms {
             specular: p.specular,
             shininess: p.shininess,
             _pad: 0.0,
+            ray_origin: PixelRays::vec4(rays.origin, 0.0),
+            ray_x: PixelRays::vec4(rays.x, 0.0),
+            ray_y: PixelRays::vec4(rays.y, 0.0),
         }
     }
 }
@@ -125,12 +146,16 @@ pub struct CubeField {
     block: crate::gpu::UniformBlock,
     instances: wgpu::Buffer,
     scratch: Vec<CubeInstance>,
+    /// The compute draw, where the adapter has 64-bit atomics (a cell: its passes keep bind
+    /// groups while the graph holds the node shared).
+    compute: Option<RefCell<SplatDraw>>,
 }
 
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let device = &setup.gpu.device;
-    let (origin, source) = setup.shader_source("cube_field.wgsl", &[("u", 0)])?;
-    let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
+    let shader = setup.joined_shader_source("cube_field.wgsl", &[("u", 0)])?;
+    let origin = shader.origin().to_string();
+    let (module, _) = crate::gpu::compile_wgsl(device, &origin, &shader.source).map_err(|e| shader.relocate(e))?;
     let block = crate::gpu::UniformBlock::new::<CubeFieldUniforms>(device, "cube_field_uniforms");
     let samples = setup.samples_for(&[FORMAT, DEPTH]);
     let pipeline = crate::gpu::validated(device, &origin, || {
@@ -157,10 +182,17 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let instances = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("cube_field_instances"),
         size: (MAX_CUBES * size_of::<CubeInstance>()) as u64,
-        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    Ok(Box::new(CubeField { pipeline, samples, block, instances, scratch: Vec::with_capacity(MAX_CUBES) }))
+    let compute = if device.features().contains(splat_draw::FEATURES) {
+        let draw = SplatDraw::new::<CubeFieldUniforms>(setup, "cube_field_raster.wgsl", &[("u", 0)], &block.buffer)?;
+        Some(RefCell::new(draw))
+    } else {
+        None
+    };
+    let scratch = Vec::with_capacity(MAX_CUBES);
+    Ok(Box::new(CubeField { pipeline, samples, block, instances, scratch, compute }))
 }
 
 impl Technique for CubeField {
@@ -171,13 +203,18 @@ impl Technique for CubeField {
         time: &FrameTime,
         _inputs: &[TextureHandle],
     ) -> TextureHandle {
-        let targets = graph.create_raster_targets("cube_field", FORMAT, Some(DEPTH), self.samples);
-        let (w, h) = graph.texture_size(targets.color);
+        let size = graph.output_size();
         let settings = Settings::read(params);
-        let uniforms = CubeFieldUniforms::from_params(&settings, w as f32 / h as f32);
+        let uniforms = CubeFieldUniforms::from_params(&settings, size);
         cubes_at(&settings, time, &mut self.scratch);
         let count = self.scratch.len() as u32;
+        let in_compute = settings.rasterizer == Rasterizer::Compute
+            && self.compute.as_mut().is_some_and(|c| c.get_mut().prepare(size, self.samples, count, false));
         let this: &'r CubeField = self;
+        if in_compute {
+            return this.add_compute_passes(graph, uniforms, count);
+        }
+        let targets = graph.create_raster_targets("cube_field", FORMAT, Some(DEPTH), self.samples);
         graph.add_pass("cube_field/draw").draws_into(&targets).record(move |ctx| {
             ctx.queue.write_buffer(&this.block.buffer, 0, bytemuck::bytes_of(&uniforms));
             ctx.queue.write_buffer(&this.instances, 0, bytemuck::cast_slice(&this.scratch));
@@ -188,6 +225,34 @@ impl Technique for CubeField {
             pass.draw(0..36, 0..count);
         });
         targets.color
+    }
+}
+
+impl CubeField {
+    /// The cubes drawn in compute (after a successful `prepare`): coverage into the visibility
+    /// buffer, then shading into a new image.
+    fn add_compute_passes<'r>(
+        &'r self,
+        graph: &mut FrameGraph<'r>,
+        uniforms: CubeFieldUniforms,
+        count: u32,
+    ) -> TextureHandle {
+        let compute = self.compute.as_ref().expect("prepared");
+        let (buffer, id) = compute.borrow().visibility().map(|(b, id)| (b.clone(), id)).expect("prepared");
+        let visibility = graph.import_buffer("cube_field/visibility", &buffer, id);
+        let image = graph.create_texture("cube_field/image", TextureDesc::full(FORMAT));
+        let splat = SplatUniforms::new(graph.output_size(), count, self.samples, [0.0, 0.0, 0.0, 1.0]);
+        graph.add_pass("cube_field/raster").write_buffer(visibility).record(move |ctx| {
+            ctx.queue.write_buffer(&self.block.buffer, 0, bytemuck::bytes_of(&uniforms));
+            ctx.queue.write_buffer(&self.instances, 0, bytemuck::cast_slice(&self.scratch));
+            compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &splat, &self.instances);
+        });
+        graph.add_pass("cube_field/resolve").read_buffer(visibility).write(image).record(move |ctx| {
+            // Views are shared handles: a clone frees the context for the encoder.
+            let (view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
+            compute.borrow_mut().record_resolve(ctx.encoder, &self.instances, (&view, id));
+        });
+        image
     }
 }
 

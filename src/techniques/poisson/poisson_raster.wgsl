@@ -1,10 +1,11 @@
-// Chapter 7's discs and spheres drawn in compute (`shaders/splat_draw.wgsl` runs the kernels).
+// Chapter 7's discs and spheres drawn in compute (the steps shared in `shaders/splat_draw.wgsl`).
 // A sample's quad faces the camera, so on screen it is an axis-aligned box with one depth, and
 // its disc an ellipse found per sample position without any mesh. A sample keeps the nearest
 // disc by (inverted depth bits, inverted index): the pipeline's depth test (less, the first
 // drawn winning a tie, as overlapping 2-D discs all lie at one depth). A disc is shaded at the
 // pixel centre by the fragment shader's own `disc_colour`.
 // extends: poisson.wgsl
+// extends: splat_draw.wgsl
 
 @group(1) @binding(1) var<storage, read> discs: array<vec4<f32>>;
 
@@ -50,16 +51,10 @@ fn disc_box(f: Footprint) -> DiscBox {
     return DiscBox(lo, select(vec2<i32>(0), hi - lo + 1, f.drawn && all(hi >= lo)));
 }
 
-fn primitive_pixels(index: u32) -> i32 {
-    let b = disc_box(footprint(discs[index]));
-    return b.size.x * b.size.y;
-}
-
-fn cover(index: u32, first: i32, step: i32) {
-    let f = footprint(discs[index]);
-    let b = disc_box(f);
+// Covers pixels first, first + step, … below `end` of the disc's box `b`.
+fn cover(f: Footprint, b: DiscBox, index: u32, first: i32, step: i32, end: i32) {
     let depth_key = ~bitcast<u32>(f.depth);
-    for (var k = first; k < b.size.x * b.size.y; k += step) {
+    for (var k = first; k < min(end, b.size.x * b.size.y); k += step) {
         let pixel = box_pixel(b.lo, b.size.x, k);
         for (var s = 0u; s < splat.samples; s++) {
             let c = corner_at(f, sample_position(pixel, s));
@@ -70,7 +65,59 @@ fn cover(index: u32, first: i32, step: i32) {
     }
 }
 
+@compute @workgroup_size(64)
+fn raster(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let index = splat_index(id, groups);
+    if index >= splat.count {
+        return;
+    }
+    let f = footprint(discs[index]);
+    let b = disc_box(f);
+    if covers_inline(index, b.size.x * b.size.y) {
+        cover(f, b, index, 0, 1, INLINE_PIXELS);
+    }
+}
+
+@compute @workgroup_size(64)
+fn raster_big(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    let job = big_job(group, groups, lane);
+    if job.index < splat.count {
+        let f = footprint(discs[job.index]);
+        let b = disc_box(f);
+        let span = job_span(job, b.size.x * b.size.y);
+        cover(f, b, job.index, span.first, span.step, span.end);
+    }
+}
+
+// The disc a sample key names, shaded at a pixel centre.
 fn shade(key: u32, centre: vec2<f32>) -> vec3<f32> {
     let disc = discs[~key];
     return disc_colour(corner_at(footprint(disc), centre), order_of(disc.w));
+}
+
+@compute @workgroup_size(16, 16)
+fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= splat.width || id.y >= splat.height {
+        return;
+    }
+    let background = as_stored(splat.background.rgb);
+    var last = 0u;
+    var colour = background;
+    var sum = vec3<f32>(0.0);
+    for (var s = 0u; s < splat.samples; s++) {
+        let key = sample_key(id.xy, s);
+        if key != last {
+            last = key;
+            colour = background;
+            if key != 0u {
+                colour = as_stored(shade(key, vec2<f32>(id.xy) + 0.5));
+            }
+        }
+        sum += colour;
+    }
+    store_pixel(id.xy, sum);
 }

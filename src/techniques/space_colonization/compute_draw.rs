@@ -6,7 +6,7 @@
 use crate::gpu::{
     BindGroupCache, ComputeKernel, JoinedSource, ShaderError, buffer_entry as entry, storage_entry as storage,
 };
-use crate::techniques::visibility::VisibilityBuffer;
+use crate::techniques::visibility::{PixelRays, VisibilityBuffer};
 
 use super::FORMAT;
 
@@ -58,18 +58,11 @@ impl RasterUniforms {
         capacity: u32,
         background: [f32; 4],
     ) -> Self {
-        // In f64: the far plane is 10⁴ near planes away, and the rays are its points' differences.
-        let inverse = view_proj.as_dmat4().inverse();
+        let PixelRays { origin, x: ray_x, y: ray_y } = PixelRays::new(view_proj, eye, size);
         let (width, height) = (f64::from(size.0.max(1)), f64::from(size.1.max(1)));
-        let ray = |x: f64, y: f64| {
-            let far = inverse * glam::DVec4::new(x / width * 2.0 - 1.0, 1.0 - y / height * 2.0, 1.0, 1.0);
-            far.truncate() / far.w - eye.as_dvec3()
-        };
-        let origin = ray(0.0, 0.0);
-        let (ray_x, ray_y) = (ray(1.0, 0.0) - origin, ray(0.0, 1.0) - origin);
         let centre = origin + ray_x * (width / 2.0) + ray_y * (height / 2.0);
         let angle = ray_x.length().max(ray_y.length()) / centre.length();
-        let v = |v: glam::DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
+        let v = PixelRays::vec4;
         Self {
             ray_origin: v(origin, angle),
             ray_x: v(ray_x, 0.0),

@@ -167,8 +167,9 @@ fn render_star_glow(sets: &[&str], frame: u64) -> indra::offscreen::RenderedFram
 fn fused_layout_matches_the_book_layout() {
     for iteration in ["1", "2", "3"] {
         let set = format!("glow.iteration={iteration}");
-        let book = render_star_glow(&[&set, "glow.layout=Book"], 60);
-        let fused = render_star_glow(&[&set, "glow.layout=Fused"], 60);
+        // The cubes through the pipeline: one draw pass (the compute draw is two).
+        let book = render_star_glow(&[&set, "glow.layout=Book", "cubes.rasterizer=pipeline"], 60);
+        let fused = render_star_glow(&[&set, "glow.layout=Fused", "cubes.rasterizer=pipeline"], 60);
         let levels: usize = iteration.parse().unwrap();
         // Each frame ends in the display encode (one pass).
         assert_eq!(
@@ -189,8 +190,10 @@ fn fused_layout_matches_the_book_layout() {
 
 #[test]
 fn book_layout_reuses_transient_textures() {
-    // The sample's defaults: 4 streaks × 5 levels → 26 StarGlow passes.
-    let f = render_star_glow(&["glow.layout=Book", "glow.streaks=4", "glow.iteration=5", "glow.divide=3"], 0);
+    // The sample's defaults: 4 streaks × 5 levels → 26 StarGlow passes; the cubes through the
+    // pipeline (one pass, its multisampled targets).
+    let sets = ["glow.layout=Book", "glow.streaks=4", "glow.iteration=5", "glow.divide=3", "cubes.rasterizer=pipeline"];
+    let f = render_star_glow(&sets, 0);
     let s = &f.stats;
     // 27 and the display encode.
     assert_eq!((s.passes_declared, s.passes_executed), (28, 28));
@@ -207,7 +210,7 @@ fn book_layout_reuses_transient_textures() {
 #[test]
 fn zero_intensity_adds_no_passes() {
     let off = render_star_glow(&["glow.intensity=0"], 30);
-    assert_eq!(off.stats.passes_executed, 2, "only the cube draw runs, then the display encode");
+    assert_eq!(off.stats.passes_executed, 3, "only the cube draw runs (raster, resolve), then the display encode");
     let on = render_star_glow(&[], 30);
     assert_ne!(off.rgba, on.rgba);
 }

@@ -1,0 +1,183 @@
+// The cubes drawn in compute (the steps shared in `shaders/splat_draw.wgsl`): each cube is found
+// by a ray per sample (a slab test in the cube's own frame) instead of 12 triangles; a sample
+// keeps the nearest face by (inverted depth bits, cube and face). Faces are flat (one normal,
+// one view vector), so a face is shaded at the pixel centre by the fragment shader's own
+// `face_colour`. A hit nearer than the near plane is dropped and the exit kept instead, as the
+// pipeline shows the inside of a cube the plane cuts open.
+// extends: cube_field.wgsl
+// extends: splat_draw.wgsl
+
+struct Cube {
+    position_size: vec4<f32>, // xyz centre, w edge length
+    rotation: vec4<f32>,      // unit quaternion (x, y, z, w)
+};
+
+@group(1) @binding(1) var<storage, read> cubes: array<Cube>;
+
+fn conjugate(q: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(-q.xyz, q.w);
+}
+
+fn pixel_ray(p: vec2<f32>) -> vec3<f32> {
+    return u.ray_origin.xyz + u.ray_x.xyz * p.x + u.ray_y.xyz * p.y;
+}
+
+// Depth (0 near, 1 far) of the point t along ray d from the camera; outside [0, 1) unseen.
+fn depth_at(d: vec3<f32>, t: f32) -> f32 {
+    let clip = u.view_proj * vec4<f32>(d * t, 1.0);
+    return clip.z / clip.w;
+}
+
+// The visible face a ray meets: depth and face (axis 2 + 1 if the face points down the axis),
+// face -1 for none.
+struct Hit {
+    depth: f32,
+    face: i32,
+};
+
+// The local face (axis, sign) as its code.
+fn face_code(axis: i32, negative: bool) -> i32 {
+    return axis * 2 + select(0, 1, negative);
+}
+
+fn axis_of(v: vec3<f32>, value: f32) -> i32 {
+    return select(select(2, 1, v.y == value), 0, v.x == value);
+}
+
+fn cube_hit(c: Cube, d: vec3<f32>) -> Hit {
+    let q = conjugate(c.rotation);
+    let o = rotate(q, -c.position_size.xyz);
+    let dl = rotate(q, d);
+    let half = c.position_size.w * 0.5;
+    let t1 = (-half - o) / dl;
+    let t2 = (half - o) / dl;
+    let near = min(t1, t2);
+    let far = max(t1, t2);
+    let enter = max(max(near.x, near.y), near.z);
+    let exit = min(min(far.x, far.y), far.z);
+    if !(enter <= exit) || exit <= 0.0 {
+        return Hit(1.0, -1);
+    }
+    // Entering through a face whose outward normal points against the ray.
+    let enter_depth = depth_at(d, enter);
+    if enter > 0.0 && enter_depth >= 0.0 && enter_depth < 1.0 {
+        let axis = axis_of(near, enter);
+        return Hit(enter_depth, face_code(axis, dl[axis] > 0.0));
+    }
+    let exit_depth = depth_at(d, exit);
+    if exit_depth >= 0.0 && exit_depth < 1.0 {
+        let axis = axis_of(far, exit);
+        return Hit(exit_depth, face_code(axis, dl[axis] < 0.0));
+    }
+    return Hit(1.0, -1);
+}
+
+// The pixels with a sample the cube may cover: its corners' box on screen (none when the cube
+// lies behind the camera, the whole image when it reaches round it).
+struct CubeBox {
+    lo: vec2<i32>,
+    size: vec2<i32>,
+};
+
+fn cube_box(c: Cube) -> CubeBox {
+    let extent = vec2<f32>(f32(splat.width), f32(splat.height));
+    var lo = extent;
+    var hi = vec2<f32>(0.0);
+    var behind = 0u;
+    for (var k = 0u; k < 8u; k++) {
+        let corner = vec3<f32>(f32(k & 1u), f32((k >> 1u) & 1u), f32(k >> 2u)) - 0.5;
+        let world = c.position_size.xyz + rotate(c.rotation, corner * c.position_size.w);
+        let clip = u.view_proj * vec4<f32>(world, 1.0);
+        if clip.w <= 1e-6 {
+            behind++;
+            continue;
+        }
+        let ndc = clip.xy / clip.w;
+        let p = vec2<f32>((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * extent;
+        lo = min(lo, p);
+        hi = max(hi, p);
+    }
+    if behind == 8u {
+        return CubeBox(vec2<i32>(0), vec2<i32>(0));
+    }
+    if behind > 0u {
+        lo = vec2<f32>(0.0);
+        hi = extent;
+    }
+    let first = max(vec2<i32>(floor(lo - 0.5)), vec2<i32>(0));
+    let last = min(vec2<i32>(ceil(hi + 0.5)), vec2<i32>(i32(splat.width), i32(splat.height)) - 1);
+    return CubeBox(first, max(last - first + 1, vec2<i32>(0)));
+}
+
+// Covers pixels first, first + step, … below `end` of the cube's box `b`.
+fn cover(c: Cube, b: CubeBox, index: u32, first: i32, step: i32, end: i32) {
+    for (var k = first; k < min(end, b.size.x * b.size.y); k += step) {
+        let pixel = box_pixel(b.lo, b.size.x, k);
+        for (var s = 0u; s < splat.samples; s++) {
+            let hit = cube_hit(c, pixel_ray(sample_position(pixel, s)));
+            if hit.face >= 0 {
+                keep(pixel, s, ~bitcast<u32>(hit.depth), index * 8u + u32(hit.face) + 1u);
+            }
+        }
+    }
+}
+
+@compute @workgroup_size(64)
+fn raster(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let index = splat_index(id, groups);
+    if index >= splat.count {
+        return;
+    }
+    let c = cubes[index];
+    let b = cube_box(c);
+    if covers_inline(index, b.size.x * b.size.y) {
+        cover(c, b, index, 0, 1, INLINE_PIXELS);
+    }
+}
+
+@compute @workgroup_size(64)
+fn raster_big(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    let job = big_job(group, groups, lane);
+    if job.index < splat.count {
+        let c = cubes[job.index];
+        let b = cube_box(c);
+        let span = job_span(job, b.size.x * b.size.y);
+        cover(c, b, job.index, span.first, span.step, span.end);
+    }
+}
+
+// The cube face a sample key names (cube × 8 + face + 1), shaded: faces are flat.
+fn shade(key: u32) -> vec3<f32> {
+    let c = cubes[(key - 1u) / 8u];
+    let face = i32((key - 1u) % 8u);
+    var normal = vec3<f32>(0.0);
+    normal[face / 2] = select(1.0, -1.0, (face & 1) == 1);
+    return face_colour(rotate(c.rotation, normal));
+}
+
+@compute @workgroup_size(16, 16)
+fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= splat.width || id.y >= splat.height {
+        return;
+    }
+    let background = as_stored(splat.background.rgb);
+    var last = 0u;
+    var colour = background;
+    var sum = vec3<f32>(0.0);
+    for (var s = 0u; s < splat.samples; s++) {
+        let key = sample_key(id.xy, s);
+        if key != last {
+            last = key;
+            colour = background;
+            if key != 0u {
+                colour = as_stored(shade(key));
+            }
+        }
+        sum += colour;
+    }
+    store_pixel(id.xy, sum);
+}
