@@ -225,7 +225,9 @@ impl Technique for Cloth {
             // The normals pass is also where the positions are checked for a blow-up.
             state.nan.after_check(ctx.encoder, &state.status, &state.status_readback);
         });
-        let targets = graph.create_raster_targets("cloth", FORMAT, Some(render::DEPTH), this.renderer.samples);
+        // The debug view draws without depth (see `render::Renderer::new`).
+        let depth = (!debug).then_some(render::DEPTH);
+        let targets = graph.create_raster_targets("cloth", FORMAT, depth, this.renderer.samples);
         let mode = render::DrawMode { clear: view.background, debug, sphere: view.uniforms.sphere[3] > 0.0 };
         graph
             .add_pass("cloth/draw")
