@@ -52,8 +52,6 @@ pub struct SplatDraw {
     raster_layout: wgpu::BindGroupLayout,
     big_layout: wgpu::BindGroupLayout,
     resolve_layout: wgpu::BindGroupLayout,
-    /// Group 0: the node's uniform block, seen from compute.
-    view_group: wgpu::BindGroup,
     uniforms: wgpu::Buffer,
     visibility: Option<VisibilityBuffer>,
     /// The large primitives' queue (its length, then one slot each), by its capacity.
@@ -66,14 +64,30 @@ pub struct SplatDraw {
 }
 
 impl SplatDraw {
+    /// Group 0 for a node whose kernels see only its uniform block of `T` in `buffer`.
+    pub fn uniform_view<T>(device: &wgpu::Device, buffer: &wgpu::Buffer) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("splat_view"),
+            entries: &[crate::gpu::uniform_entry::<T>(0, wgpu::ShaderStages::COMPUTE)],
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("splat_view"),
+            layout: &layout,
+            entries: &[entry(0, buffer)],
+        });
+        (layout, group)
+    }
+
     /// Builds the kernels from the technique's raster shader `file` (with the files it extends,
-    /// `splat_draw.wgsl` among them; each group-0 binding of `bindings` checked); `view` is the
-    /// node's uniform block of `T` (group 0).
-    pub fn new<T>(
+    /// `splat_draw.wgsl` among them; each group-0 binding of `bindings` checked); group 0 (the
+    /// node's own) has `view_layout`; `primitives` says whether group 1 binds a buffer of them
+    /// (binding 1) or the shader finds them itself.
+    pub fn new(
         setup: &NodeSetup<'_>,
         file: &str,
         bindings: &[(&str, u32)],
-        view: &wgpu::Buffer,
+        view_layout: &wgpu::BindGroupLayout,
+        primitives: bool,
     ) -> Result<Self, ShaderError> {
         let device = &setup.gpu.device;
         let shader = setup.joined_shader_source(file, bindings)?;
@@ -81,26 +95,21 @@ impl SplatDraw {
         let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries })
         };
-        let view_layout = layout("splat_view", &[crate::gpu::uniform_entry::<T>(0, compute)]);
         let uniforms_entry = crate::gpu::uniform_entry::<SplatUniforms>(0, compute);
-        let (primitives, visibility) = (storage(1, compute, true), storage(2, compute, false));
+        let first: Vec<_> =
+            [Some(uniforms_entry), primitives.then(|| storage(1, compute, true))].into_iter().flatten().collect();
+        let with = |more: &[wgpu::BindGroupLayoutEntry]| [&first[..], more].concat();
+        let visibility = storage(2, compute, false);
         let (queue, args) = (storage(5, compute, false), storage(6, compute, false));
-        let raster_layout = layout("splat_raster_layout", &[uniforms_entry, primitives, visibility, queue, args]);
+        let raster_layout = layout("splat_raster_layout", &with(&[visibility, queue, args]));
         // The large primitives' kernel reads big_args as its dispatch, so it may not bind them too.
-        let big_layout =
-            layout("splat_big_layout", &[uniforms_entry, primitives, visibility, storage(7, compute, true)]);
+        let big_layout = layout("splat_big_layout", &with(&[visibility, storage(7, compute, true)]));
         let output = crate::gpu::output_image_entry(4, wgpu::TextureFormat::Rgba16Float);
-        let resolve_layout =
-            layout("splat_resolve_layout", &[uniforms_entry, primitives, storage(3, compute, true), output]);
+        let resolve_layout = layout("splat_resolve_layout", &with(&[storage(3, compute, true), output]));
         let kernel = |entry, group: &wgpu::BindGroupLayout| {
-            ComputeKernel::new(device, shader.origin(), &shader.source, entry, &[&view_layout, group])
+            ComputeKernel::new(device, shader.origin(), &shader.source, entry, &[view_layout, group])
                 .map_err(|e| shader.relocate(e))
         };
-        let view_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("splat_view"),
-            layout: &view_layout,
-            entries: &[entry(0, view)],
-        });
         Ok(Self {
             device: device.clone(),
             raster: kernel("raster", &raster_layout)?,
@@ -109,7 +118,6 @@ impl SplatDraw {
             raster_layout,
             big_layout,
             resolve_layout,
-            view_group,
             uniforms: crate::gpu::uniform_buffer::<SplatUniforms>(device, "splat_uniforms"),
             visibility: None,
             big_queue: None,
@@ -156,14 +164,16 @@ impl SplatDraw {
         self.visibility.as_ref().map(|v| (&v.buffer, v.id))
     }
 
-    /// Records the coverage of `u.count` primitives from `primitives`: the visibility buffer
-    /// cleared, then one thread per primitive and one workgroup per large one.
+    /// Records the coverage of `u.count` primitives (from `primitives`, where group 1 binds
+    /// them): the visibility buffer cleared, then one thread per primitive and one workgroup per
+    /// large one; `view` is group 0.
     pub fn record_raster(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         queue: &wgpu::Queue,
         u: &SplatUniforms,
-        primitives: &wgpu::Buffer,
+        view: &wgpu::BindGroup,
+        primitives: Option<&wgpu::Buffer>,
     ) {
         let (Some(visibility), Some((_, big_queue))) = (&self.visibility, &self.big_queue) else { return };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(u));
@@ -176,7 +186,8 @@ impl SplatDraw {
                 } else {
                     vec![entry(7, big_queue)]
                 };
-                let entries = [vec![entry(0, uniforms), entry(1, primitives), entry(2, v)], own].concat();
+                let first = [Some(entry(0, uniforms)), primitives.map(|p| entry(1, p))].into_iter().flatten();
+                let entries = [first.collect(), vec![entry(2, v)], own].concat();
                 let label = Some("splat_raster_group");
                 device.create_bind_group(&wgpu::BindGroupDescriptor { label, layout, entries: &entries })
             });
@@ -191,18 +202,20 @@ impl SplatDraw {
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("splat/raster"), timestamp_writes: None });
         let threads = u.count.max(1);
         let rows = [threads.min(THREADS_PER_ROW), threads.div_ceil(THREADS_PER_ROW), 1];
-        self.raster.dispatch(&mut pass, &[&self.view_group, small], rows);
+        self.raster.dispatch(&mut pass, &[view, small], rows);
         pass.set_pipeline(&self.raster_big.pipeline);
-        pass.set_bind_group(0, &self.view_group, &[]);
+        pass.set_bind_group(0, view, &[]);
         pass.set_bind_group(1, big, &[]);
         pass.dispatch_workgroups_indirect(args, 0);
     }
 
-    /// Records the shading of every pixel into `image` (its view and graph id).
+    /// Records the shading of every pixel into `image` (its view and graph id); `view` and
+    /// `primitives` as for [`Self::record_raster`].
     pub fn record_resolve(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
-        primitives: &wgpu::Buffer,
+        view: &wgpu::BindGroup,
+        primitives: Option<&wgpu::Buffer>,
         image: (&wgpu::TextureView, u64),
     ) {
         let Some(visibility) = &self.visibility else { return };
@@ -212,17 +225,19 @@ impl SplatDraw {
                 label: Some("splat_resolve_group"),
                 layout,
                 entries: &[
-                    entry(0, uniforms),
-                    entry(1, primitives),
-                    entry(3, &visibility.buffer),
-                    wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(image.0) },
-                ],
+                    [Some(entry(0, uniforms)), primitives.map(|p| entry(1, p))].into_iter().flatten().collect(),
+                    vec![
+                        entry(3, &visibility.buffer),
+                        wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(image.0) },
+                    ],
+                ]
+                .concat(),
             })
         });
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("splat/resolve"), timestamp_writes: None });
         let (width, height, _) = visibility.key();
-        self.resolve.dispatch(&mut pass, &[&self.view_group, group], [width, height, 1]);
+        self.resolve.dispatch(&mut pass, &[view, group], [width, height, 1]);
     }
 }
 

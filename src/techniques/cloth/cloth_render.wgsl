@@ -10,6 +10,11 @@ struct ClothView {
     color: vec4<f32>,        // linear cloth colour
     sphere_color: vec4<f32>, // linear sphere colour (rgb), output aspect (w)
     sphere: vec4<f32>,       // centre (xyz), radius (w)
+    // The compute draw's camera rays: through pixel position p (y down) runs
+    // ray_origin + ray_x p.x + ray_y p.y from the camera.
+    ray_origin: vec4<f32>,
+    ray_x: vec4<f32>,
+    ray_y: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> view: ClothView;
@@ -55,9 +60,14 @@ const SPHERE_SEGMENTS: u32 = 32u;
 const SPHERE_RINGS: u32 = 16u;
 const PI: f32 = 3.14159265;
 
-// 32 x 16 quads, 6 vertices each, generated from the vertex index.
-@vertex
-fn vs_sphere(@builtin(vertex_index) index: u32) -> Shaded {
+// A vertex of the sphere: its position and its outward direction.
+struct SphereVertex {
+    position: vec3<f32>,
+    direction: vec3<f32>,
+};
+
+// Vertex `index` of the sphere's 32 x 16 quads, 6 vertices each.
+fn sphere_vertex(index: u32) -> SphereVertex {
     let quad = index / 6u;
     let corner = array<vec2<f32>, 6>(
         vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
@@ -68,11 +78,16 @@ fn vs_sphere(@builtin(vertex_index) index: u32) -> Shaded {
     let theta = r * PI;
     let phi = s * 2.0 * PI;
     let dir = vec3<f32>(sin(theta) * cos(phi), cos(theta), sin(theta) * sin(phi));
-    let p = view.sphere.xyz + dir * view.sphere.w * 0.985; // drawn just inside the collider
+    return SphereVertex(view.sphere.xyz + dir * view.sphere.w * 0.985, dir); // just inside the collider
+}
+
+@vertex
+fn vs_sphere(@builtin(vertex_index) index: u32) -> Shaded {
+    let v = sphere_vertex(index);
     var out: Shaded;
-    out.clip = view.view_proj * vec4<f32>(p, 1.0);
-    out.world = p;
-    out.normal = dir;
+    out.clip = view.view_proj * vec4<f32>(v.position, 1.0);
+    out.world = v.position;
+    out.normal = v.direction;
     return out;
 }
 

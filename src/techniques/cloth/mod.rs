@@ -18,11 +18,12 @@ use render::{ClothView, Renderer};
 use state::State;
 
 use crate::gpu::{ComputeKernel, ShaderError};
-use crate::graph::{FrameGraph, TextureHandle};
+use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
 use crate::params::ParamSet;
 use crate::time::{FrameTime, MAX_CATCH_UP_STEPS};
 
-use super::{NodeSetup, Technique, TechniqueInfo};
+use super::splat_draw::SplatUniforms;
+use super::{NodeSetup, Rasterizer, Technique, TechniqueInfo};
 
 /// The registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -31,7 +32,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "mass-spring (Verlet) or XPBD cloth on the GPU with a colliding sphere",
     params,
     inputs: &[],
-    shaders: &["cloth.wgsl", "cloth_render.wgsl"],
+    shaders: &["cloth.wgsl", "cloth_render.wgsl", "cloth_raster.wgsl", "splat_draw.wgsl", "msaa_samples.wgsl"],
     create,
     check: None,
     stage: None,
@@ -186,7 +187,7 @@ impl Technique for Cloth {
         let state = &mut self.state;
         let dispatches = state.plan(&self.device, &self.kernels.layout, &self.uniforms, &steps, substeps);
         let (w, h) = graph.output_size();
-        let view = ClothView::from_params(&settings, time, w as f32 / h as f32);
+        let view = ClothView::from_params(&settings, time, (w, h));
         let debug = settings.view == View::Debug;
         self.renderer.prepare(&self.device, &self.queue, state, &view, debug);
         let this: &'r Cloth = self;
@@ -225,6 +226,44 @@ impl Technique for Cloth {
             // The normals pass is also where the positions are checked for a blow-up.
             state.nan.after_check(ctx.encoder, &state.status, &state.status_readback);
         });
+        let in_compute = !debug
+            && settings.rasterizer == Rasterizer::Compute
+            && this.renderer.compute.as_ref().is_some_and(|c| {
+                c.borrow_mut().prepare(
+                    (w, h),
+                    this.renderer.samples,
+                    state.triangles(view.uniforms.sphere[3] > 0.0),
+                    false,
+                )
+            });
+        if in_compute {
+            let compute = this.renderer.compute.as_ref().expect("prepared");
+            let (buffer, id) = compute.borrow().visibility().map(|(b, id)| (b.clone(), id)).expect("prepared");
+            let visibility = graph.import_buffer("cloth/visibility", &buffer, id);
+            let image = graph.create_texture("cloth/image", TextureDesc::full(FORMAT));
+            let b = view.background;
+            let background = [b.r as f32, b.g as f32, b.b as f32, 1.0];
+            let count = state.triangles(view.uniforms.sphere[3] > 0.0);
+            let splat = SplatUniforms::new((w, h), count, this.renderer.samples, background);
+            let group = &state.draw_groups[&state.cur];
+            graph.add_pass("cloth/raster").read_buffer(cur).read_buffer(normals).write_buffer(visibility).record(
+                move |ctx| {
+                    compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &splat, group, None);
+                },
+            );
+            graph
+                .add_pass("cloth/resolve")
+                .read_buffer(cur)
+                .read_buffer(normals)
+                .read_buffer(visibility)
+                .write(image)
+                .record(move |ctx| {
+                    // Views are shared handles: a clone frees the context for the encoder.
+                    let (image_view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
+                    compute.borrow_mut().record_resolve(ctx.encoder, group, None, (&image_view, id));
+                });
+            return image;
+        }
         // The debug view draws without depth (see `render::Renderer::new`).
         let depth = (!debug).then_some(render::DEPTH);
         let targets = graph.create_raster_targets("cloth", FORMAT, depth, this.renderer.samples);

@@ -1,6 +1,7 @@
 //! Cloth parameters and the uniform block built from them.
 
 use crate::params::{InputRole, ParamDecl, ParamValue};
+use crate::techniques::Rasterizer;
 use crate::time::FrameTime;
 
 crate::param_enum! {
@@ -83,6 +84,10 @@ crate::technique_params! {
         wind_gust: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(0.5), Some((0.0, 1.0)), doc),
         /// lit surface, or particles and springs
         view: View = |n, doc| ParamDecl::choice(n, View::OPTIONS, 0, doc),
+        /// how the lit surface is drawn — compute: its triangles found by a ray per sample into
+        /// a visibility buffer (where the adapter has 64-bit atomics); pipeline: the hardware
+        /// rasterizer (the debug view always uses it)
+        rasterizer: Rasterizer = |n, doc| ParamDecl::choice(n, Rasterizer::OPTIONS, 0, doc),
         /// cloth colour
         color: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([0.0, 0.273, 1.0, 1.0]), None, doc),
         /// sphere colour

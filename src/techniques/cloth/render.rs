@@ -4,8 +4,11 @@ use super::Settings;
 use super::state::State;
 use crate::gpu::ShaderError;
 use crate::graph::{PassContext, RasterTargets};
+use crate::techniques::splat_draw::{self, SplatDraw};
+use crate::techniques::visibility::PixelRays;
 use crate::techniques::{NodeSetup, linear_rgba};
 use crate::time::FrameTime;
+use std::cell::RefCell;
 
 /// Depth format of the draw pass.
 pub const DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -27,6 +30,12 @@ pub struct ClothViewUniforms {
     pub sphere_color: [f32; 4],
     /// Sphere centre and radius (0: not drawn).
     pub sphere: [f32; 4],
+    /// The compute draw's ray through the image's top-left corner (from the camera).
+    pub ray_origin: [f32; 4],
+    /// The ray's change per pixel to the right.
+    pub ray_x: [f32; 4],
+    /// The ray's change per pixel down.
+    pub ray_y: [f32; 4],
 }
 
 /// What one frame's draw needs from the parameters.
@@ -39,7 +48,8 @@ pub struct ClothView {
 
 impl ClothView {
     /// Camera at (0, 0, −distance) looking down +z, y up (the sample's camera at (0, 0, −10)).
-    pub fn from_params(p: &Settings, time: &FrameTime, aspect: f32) -> Self {
+    pub fn from_params(p: &Settings, time: &FrameTime, size: (u32, u32)) -> Self {
+        let aspect = size.0 as f32 / size.1.max(1) as f32;
         let eye = glam::Vec3::new(0.0, 0.0, -p.camera_distance);
         let proj = glam::camera::lh::proj::directx::perspective(p.fov.to_radians(), aspect, 0.05, 500.0);
         let view = glam::camera::lh::view::look_to_mat4(eye, glam::Vec3::Z, glam::Vec3::Y);
@@ -50,6 +60,7 @@ impl ClothView {
         let half_width = (p.resolution.max(2) - 1) as f32 * p.rest_length / 2.0;
         let mut sphere_color = linear_rgba(p.sphere_color);
         sphere_color[3] = aspect;
+        let rays = PixelRays::new(proj * view, eye, size);
         Self {
             uniforms: ClothViewUniforms {
                 view_proj: (proj * view).to_cols_array_2d(),
@@ -58,6 +69,9 @@ impl ClothView {
                 color: linear_rgba(p.color),
                 sphere_color,
                 sphere: [c[0], c[1], c[2], radius],
+                ray_origin: PixelRays::vec4(rays.origin, 0.0),
+                ray_x: PixelRays::vec4(rays.x, 0.0),
+                ray_y: PixelRays::vec4(rays.y, 0.0),
             },
             background: wgpu::Color { r: f64::from(b[0]), g: f64::from(b[1]), b: f64::from(b[2]), a: 1.0 },
         }
@@ -86,6 +100,9 @@ pub struct Renderer {
     uniform: wgpu::Buffer,
     /// Samples per pixel of the draw (the scene's `msaa`, as the adapter allows).
     pub samples: u32,
+    /// The lit surface and sphere drawn in compute, where the adapter has 64-bit atomics (a
+    /// cell: its passes keep bind groups while the graph holds the node shared).
+    pub compute: Option<RefCell<SplatDraw>>,
 }
 
 impl Renderer {
@@ -95,14 +112,12 @@ impl Renderer {
         let (origin, source) =
             setup.shader_source("cloth_render.wgsl", &[("view", 0), ("positions", 1), ("normals", 2)])?;
         let (module, _) = crate::gpu::compile_wgsl(device, &origin, &source)?;
-        let storage = |binding| crate::gpu::storage_entry(binding, wgpu::ShaderStages::VERTEX_FRAGMENT, true);
+        // The compute draw binds the same group.
+        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE;
+        let storage = |binding| crate::gpu::storage_entry(binding, stages, true);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("cloth_draw_layout"),
-            entries: &[
-                crate::gpu::uniform_entry::<ClothViewUniforms>(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
-                storage(1),
-                storage(2),
-            ],
+            entries: &[crate::gpu::uniform_entry::<ClothViewUniforms>(0, stages), storage(1), storage(2)],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("cloth_draw_pipeline_layout"),
@@ -142,7 +157,13 @@ impl Renderer {
             )
         })?;
         let uniform = crate::gpu::uniform_buffer::<ClothViewUniforms>(device, "cloth_view");
-        Ok(Self { surface, sphere, lines, points, insets, layout, uniform, samples })
+        let compute = if device.features().contains(splat_draw::FEATURES) {
+            let bindings = [("view", 0), ("positions", 1), ("normals", 2)];
+            Some(RefCell::new(SplatDraw::new(setup, "cloth_raster.wgsl", &bindings, &layout, false)?))
+        } else {
+            None
+        };
+        Ok(Self { surface, sphere, lines, points, insets, layout, uniform, samples, compute })
     }
 
     /// Two triangles per grid cell, shared vertices: indices are particle numbers.

@@ -275,3 +275,43 @@ fn a_cloth_blowing_for_seconds_does_not_crumple() {
         assert!(whole < 0.004, "crumpled after {second} s: roughness {whole:.4}");
     }
 }
+
+/// A scene, its frame, its settings, its multisampling, its size and the largest mean FLIP.
+type Comparison = (&'static str, u64, &'static [&'static str], u32, (u32, u32), f32);
+
+#[test]
+fn the_compute_draw_matches_the_pipeline() {
+    // The lit surface and sphere found by a ray per sample against the pipeline's triangles:
+    // the book's scene, the 1024² cloth (triangles under a pixel), one sample per pixel, close
+    // up (the sphere's triangles large enough for the workgroup kernel) and the camera inside
+    // the sphere's reach, where the near plane cuts the draw.
+    let cases: &[Comparison] = &[
+        ("cloth", 60, &[], 4, (203, 117), 0.002),
+        ("cloth_1024", 2, &[], 4, (160, 96), 0.002),
+        ("cloth", 60, &[], 1, (331, 190), 0.002),
+        ("cloth", 60, &["cloth.camera_distance=3.0", "cloth.fov=100.0"], 4, (203, 117), 0.002),
+        // Close up the pipeline's clipped triangles and the rays part by a little more.
+        ("cloth", 40, &["cloth.camera_distance=1.0"], 4, (160, 96), 0.008),
+    ];
+    for (scene, frame, sets, msaa, size, bound) in cases {
+        let [compute, pipeline] = ["compute", "pipeline"].map(|rasterizer| {
+            let mut s = load_scene(&common::assets(), scene).unwrap();
+            s.msaa = *msaa;
+            for set in *sets {
+                s.set_from_str(set).unwrap();
+            }
+            s.set_from_str(&format!("cloth.rasterizer={rasterizer}")).unwrap();
+            let mut r =
+                indra::offscreen::OffscreenRenderer::new(common::gpu(), &common::assets(), s, Some(*size), None, None)
+                    .unwrap();
+            r.seek(*frame).unwrap();
+            r.render_next().unwrap().rgba
+        });
+        assert!(compute != pipeline, "{scene} {sets:?}: the two draws should be different code");
+        let background = pipeline[..4].to_vec();
+        let drawn = pipeline.chunks(4).filter(|p| *p != background.as_slice()).count();
+        assert!(drawn > (size.0 * size.1 / 20) as usize, "{scene} {sets:?}: only {drawn} pixels drawn");
+        let (score, _) = indra::offscreen::flip_score(&pipeline, &compute, *size, 0.99);
+        assert!(score.mean < *bound, "{scene} {sets:?} msaa {msaa}: mean FLIP {} against the pipeline", score.mean);
+    }
+}

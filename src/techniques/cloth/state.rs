@@ -120,6 +120,11 @@ fn storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
 }
 
 impl State {
+    /// Triangles of the compute draw: the surface's, then the sphere's 32 × 16 × 2 if drawn.
+    pub fn triangles(&self, sphere: bool) -> u32 {
+        self.surface_count / 3 + if sphere { 32 * 16 * 2 } else { 0 }
+    }
+
     /// Buffers for `res` × `res` particles.
     pub fn new(device: &wgpu::Device, renderer: &Renderer, res: u32, pin: u32) -> Self {
         let bytes = u64::from(res * res) * 16;

@@ -164,7 +164,7 @@ fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= splat.width || id.y >= splat.height {
         return;
     }
-    let background = as_stored(splat.background.rgb);
+    let background = splat.background.rgb;
     var last = 0u;
     var colour = background;
     var sum = vec3<f32>(0.0);

@@ -148,7 +148,7 @@ pub struct CubeField {
     scratch: Vec<CubeInstance>,
     /// The compute draw, where the adapter has 64-bit atomics (a cell: its passes keep bind
     /// groups while the graph holds the node shared).
-    compute: Option<RefCell<SplatDraw>>,
+    compute: Option<(RefCell<SplatDraw>, wgpu::BindGroup)>,
 }
 
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
@@ -186,8 +186,9 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         mapped_at_creation: false,
     });
     let compute = if device.features().contains(splat_draw::FEATURES) {
-        let draw = SplatDraw::new::<CubeFieldUniforms>(setup, "cube_field_raster.wgsl", &[("u", 0)], &block.buffer)?;
-        Some(RefCell::new(draw))
+        let (layout, view) = SplatDraw::uniform_view::<CubeFieldUniforms>(device, &block.buffer);
+        let draw = SplatDraw::new(setup, "cube_field_raster.wgsl", &[("u", 0)], &layout, true)?;
+        Some((RefCell::new(draw), view))
     } else {
         None
     };
@@ -209,7 +210,7 @@ impl Technique for CubeField {
         cubes_at(&settings, time, &mut self.scratch);
         let count = self.scratch.len() as u32;
         let in_compute = settings.rasterizer == Rasterizer::Compute
-            && self.compute.as_mut().is_some_and(|c| c.get_mut().prepare(size, self.samples, count, false));
+            && self.compute.as_mut().is_some_and(|c| c.0.get_mut().prepare(size, self.samples, count, false));
         let this: &'r CubeField = self;
         if in_compute {
             return this.add_compute_passes(graph, uniforms, count);
@@ -237,7 +238,7 @@ impl CubeField {
         uniforms: CubeFieldUniforms,
         count: u32,
     ) -> TextureHandle {
-        let compute = self.compute.as_ref().expect("prepared");
+        let (compute, view) = self.compute.as_ref().expect("prepared");
         let (buffer, id) = compute.borrow().visibility().map(|(b, id)| (b.clone(), id)).expect("prepared");
         let visibility = graph.import_buffer("cube_field/visibility", &buffer, id);
         let image = graph.create_texture("cube_field/image", TextureDesc::full(FORMAT));
@@ -245,12 +246,12 @@ impl CubeField {
         graph.add_pass("cube_field/raster").write_buffer(visibility).record(move |ctx| {
             ctx.queue.write_buffer(&self.block.buffer, 0, bytemuck::bytes_of(&uniforms));
             ctx.queue.write_buffer(&self.instances, 0, bytemuck::cast_slice(&self.scratch));
-            compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &splat, &self.instances);
+            compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &splat, view, Some(&self.instances));
         });
         graph.add_pass("cube_field/resolve").read_buffer(visibility).write(image).record(move |ctx| {
             // Views are shared handles: a clone frees the context for the encoder.
-            let (view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
-            compute.borrow_mut().record_resolve(ctx.encoder, &self.instances, (&view, id));
+            let (image_view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
+            compute.borrow_mut().record_resolve(ctx.encoder, view, Some(&self.instances), (&image_view, id));
         });
         image
     }

@@ -263,7 +263,7 @@ pub struct Poisson {
     device: wgpu::Device,
     /// The compute draw, where the adapter has 64-bit atomics (a cell: its passes keep bind
     /// groups while the graph holds the node shared).
-    compute: Option<RefCell<SplatDraw>>,
+    compute: Option<(RefCell<SplatDraw>, wgpu::BindGroup)>,
 }
 
 /// Bytes of one instance: position and insertion index.
@@ -298,8 +298,9 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         )
     })?;
     let compute = if device.features().contains(splat_draw::FEATURES) {
-        let draw = SplatDraw::new::<PoissonUniforms>(setup, "poisson_raster.wgsl", &[("u", 0)], &block.buffer)?;
-        Some(RefCell::new(draw))
+        let (layout, view) = SplatDraw::uniform_view::<PoissonUniforms>(device, &block.buffer);
+        let draw = SplatDraw::new(setup, "poisson_raster.wgsl", &[("u", 0)], &layout, true)?;
+        Some((RefCell::new(draw), view))
     } else {
         None
     };
@@ -386,7 +387,7 @@ impl Technique for Poisson {
             && self
                 .compute
                 .as_mut()
-                .is_some_and(|c| c.get_mut().prepare((w, h), self.samples, count as u32, new_buffer));
+                .is_some_and(|c| c.0.get_mut().prepare((w, h), self.samples, count as u32, new_buffer));
         if in_compute {
             return self.add_compute_passes(graph, uniforms, first_new, count as u32);
         }
@@ -424,19 +425,19 @@ impl Poisson {
         count: u32,
     ) -> TextureHandle {
         let this: &'r Poisson = self;
-        let compute = this.compute.as_ref().expect("prepared");
+        let (compute, view) = this.compute.as_ref().expect("prepared");
         let (buffer, id) = compute.borrow().visibility().map(|(b, id)| (b.clone(), id)).expect("prepared");
         let visibility = graph.import_buffer("poisson/visibility", &buffer, id);
         let image = graph.create_texture("poisson/image", TextureDesc::full(FORMAT));
         let raster = SplatUniforms::new(graph.output_size(), count, uniforms.samples, [0.0, 0.0, 0.0, 1.0]);
         graph.add_pass("poisson/raster").write_buffer(visibility).record(move |ctx| {
             this.upload(ctx.queue, &uniforms, first_new);
-            compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &raster, this.instances.buffer());
+            compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &raster, view, Some(this.instances.buffer()));
         });
         graph.add_pass("poisson/resolve").read_buffer(visibility).write(image).record(move |ctx| {
             // Views are shared handles: a clone frees the context for the encoder.
-            let (view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
-            compute.borrow_mut().record_resolve(ctx.encoder, this.instances.buffer(), (&view, id));
+            let (image_view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
+            compute.borrow_mut().record_resolve(ctx.encoder, view, Some(this.instances.buffer()), (&image_view, id));
         });
         image
     }
