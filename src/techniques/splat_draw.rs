@@ -2,8 +2,8 @@
 //! in `shaders/splat_draw.wgsl`; the technique's raster shader extends it with what a primitive
 //! covers and how it is shaded): coverage per sample into a visibility buffer, then
 //! shading once per pixel and primitive. Where the raster path is narrow (the H100/H200) this
-//! replaces instanced quads and meshes (Poisson's discs, the cube field's cubes); the pipeline
-//! stays for adapters without 64-bit atomics.
+//! replaces instanced quads and meshes (Poisson's discs, the cube field's cubes, the cloth); the
+//! pipeline stays for adapters without 64-bit atomics.
 
 use crate::gpu::{BindGroupCache, ComputeKernel, ShaderError, buffer_entry as entry, storage_entry as storage};
 use crate::techniques::NodeSetup;
