@@ -1,6 +1,7 @@
 // A draw in compute of primitives that each cover a box of pixels on screen (Poisson's discs,
-// the cube field's cubes, the cloth's triangles), for GPUs whose raster path is narrow (the H100/H200: a 4×
-// multisampled 4K target with depth costs ~8 ms to clear and resolve before anything is drawn).
+// the cube field's cubes, the cloth's triangles), for GPUs whose raster path is narrow (the
+// H100/H200: a 4× multisampled 4K target with depth costs ~8 ms to clear and resolve before
+// anything is drawn).
 // The bindings and the steps the technique's kernels share (`techniques/splat_draw.rs` binds
 // and dispatches them); the technique's raster shader extends this file and its own, binds its
 // primitives at group 1 binding 1, and has three entry points:
