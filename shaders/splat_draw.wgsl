@@ -10,9 +10,9 @@
 //   raster_big  dispatched from the queue (`big_job`, `job_span`): a workgroup per CHUNK_PIXELS
 //               of a queued primitive's box, up to MAX_CHUNKS, so that a primitive as large as
 //               the image still spreads over the GPU while small ones launch few workgroups;
-//   resolve     one thread per pixel: each sample's primitive (`sample_key`) shaded at the pixel
+//   resolve     one thread per pixel (`Resolve`): each sample's primitive shaded at the pixel
 //               centre once per run of equal keys, stored at the multisampled target's precision
-//               (`as_stored`) and averaged as the multisample resolve does (`store_pixel`).
+//               (`as_stored`) and averaged as the multisample resolve does.
 // Each sample keeps the nearest primitive with one 64-bit atomicMax of (depth key, key)
 // (`keep`): the same image whatever order the threads run in. Key 0 is the background.
 // extends: msaa_samples.wgsl
@@ -112,6 +112,46 @@ fn keep(pixel: vec2<i32>, s: u32, depth_key: u32, key: u32) {
     atomicMax(&visibility[word], (u64(depth_key) << 32u) | u64(key));
 }
 
+// The pixels of the image with a sample inside the screen rectangle lo..hi (pixels, y down).
+struct PixelBox {
+    lo: vec2<i32>,
+    size: vec2<i32>,
+};
+
+fn pixels_around(lo: vec2<f32>, hi: vec2<f32>) -> PixelBox {
+    let first = max(vec2<i32>(floor(lo - 0.5)), vec2<i32>(0));
+    let last = min(vec2<i32>(ceil(hi + 0.5)), vec2<i32>(i32(splat.width), i32(splat.height)) - 1);
+    return PixelBox(first, max(last - first + 1, vec2<i32>(0)));
+}
+
+// The pixels a primitive inside the hull of `corners[0..count]` may cover, seen through
+// `view_proj`: their box on screen, none when all lie behind the camera, the whole image when
+// some do (the primitive reaches round the camera).
+fn corners_box(view_proj: mat4x4<f32>, corners: array<vec3<f32>, 8>, count: u32) -> PixelBox {
+    let extent = vec2<f32>(f32(splat.width), f32(splat.height));
+    var lo = extent;
+    var hi = vec2<f32>(0.0);
+    var behind = 0u;
+    for (var k = 0u; k < count; k++) {
+        let clip = view_proj * vec4<f32>(corners[k], 1.0);
+        if clip.w <= 1e-6 {
+            behind++;
+            continue;
+        }
+        let ndc = clip.xy / clip.w;
+        let p = vec2<f32>((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * extent;
+        lo = min(lo, p);
+        hi = max(hi, p);
+    }
+    if behind == count {
+        return PixelBox(vec2<i32>(0), vec2<i32>(0));
+    }
+    if behind > 0u {
+        return pixels_around(vec2<f32>(0.0), extent);
+    }
+    return pixels_around(lo, hi);
+}
+
 // Pixel k of a box at `lo`, `width` pixels wide.
 fn box_pixel(lo: vec2<i32>, width: i32, k: i32) -> vec2<i32> {
     return lo + vec2<i32>(k % width, k / width);
@@ -127,7 +167,56 @@ fn as_stored(c: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(unpack2x16float(pack2x16float(c.rg)), unpack2x16float(pack2x16float(c.bb)).x);
 }
 
-// Stores the mean of a pixel's samples, `sum`.
-fn store_pixel(pixel: vec2<u32>, sum: vec3<f32>) {
-    textureStore(image, pixel, vec4<f32>(sum / f32(splat.samples), 1.0));
+// One pixel of the resolve: its samples walked in order, each run of equal keys shaded once.
+// The technique's resolve is
+//     var r = resolve_begin(id.xy);
+//     while resolve_next(&r) { resolve_shade(&r, <colour of primitive r.key at r.centre>); }
+//     resolve_end(r);
+struct Resolve {
+    pixel: vec2<u32>,
+    centre: vec2<f32>, // the pixel centre, where primitives are shaded
+    inside: bool,      // the pixel lies in the image
+    s: u32,            // the next sample
+    key: u32,          // the primitive to shade now
+    last: u32,         // the key of the run so far (0: the background)
+    colour: vec3<f32>, // its colour as stored
+    sum: vec3<f32>,
+};
+
+fn resolve_begin(pixel: vec2<u32>) -> Resolve {
+    let inside = pixel.x < splat.width && pixel.y < splat.height;
+    // The background is stored as a clear is, unrounded.
+    return Resolve(pixel, vec2<f32>(pixel) + 0.5, inside, 0u, 0u, 0u, splat.background.rgb, vec3<f32>(0.0));
+}
+
+// Adds the samples that repeat the run's key or show the background; true when sample
+// r.s - 1 starts a run of primitive r.key, to be shaded by `resolve_shade`.
+fn resolve_next(r: ptr<function, Resolve>) -> bool {
+    while (*r).inside && (*r).s < splat.samples {
+        let key = sample_key((*r).pixel, (*r).s);
+        (*r).s += 1u;
+        if key != (*r).last {
+            (*r).last = key;
+            if key != 0u {
+                (*r).key = key;
+                return true;
+            }
+            (*r).colour = splat.background.rgb;
+        }
+        (*r).sum += (*r).colour;
+    }
+    return false;
+}
+
+// The colour `c` of the run `resolve_next` started.
+fn resolve_shade(r: ptr<function, Resolve>, c: vec3<f32>) {
+    (*r).colour = as_stored(c);
+    (*r).sum += (*r).colour;
+}
+
+// Stores the mean of the pixel's samples.
+fn resolve_end(r: Resolve) {
+    if r.inside {
+        textureStore(image, r.pixel, vec4<f32>(r.sum / f32(splat.samples), 1.0));
+    }
 }

@@ -72,44 +72,17 @@ fn depth_of(p: vec3<f32>) -> f32 {
     return clip.z / clip.w;
 }
 
-// The pixels with a sample the triangle may cover: its corners' box on screen (none when it
-// lies behind the camera, the whole image when it reaches round it).
-struct TriangleBox {
-    lo: vec2<i32>,
-    size: vec2<i32>,
-};
-
-fn triangle_box(tr: Triangle) -> TriangleBox {
-    let extent = vec2<f32>(f32(splat.width), f32(splat.height));
-    let corners = array<vec3<f32>, 3>(tr.a, tr.b, tr.c);
-    var lo = extent;
-    var hi = vec2<f32>(0.0);
-    var behind = 0u;
-    for (var k = 0u; k < 3u; k++) {
-        let clip = view.view_proj * vec4<f32>(corners[k], 1.0);
-        if clip.w <= 1e-6 {
-            behind++;
-            continue;
-        }
-        let ndc = clip.xy / clip.w;
-        let p = vec2<f32>((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * extent;
-        lo = min(lo, p);
-        hi = max(hi, p);
-    }
-    if behind == 3u {
-        return TriangleBox(vec2<i32>(0), vec2<i32>(0));
-    }
-    if behind > 0u {
-        lo = vec2<f32>(0.0);
-        hi = extent;
-    }
-    let first = max(vec2<i32>(floor(lo - 0.5)), vec2<i32>(0));
-    let last = min(vec2<i32>(ceil(hi + 0.5)), vec2<i32>(i32(splat.width), i32(splat.height)) - 1);
-    return TriangleBox(first, max(last - first + 1, vec2<i32>(0)));
+// The pixels with a sample the triangle may cover: its corners' box on screen.
+fn triangle_box(tr: Triangle) -> PixelBox {
+    var corners: array<vec3<f32>, 8>;
+    corners[0] = tr.a;
+    corners[1] = tr.b;
+    corners[2] = tr.c;
+    return corners_box(view.view_proj, corners, 3u);
 }
 
 // Covers pixels first, first + step, … below `end` of the triangle's box `b`.
-fn cover(tr: Triangle, b: TriangleBox, index: u32, first: i32, step: i32, end: i32) {
+fn cover(tr: Triangle, b: PixelBox, index: u32, first: i32, step: i32, end: i32) {
     for (var k = first; k < min(end, b.size.x * b.size.y); k += step) {
         let pixel = box_pixel(b.lo, b.size.x, k);
         for (var s = 0u; s < splat.samples; s++) {
@@ -165,23 +138,9 @@ fn shade_triangle(key: u32, centre: vec2<f32>) -> vec3<f32> {
 
 @compute @workgroup_size(16, 16)
 fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= splat.width || id.y >= splat.height {
-        return;
+    var r = resolve_begin(id.xy);
+    while resolve_next(&r) {
+        resolve_shade(&r, shade_triangle(r.key, r.centre));
     }
-    let background = splat.background.rgb;
-    var last = 0u;
-    var colour = background;
-    var sum = vec3<f32>(0.0);
-    for (var s = 0u; s < splat.samples; s++) {
-        let key = sample_key(id.xy, s);
-        if key != last {
-            last = key;
-            colour = background;
-            if key != 0u {
-                colour = as_stored(shade_triangle(key, vec2<f32>(id.xy) + 0.5));
-            }
-        }
-        sum += colour;
-    }
-    store_pixel(id.xy, sum);
+    resolve_end(r);
 }

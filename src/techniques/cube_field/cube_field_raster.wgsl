@@ -72,45 +72,18 @@ fn cube_hit(c: Cube, d: vec3<f32>) -> Hit {
     return Hit(1.0, -1);
 }
 
-// The pixels with a sample the cube may cover: its corners' box on screen (none when the cube
-// lies behind the camera, the whole image when it reaches round it).
-struct CubeBox {
-    lo: vec2<i32>,
-    size: vec2<i32>,
-};
-
-fn cube_box(c: Cube) -> CubeBox {
-    let extent = vec2<f32>(f32(splat.width), f32(splat.height));
-    var lo = extent;
-    var hi = vec2<f32>(0.0);
-    var behind = 0u;
+// The pixels with a sample the cube may cover: its corners' box on screen.
+fn cube_box(c: Cube) -> PixelBox {
+    var corners: array<vec3<f32>, 8>;
     for (var k = 0u; k < 8u; k++) {
         let corner = vec3<f32>(f32(k & 1u), f32((k >> 1u) & 1u), f32(k >> 2u)) - 0.5;
-        let world = c.position_size.xyz + rotate(c.rotation, corner * c.position_size.w);
-        let clip = u.view_proj * vec4<f32>(world, 1.0);
-        if clip.w <= 1e-6 {
-            behind++;
-            continue;
-        }
-        let ndc = clip.xy / clip.w;
-        let p = vec2<f32>((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * extent;
-        lo = min(lo, p);
-        hi = max(hi, p);
+        corners[k] = c.position_size.xyz + rotate(c.rotation, corner * c.position_size.w);
     }
-    if behind == 8u {
-        return CubeBox(vec2<i32>(0), vec2<i32>(0));
-    }
-    if behind > 0u {
-        lo = vec2<f32>(0.0);
-        hi = extent;
-    }
-    let first = max(vec2<i32>(floor(lo - 0.5)), vec2<i32>(0));
-    let last = min(vec2<i32>(ceil(hi + 0.5)), vec2<i32>(i32(splat.width), i32(splat.height)) - 1);
-    return CubeBox(first, max(last - first + 1, vec2<i32>(0)));
+    return corners_box(u.view_proj, corners, 8u);
 }
 
 // Covers pixels first, first + step, … below `end` of the cube's box `b`.
-fn cover(c: Cube, b: CubeBox, index: u32, first: i32, step: i32, end: i32) {
+fn cover(c: Cube, b: PixelBox, index: u32, first: i32, step: i32, end: i32) {
     for (var k = first; k < min(end, b.size.x * b.size.y); k += step) {
         let pixel = box_pixel(b.lo, b.size.x, k);
         for (var s = 0u; s < splat.samples; s++) {
@@ -161,23 +134,9 @@ fn shade(key: u32) -> vec3<f32> {
 
 @compute @workgroup_size(16, 16)
 fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= splat.width || id.y >= splat.height {
-        return;
+    var r = resolve_begin(id.xy);
+    while resolve_next(&r) {
+        resolve_shade(&r, shade(r.key));
     }
-    let background = splat.background.rgb;
-    var last = 0u;
-    var colour = background;
-    var sum = vec3<f32>(0.0);
-    for (var s = 0u; s < splat.samples; s++) {
-        let key = sample_key(id.xy, s);
-        if key != last {
-            last = key;
-            colour = background;
-            if key != 0u {
-                colour = as_stored(shade(key));
-            }
-        }
-        sum += colour;
-    }
-    store_pixel(id.xy, sum);
+    resolve_end(r);
 }

@@ -38,21 +38,16 @@ fn corner_at(f: Footprint, p: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(p.x - f.centre.x, f.centre.y - p.y) / f.radius;
 }
 
-// The pixels with a sample the disc may cover (samples lie within half a pixel of the centre).
-struct DiscBox {
-    lo: vec2<i32>,
-    size: vec2<i32>,
-};
-
-fn disc_box(f: Footprint) -> DiscBox {
-    let reach = abs(f.radius) + 0.5;
-    let lo = max(vec2<i32>(floor(f.centre - reach)), vec2<i32>(0));
-    let hi = min(vec2<i32>(ceil(f.centre + reach)), vec2<i32>(i32(splat.width), i32(splat.height)) - 1);
-    return DiscBox(lo, select(vec2<i32>(0), hi - lo + 1, f.drawn && all(hi >= lo)));
+// The pixels with a sample the disc may cover.
+fn disc_box(f: Footprint) -> PixelBox {
+    if !f.drawn {
+        return PixelBox(vec2<i32>(0), vec2<i32>(0));
+    }
+    return pixels_around(f.centre - abs(f.radius), f.centre + abs(f.radius));
 }
 
 // Covers pixels first, first + step, … below `end` of the disc's box `b`.
-fn cover(f: Footprint, b: DiscBox, index: u32, first: i32, step: i32, end: i32) {
+fn cover(f: Footprint, b: PixelBox, index: u32, first: i32, step: i32, end: i32) {
     let depth_key = ~bitcast<u32>(f.depth);
     for (var k = first; k < min(end, b.size.x * b.size.y); k += step) {
         let pixel = box_pixel(b.lo, b.size.x, k);
@@ -101,23 +96,9 @@ fn shade(key: u32, centre: vec2<f32>) -> vec3<f32> {
 
 @compute @workgroup_size(16, 16)
 fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= splat.width || id.y >= splat.height {
-        return;
+    var r = resolve_begin(id.xy);
+    while resolve_next(&r) {
+        resolve_shade(&r, shade(r.key, r.centre));
     }
-    let background = splat.background.rgb;
-    var last = 0u;
-    var colour = background;
-    var sum = vec3<f32>(0.0);
-    for (var s = 0u; s < splat.samples; s++) {
-        let key = sample_key(id.xy, s);
-        if key != last {
-            last = key;
-            colour = background;
-            if key != 0u {
-                colour = as_stored(shade(key, vec2<f32>(id.xy) + 0.5));
-            }
-        }
-        sum += colour;
-    }
-    store_pixel(id.xy, sum);
+    resolve_end(r);
 }
