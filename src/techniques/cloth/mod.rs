@@ -226,16 +226,14 @@ impl Technique for Cloth {
             // The normals pass is also where the positions are checked for a blow-up.
             state.nan.after_check(ctx.encoder, &state.status, &state.status_readback);
         });
+        let triangles = state.triangles(view.uniforms.sphere[3] > 0.0);
         let in_compute = !debug
             && settings.rasterizer == Rasterizer::Compute
-            && this.renderer.compute.as_ref().is_some_and(|c| {
-                c.borrow_mut().prepare(
-                    (w, h),
-                    this.renderer.samples,
-                    state.triangles(view.uniforms.sphere[3] > 0.0),
-                    false,
-                )
-            });
+            && this
+                .renderer
+                .compute
+                .as_ref()
+                .is_some_and(|c| c.borrow_mut().prepare((w, h), this.renderer.samples, triangles, false));
         if in_compute {
             let compute = this.renderer.compute.as_ref().expect("prepared");
             let (buffer, id) = compute.borrow().visibility().map(|(b, id)| (b.clone(), id)).expect("prepared");
@@ -243,8 +241,7 @@ impl Technique for Cloth {
             let image = graph.create_texture("cloth/image", TextureDesc::full(FORMAT));
             let b = view.background;
             let background = [b.r as f32, b.g as f32, b.b as f32, 1.0];
-            let count = state.triangles(view.uniforms.sphere[3] > 0.0);
-            let splat = SplatUniforms::new((w, h), count, this.renderer.samples, background);
+            let splat = SplatUniforms::new((w, h), triangles, this.renderer.samples, background);
             let group = &state.draw_groups[&state.cur];
             graph.add_pass("cloth/raster").read_buffer(cur).read_buffer(normals).write_buffer(visibility).record(
                 move |ctx| {
