@@ -124,32 +124,44 @@ fn pixels_around(lo: vec2<f32>, hi: vec2<f32>) -> PixelBox {
     return PixelBox(first, max(last - first + 1, vec2<i32>(0)));
 }
 
-// The pixels a primitive inside the hull of `corners[0..count]` may cover, seen through
-// `view_proj`: their box on screen, none when all lie behind the camera, the whole image when
-// some do (the primitive reaches round the camera).
-fn corners_box(view_proj: mat4x4<f32>, corners: array<vec3<f32>, 8>, count: u32) -> PixelBox {
-    let extent = vec2<f32>(f32(splat.width), f32(splat.height));
-    var lo = extent;
-    var hi = vec2<f32>(0.0);
-    var behind = 0u;
-    for (var k = 0u; k < count; k++) {
-        let clip = view_proj * vec4<f32>(corners[k], 1.0);
-        if clip.w <= 1e-6 {
-            behind++;
-            continue;
-        }
-        let ndc = clip.xy / clip.w;
-        let p = vec2<f32>((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * extent;
-        lo = min(lo, p);
-        hi = max(hi, p);
+// The screen box of a primitive inside the hull of some corners, grown corner by corner
+// (`box_start`, `box_add` with each corner's clip position, then `box_pixels`). An accumulator
+// rather than an array of corners: an array passed by value lives in local memory, and with it
+// the cube field's raster took 2.8× as long (0.97 against 0.35 ms at 4K on the H200).
+struct ScreenBox {
+    lo: vec2<f32>,
+    hi: vec2<f32>,
+    // Corners behind the camera, and all corners.
+    behind: u32,
+    count: u32,
+};
+
+fn box_start() -> ScreenBox {
+    return ScreenBox(vec2<f32>(f32(splat.width), f32(splat.height)), vec2<f32>(0.0), 0u, 0u);
+}
+
+fn box_add(b: ptr<function, ScreenBox>, clip: vec4<f32>) {
+    (*b).count += 1u;
+    if clip.w <= 1e-6 {
+        (*b).behind += 1u;
+        return;
     }
-    if behind == count {
+    let ndc = clip.xy / clip.w;
+    let p = vec2<f32>((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * vec2<f32>(f32(splat.width), f32(splat.height));
+    (*b).lo = min((*b).lo, p);
+    (*b).hi = max((*b).hi, p);
+}
+
+// The pixels the primitive may cover: the box's, none when all its corners lie behind the
+// camera, the whole image when some do (the primitive reaches round the camera).
+fn box_pixels(b: ScreenBox) -> PixelBox {
+    if b.behind == b.count {
         return PixelBox(vec2<i32>(0), vec2<i32>(0));
     }
-    if behind > 0u {
-        return pixels_around(vec2<f32>(0.0), extent);
+    if b.behind > 0u {
+        return pixels_around(vec2<f32>(0.0), vec2<f32>(f32(splat.width), f32(splat.height)));
     }
-    return pixels_around(lo, hi);
+    return pixels_around(b.lo, b.hi);
 }
 
 // Pixel k of a box at `lo`, `width` pixels wide.

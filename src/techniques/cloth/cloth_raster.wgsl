@@ -74,11 +74,11 @@ fn depth_of(p: vec3<f32>) -> f32 {
 
 // The pixels with a sample the triangle may cover: its corners' box on screen.
 fn triangle_box(tr: Triangle) -> PixelBox {
-    var corners: array<vec3<f32>, 8>;
-    corners[0] = tr.a;
-    corners[1] = tr.b;
-    corners[2] = tr.c;
-    return corners_box(view.view_proj, corners, 3u);
+    var b = box_start();
+    box_add(&b, view.view_proj * vec4<f32>(tr.a, 1.0));
+    box_add(&b, view.view_proj * vec4<f32>(tr.b, 1.0));
+    box_add(&b, view.view_proj * vec4<f32>(tr.c, 1.0));
+    return box_pixels(b);
 }
 
 // Covers pixels first, first + step, … below `end` of the triangle's box `b`.

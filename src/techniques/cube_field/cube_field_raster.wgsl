@@ -74,12 +74,13 @@ fn cube_hit(c: Cube, d: vec3<f32>) -> Hit {
 
 // The pixels with a sample the cube may cover: its corners' box on screen.
 fn cube_box(c: Cube) -> PixelBox {
-    var corners: array<vec3<f32>, 8>;
+    var b = box_start();
     for (var k = 0u; k < 8u; k++) {
         let corner = vec3<f32>(f32(k & 1u), f32((k >> 1u) & 1u), f32(k >> 2u)) - 0.5;
-        corners[k] = c.position_size.xyz + rotate(c.rotation, corner * c.position_size.w);
+        let world = c.position_size.xyz + rotate(c.rotation, corner * c.position_size.w);
+        box_add(&b, u.view_proj * vec4<f32>(world, 1.0));
     }
-    return corners_box(u.view_proj, corners, 8u);
+    return box_pixels(b);
 }
 
 // Covers pixels first, first + step, … below `end` of the cube's box `b`.
