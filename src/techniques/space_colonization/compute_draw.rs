@@ -1,7 +1,9 @@
 //! The tubes drawn in compute (`space_colonization_raster.wgsl`): exact capsules found by a ray
-//! per sample into a visibility buffer, then shaded once per pixel and edge. Where the raster
+//! per sample into a visibility buffer, then shaded once per pixel and edge; the skinned scene's
+//! floor (a ray–plane test per sample, filling the buffer first) and the model's additive glow
+//! (a ray per sample and mesh triangle, summed per pixel in integers) with them. Where the raster
 //! path is narrow (the H100/H200) this replaces the instanced eight-sided tubes; the pipeline
-//! stays for lines, for the floor and the model's glow, and for adapters without 64-bit atomics.
+//! stays for lines and for adapters without 64-bit atomics.
 
 use crate::gpu::{
     BindGroupCache, ComputeKernel, JoinedSource, ShaderError, buffer_entry as entry, storage_entry as storage,
@@ -39,7 +41,12 @@ pub struct RasterUniforms {
     /// Boxes of more pixels go to the large edges' queue (a workgroup each), fewer to the medium
     /// edges' (a thread each).
     pub large_pixels: i32,
-    _pad: [u32; 3],
+    /// 1: the floor is drawn.
+    pub floor: u32,
+    /// 1: the model's glow is drawn.
+    pub glow: u32,
+    /// The model's triangles (the glow's).
+    pub triangles: u32,
 }
 
 /// Edge slots that fill an H200 one thread each (132 SMs × 2,048 threads, rounded up): with fewer
@@ -74,10 +81,20 @@ impl RasterUniforms {
             samples,
             capacity,
             large_pixels: if capacity >= EDGES_FOR_THREADS { 256 } else { 0 },
-            _pad: [0; 3],
+            floor: 0,
+            glow: 0,
+            triangles: 0,
         }
     }
+
+    /// These uniforms with the floor (`floor`) and the glow of a model of `triangles` (none: 0).
+    pub fn with_extras(self, floor: bool, triangles: u32) -> Self {
+        Self { floor: u32::from(floor), glow: u32::from(triangles > 0), triangles, ..self }
+    }
 }
+
+/// Workgroups per glow triangle (`GLOW_CHUNKS` in the shader).
+const GLOW_CHUNKS: u32 = 16;
 
 /// The kernels and the visibility buffer of the compute draw.
 pub struct ComputeDraw {
@@ -85,12 +102,22 @@ pub struct ComputeDraw {
     raster: ComputeKernel,
     raster_medium: ComputeKernel,
     raster_big: ComputeKernel,
+    floor_fill: ComputeKernel,
+    glow: ComputeKernel,
     resolve: ComputeKernel,
     raster_layout: wgpu::BindGroupLayout,
     big_layout: wgpu::BindGroupLayout,
+    floor_layout: wgpu::BindGroupLayout,
+    glow_layout: wgpu::BindGroupLayout,
     resolve_layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     visibility: Option<VisibilityBuffer>,
+    /// The glow's sum per pixel (a u32 each) and its graph id, made with the visibility buffer.
+    glow_sum: Option<(wgpu::Buffer, u64)>,
+    /// Group 1 of the floor's fill and of the glow (they bind no per-frame resource).
+    extras_groups: Option<[wgpu::BindGroup; 2]>,
+    /// This frame's uniforms.
+    frame: Option<RasterUniforms>,
     /// Edge slots this frame (the raster's threads).
     capacity: u32,
     /// The queue of medium and large edges (two counts, then up to `capacity` edges), by its
@@ -131,7 +158,13 @@ impl ComputeDraw {
         let big_layout =
             layout("sc_raster_big_layout", &[uniforms_entry, storage(1, compute, false), storage(8, compute, true)]);
         let output = crate::gpu::output_image_entry(4, FORMAT);
-        let resolve_layout = layout("sc_resolve_layout", &[uniforms_entry, storage(3, compute, true), output]);
+        let resolve_layout = layout(
+            "sc_resolve_layout",
+            &[uniforms_entry, storage(3, compute, true), output, storage(10, compute, true)],
+        );
+        let floor_layout = layout("sc_floor_layout", &[uniforms_entry, storage(11, compute, false)]);
+        let glow_layout =
+            layout("sc_glow_layout", &[uniforms_entry, storage(3, compute, true), storage(9, compute, false)]);
         let kernel = |entry, group: &wgpu::BindGroupLayout| {
             ComputeKernel::new(device, shader.origin(), &shader.source, entry, &[view_layout, group])
                 .map_err(|e| shader.relocate(e))
@@ -141,12 +174,19 @@ impl ComputeDraw {
             raster: kernel("raster", &raster_layout)?,
             raster_medium: kernel("raster_medium", &big_layout)?,
             raster_big: kernel("raster_big", &big_layout)?,
+            floor_fill: kernel("floor_fill", &floor_layout)?,
+            glow: kernel("glow", &glow_layout)?,
             resolve: kernel("resolve", &resolve_layout)?,
             raster_layout,
             big_layout,
+            floor_layout,
+            glow_layout,
             resolve_layout,
             uniforms: crate::gpu::uniform_buffer::<RasterUniforms>(device, "sc_raster_uniforms"),
             visibility: None,
+            glow_sum: None,
+            extras_groups: None,
+            frame: None,
             capacity: 0,
             big_queue: None,
             big_args: wgpu::util::DeviceExt::create_buffer_init(
@@ -186,12 +226,41 @@ impl ComputeDraw {
         if made {
             self.raster_groups = BindGroupCache::default();
             self.resolve_groups = BindGroupCache::default();
+            self.make_extras_buffers(u);
         }
         self.raster_groups.begin_frame();
         self.resolve_groups.begin_frame();
         self.capacity = u.capacity;
+        self.frame = Some(*u);
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(u));
         true
+    }
+
+    /// Makes the glow's sums for `u`'s size and the floor's and the glow's bind groups over
+    /// them and the visibility buffer.
+    fn make_extras_buffers(&mut self, u: &RasterUniforms) {
+        let Some(visibility) = &self.visibility else { return };
+        let device = &self.device;
+        let sums = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sc_glow_sum"),
+            size: (u64::from(u.width) * u64::from(u.height) * 4).max(4),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let group = |layout, entries: &[wgpu::BindGroupEntry]| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("sc_extras_group"), layout, entries })
+        };
+        let (uniforms, v) = (&self.uniforms, &visibility.buffer);
+        self.extras_groups = Some([
+            group(&self.floor_layout, &[entry(0, uniforms), entry(11, v)]),
+            group(&self.glow_layout, &[entry(0, uniforms), entry(3, v), entry(9, &sums)]),
+        ]);
+        self.glow_sum = Some((sums, crate::graph::next_resource_id()));
+    }
+
+    /// The glow's sums and their graph id (after a successful [`Self::prepare`]).
+    pub fn glow_sum(&self) -> Option<(&wgpu::Buffer, u64)> {
+        self.glow_sum.as_ref().map(|(buffer, id)| (buffer, *id))
     }
 
     /// The visibility buffer and its graph id (after a successful [`Self::prepare`]).
@@ -223,7 +292,10 @@ impl ComputeDraw {
                 group(big_layout, &[entry(0, uniforms), entry(1, v), entry(8, queue)]),
             ]
         });
-        encoder.clear_buffer(&visibility.buffer, 0, None);
+        let floor = self.frame.is_some_and(|u| u.floor != 0);
+        if !floor {
+            encoder.clear_buffer(&visibility.buffer, 0, None);
+        }
         encoder.clear_buffer(queue, 0, Some(8));
         encoder.clear_buffer(big_args, 0, Some(4));
         encoder.clear_buffer(big_args, 16, Some(4));
@@ -231,6 +303,11 @@ impl ComputeDraw {
             label: Some("space_colonization/raster"),
             timestamp_writes: None,
         });
+        if let (true, Some([floor_group, _])) = (floor, &self.extras_groups) {
+            // The floor writes every word: the clear's work, with the floor's hits.
+            let (width, height, _) = visibility.key();
+            self.floor_fill.dispatch(&mut pass, &[view, floor_group], [width, height, 1]);
+        }
         // Rows of at most 65,535 workgroups; the shader numbers threads across them.
         let slots = self.capacity.max(1);
         let row = 65535 * 256;
@@ -243,6 +320,24 @@ impl ComputeDraw {
         }
     }
 
+    /// Records the model's glow (`view` is group 0): its sums cleared, then a workgroup per
+    /// triangle and chunk; nothing where this frame draws no glow.
+    pub fn record_glow(&mut self, encoder: &mut wgpu::CommandEncoder, view: &wgpu::BindGroup) {
+        let (Some(u), Some((sums, _)), Some([_, group])) = (self.frame, &self.glow_sum, &self.extras_groups) else {
+            return;
+        };
+        if u.glow == 0 {
+            return;
+        }
+        encoder.clear_buffer(sums, 0, None);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("space_colonization/glow"),
+            timestamp_writes: None,
+        });
+        // At most 65,535 workgroups in x: the shader loops over the triangles past them.
+        self.glow.dispatch(&mut pass, &[view, group], [u.triangles.min(65535) * 256, GLOW_CHUNKS, 1]);
+    }
+
     /// Records the shading of every pixel into `image` (its view and graph id).
     pub fn record_resolve(
         &mut self,
@@ -250,7 +345,7 @@ impl ComputeDraw {
         view: &wgpu::BindGroup,
         image: (&wgpu::TextureView, u64),
     ) {
-        let Some(visibility) = &self.visibility else { return };
+        let (Some(visibility), Some((sums, _))) = (&self.visibility, &self.glow_sum) else { return };
         let (device, layout, uniforms) = (&self.device, &self.resolve_layout, &self.uniforms);
         let group = self.resolve_groups.get_or_create(image.1, || {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -260,6 +355,7 @@ impl ComputeDraw {
                     wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 3, resource: visibility.buffer.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(image.0) },
+                    entry(10, sums),
                 ],
             })
         });

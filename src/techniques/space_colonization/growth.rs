@@ -295,7 +295,8 @@ impl GrowthState {
         let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("sc_mesh_indices"),
             contents: bytemuck::cast_slice(if index_data.is_empty() { &[0u32; 3][..] } else { &index_data }),
-            usage: wgpu::BufferUsages::INDEX,
+            // Drawn by the pipeline as indices, read by the compute draw's glow.
+            usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::STORAGE,
         });
         let mesh = MeshBuffers { positions: mesh_positions, indices, index_count: index_data.len() as u32 };
         Self {

@@ -468,13 +468,14 @@ impl Technique for SpaceColonization {
         let b = linear_rgba(params.background);
         let clear = wgpu::Color { r: f64::from(b[0]), g: f64::from(b[1]), b: f64::from(b[2]), a: 1.0 };
         let style = if params.view == View::Lines { Style::Lines } else { Style::Tubes };
-        // Tubes alone go to the compute draw; lines, the floor and the model's glow blend or
-        // depth-test with the pipeline's own targets.
-        let in_compute =
-            style == Style::Tubes && !extras.floor && !extras.mesh && params.rasterizer == Rasterizer::Compute && {
-                let u = compute_draw::RasterUniforms::new(view_proj, eye, (w, h), samples, self.state.capacity, b);
-                self.renderer.prepare_compute(&self.queue, &u)
-            };
+        // Tubes go to the compute draw with the floor and the glow; lines (added up whatever
+        // their depth) stay with the pipeline.
+        let glow_triangles = if extras.mesh { self.state.mesh.index_count / 3 } else { 0 };
+        let in_compute = style == Style::Tubes && params.rasterizer == Rasterizer::Compute && {
+            let u = compute_draw::RasterUniforms::new(view_proj, eye, (w, h), samples, self.state.capacity, b)
+                .with_extras(extras.floor, glow_triangles);
+            self.renderer.prepare_compute(&self.queue, &u)
+        };
         self.drew_in_compute = in_compute;
 
         let this: &'r SpaceColonization = self;
@@ -511,6 +512,8 @@ impl Technique for SpaceColonization {
         if in_compute {
             let (buffer, id) = this.renderer.compute_visibility().expect("prepared");
             let visibility = graph.import_buffer("space_colonization/visibility", &buffer, id);
+            let (buffer, id) = this.renderer.compute_glow_sum().expect("prepared");
+            let glow = graph.import_buffer("space_colonization/glow_sum", &buffer, id);
             let image = graph.create_texture("space_colonization/image", TextureDesc::full(FORMAT));
             graph
                 .add_pass("space_colonization/raster")
@@ -519,11 +522,19 @@ impl Technique for SpaceColonization {
                 .read_buffer(args)
                 .write_buffer(visibility)
                 .record(move |ctx| this.renderer.record_compute_raster(ctx.encoder, state));
+            if glow_triangles > 0 {
+                graph
+                    .add_pass("space_colonization/glow")
+                    .read_buffer(visibility)
+                    .write_buffer(glow)
+                    .record(move |ctx| this.renderer.record_compute_glow(ctx.encoder, state));
+            }
             graph
                 .add_pass("space_colonization/resolve")
                 .read_buffer(posed)
                 .read_buffer(nodes)
                 .read_buffer(visibility)
+                .read_buffer(glow)
                 .write(image)
                 .record(move |ctx| {
                     // Views are shared handles: a clone frees the context for the encoder.

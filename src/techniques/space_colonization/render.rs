@@ -103,6 +103,8 @@ impl Renderer {
                 crate::gpu::storage_entry(3, readers, true),
                 crate::gpu::storage_entry(4, readers, true),
                 crate::gpu::storage_entry(5, readers, true),
+                // The model's triangles, for the compute draw's glow.
+                crate::gpu::storage_entry(6, wgpu::ShaderStages::COMPUTE, true),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -191,6 +193,7 @@ impl Renderer {
                     wgpu::BindGroupEntry { binding: 3, resource: state.mesh.positions.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 4, resource: state.skins.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 5, resource: state.joints.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 6, resource: state.mesh.indices.as_entire_binding() },
                 ],
             })
         });
@@ -214,6 +217,20 @@ impl Renderer {
             return;
         };
         compute.borrow_mut().record_raster(encoder, group, (&state.args.buffer, state.args.id));
+    }
+
+    /// The compute draw's glow sums and their graph id (after [`Self::prepare_compute`]).
+    pub fn compute_glow_sum(&self) -> Option<(wgpu::Buffer, u64)> {
+        let compute = self.compute.as_ref()?.borrow();
+        compute.glow_sum().map(|(buffer, id)| (buffer.clone(), id))
+    }
+
+    /// Records the compute draw's glow of the model's mesh over what the raster kept.
+    pub fn record_compute_glow(&self, encoder: &mut wgpu::CommandEncoder, state: &GrowthState) {
+        let (Some(compute), Some(group)) = (&self.compute, self.groups.get(&(state.posed.id, state.nodes.id))) else {
+            return;
+        };
+        compute.borrow_mut().record_glow(encoder, group);
     }
 
     /// Records the compute draw's shading into `image` (its view and graph id).

@@ -382,6 +382,87 @@ fn the_compute_tubes_match_the_pipeline_tubes() {
     }
 }
 
+/// The sum of an RGBA8 image's bytes per colour channel.
+fn channel_sums(image: &[u8]) -> [f64; 3] {
+    let mut sums = [0.0; 3];
+    for p in image.chunks(4) {
+        for (sum, v) in sums.iter_mut().zip(p) {
+            *sum += f64::from(*v);
+        }
+    }
+    sums
+}
+
+#[test]
+fn the_compute_floor_and_glow_match_the_pipeline() {
+    // The skinned scene draws its floor and the model's additive glow with the tubes. The floor
+    // covers most of the image, so a FLIP bound holds it; the glow is faint (a rim), so its own
+    // light — the image with the model's glow less the image without — is compared channel by
+    // channel between the two draws. Far ends: the camera inside the figure (triangles cross the
+    // near plane), low over the floor (the horizon inside pixels), one sample.
+    let cases: &[Comparison] = &[
+        ("space_colonization_skinned", (203, 117), 160, &["growth.voxels=48"], 0.02),
+        ("space_colonization_skinned", (160, 96), 160, &["growth.voxels=48", "growth.msaa=off"], 0.03),
+        (
+            "space_colonization_skinned",
+            (160, 96),
+            160,
+            &["growth.voxels=48", "growth.camera_position=[0.0, 1.2, -0.3]", "growth.fov=90.0"],
+            0.05,
+        ),
+        (
+            "space_colonization_skinned",
+            (160, 96),
+            160,
+            &["growth.voxels=48", "growth.camera_position=[0.0, 0.06, -9.0]", "growth.camera_pitch=-2.0"],
+            0.05,
+        ),
+    ];
+    for (scene, size, frame, sets, bound) in cases {
+        let without: Vec<&str> = sets.iter().copied().chain(["growth.show_model=false"]).collect();
+        let [compute, pipeline] = both_draws(scene, *size, *frame, sets);
+        let [compute_bare, pipeline_bare] = both_draws(scene, *size, *frame, &without);
+        let (score, _) = indra::offscreen::flip_score(&pipeline, &compute, *size, 0.99);
+        assert!(score.mean <= *bound, "{sets:?}: mean FLIP {} (bound {bound})", score.mean);
+        let glow = |with: &[u8], bare: &[u8]| {
+            let (a, b) = (channel_sums(with), channel_sums(bare));
+            [0, 1, 2].map(|c| a[c] - b[c])
+        };
+        let (by_compute, by_pipeline) = (glow(&compute, &compute_bare), glow(&pipeline, &pipeline_bare));
+        for c in 0..3 {
+            assert!(by_pipeline[c] > 200.0, "{sets:?}: the glow adds too little to test ({by_pipeline:?})");
+            let ratio = by_compute[c] / by_pipeline[c];
+            assert!((0.93..=1.07).contains(&ratio), "{sets:?}: glow {by_compute:?} against {by_pipeline:?}");
+        }
+    }
+}
+
+#[test]
+fn the_glow_box_drops_no_sample() {
+    // The glow walks the box of each triangle's part beyond the near plane: a conservative
+    // bound, so the image must be the same bytes as walking the whole image for every triangle —
+    // also with the camera inside the figure, where triangles cross the plane or lie behind it.
+    use indra::assets::{Asset, AssetKind};
+    let assets = common::assets();
+    let shader = assets.load(AssetKind::Shader, "space_colonization_raster.wgsl").unwrap();
+    let boxed = "        let box = triangle_box(a, b, c);";
+    assert!(shader.source.contains(boxed), "the glow's box moved");
+    let whole = shader.source.replace(boxed, "        let box = vec4<i32>(0, 0, i32(r.width) - 1, i32(r.height) - 1);");
+    let whole = assets.with_shader(Asset { source: whole, ..shader });
+    for sets in [&[][..], &["growth.camera_position=[0.0, 1.2, -0.3]", "growth.fov=90.0"][..]] {
+        let [boxed, whole] = [&assets, &whole].map(|assets| {
+            let mut s = load_scene(assets, "space_colonization_skinned").unwrap();
+            for set in sets.iter().chain(&["growth.voxels=48"]) {
+                s.set_from_str(set).unwrap();
+            }
+            let mut r = OffscreenRenderer::new(common::gpu(), assets, s, Some((171, 97)), None, None).unwrap();
+            r.seek(120).unwrap();
+            r.render_next().unwrap().rgba
+        });
+        assert!(boxed == whole, "{sets:?}: the glow's box changed the image");
+    }
+}
+
 #[test]
 fn culling_by_footprint_drops_no_sample() {
     // The raster kernels walk only the pixels inside each capsule's outline on screen and skip

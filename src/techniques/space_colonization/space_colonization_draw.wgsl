@@ -162,11 +162,16 @@ fn vs_floor(@builtin(vertex_index) v: u32) -> FloorOut {
 
 @fragment
 fn fs_floor(in: FloorOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(floor_colour(in.world), 1.0);
+}
+
+// The floor's colour at `world` (a point at y = 0; also the compute draw's).
+fn floor_colour(world: vec3<f32>) -> vec3<f32> {
     let l = normalize(view.light.xyz);
     let diffuse = max(l.y, 0.0);
     // Fades out towards the edge so the square does not end in a hard line.
-    let fade = 1.0 - smoothstep(0.6, 1.0, length(in.world.xz) / view.floor.w);
-    return vec4<f32>(view.floor.rgb * (0.25 + 0.75 * diffuse) * fade, 1.0);
+    let fade = 1.0 - smoothstep(0.6, 1.0, length(world.xz) / view.floor.w);
+    return view.floor.rgb * (0.25 + 0.75 * diffuse) * fade;
 }
 
 // ---- the model's skin, drawn as a faint additive glow ----
@@ -176,22 +181,33 @@ struct MeshOut {
     @location(0) world: vec3<f32>,
 }
 
-@vertex
-fn vs_mesh(@builtin(vertex_index) v: u32) -> MeshOut {
+// Mesh vertex v posed: its 4-weight skin, then the model's transform (world space).
+fn skinned_vertex(v: u32) -> vec3<f32> {
     let s = vertex_skins[v];
     let p = mesh_positions[v];
     let skinned = (joint_matrices[s.joints.x] * p) * s.weights.x + (joint_matrices[s.joints.y] * p) * s.weights.y
         + (joint_matrices[s.joints.z] * p) * s.weights.z + (joint_matrices[s.joints.w] * p) * s.weights.w;
+    return (view.model * skinned).xyz;
+}
+
+// The glow of a face of unit normal `n` seen along the unit direction `towards_camera`, before
+// the colour and strength: grazing faces glow most (a rim).
+fn glow_weight(n: vec3<f32>, towards_camera: vec3<f32>) -> f32 {
+    return 1.0 - abs(dot(n, towards_camera));
+}
+
+@vertex
+fn vs_mesh(@builtin(vertex_index) v: u32) -> MeshOut {
     var out: MeshOut;
-    out.world = (view.model * skinned).xyz;
+    out.world = skinned_vertex(v);
     out.clip = view.view_proj * vec4<f32>(out.world, 1.0);
     return out;
 }
 
 @fragment
 fn fs_mesh(in: MeshOut) -> @location(0) vec4<f32> {
-    // Flat normal from the screen derivatives; grazing faces glow most (a rim).
+    // Flat normal from the screen derivatives.
     let n = normalize(cross(dpdx(in.world), dpdy(in.world)));
-    let facing = abs(dot(n, normalize(view.camera.xyz - in.world)));
-    return vec4<f32>(view.color.rgb * view.ghost * (1.0 - facing), 1.0);
+    let weight = glow_weight(n, normalize(view.camera.xyz - in.world));
+    return vec4<f32>(view.color.rgb * view.ghost * weight, 1.0);
 }

@@ -15,9 +15,16 @@
 //   raster_medium  one thread per queued edge of up to 256 px (where edges are many enough to
 //                  fill the GPU one thread each): warps of like sizes.
 //   raster_big     one 8×8 workgroup per larger queued edge, walking its outline.
-//   resolve  one thread per pixel: each distinct edge among its samples is shaded once at the
-//            pixel centre (as multisampling shades once per pixel and primitive) and weighted by
-//            the samples it holds; empty samples are the background.
+//   floor_fill  (with the skinned scene's floor, in place of clearing the buffer) one thread per
+//               pixel: each sample's ray meets the floor square or not; the edges then win where
+//               nearer, as the pipeline draws the floor first and the tubes depth-tested over it.
+//   glow     (with the model's glow) a workgroup per mesh triangle and chunk: the posed triangle's
+//            box, a ray per sample; a sample nearer than the opaque hit in the buffer adds the
+//            face's rim weight to the pixel's 32-bit sum — integers, so the sum is the same in any
+//            order, as the pipeline's additive blend without depth writes is.
+//   resolve  one thread per pixel: each distinct edge (or the floor) among its samples is shaded
+//            once at the pixel centre (as multisampling shades once per pixel and primitive) and
+//            weighted by the samples it holds; empty samples are the background; the glow adds.
 // Hits nearer than the camera's near plane are dropped, as the pipeline clips them.
 
 struct Raster {
@@ -37,9 +44,12 @@ struct Raster {
     capacity: u32,
     // Boxes of more pixels go to the large edges' queue (one workgroup each).
     large_pixels: i32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // 1: the floor is drawn (floor_fill fills the buffer).
+    floor: u32,
+    // 1: the model's glow is drawn (glow_in holds its sums).
+    glow: u32,
+    // The mesh's triangles (the glow kernel's workgroups in x).
+    triangles: u32,
 }
 
 @group(1) @binding(0) var<uniform> r: Raster;
@@ -55,6 +65,13 @@ struct Raster {
 // enough workgroups for the counts (at most 65,535, which then loop), zeroed before each frame.
 @group(1) @binding(6) var<storage, read_write> big_args: array<atomic<u32>>;
 @group(1) @binding(8) var<storage, read> big_queue_in: array<u32>;
+// The glow's sum per pixel, GLOW_SCALE per unit of rim weight and sample.
+@group(1) @binding(9) var<storage, read_write> glow_sum: array<atomic<u32>>;
+@group(1) @binding(10) var<storage, read> glow_in: array<u32>;
+// The floor's fill writes every word (it is the frame's first writer).
+@group(1) @binding(11) var<storage, read_write> visibility_out: array<u64>;
+// The model's triangles (3 vertex indices each), for the glow.
+@group(0) @binding(6) var<storage, read> mesh_indices: array<u32>;
 
 // Must match `TUBE_ARGS` / 4 + 1 in growth.rs: the instance count of the indexed tube draw.
 const TUBE_INSTANCES: u32 = 8u;
@@ -66,6 +83,13 @@ const NEAR: f32 = 0.05;
 const INLINE_PIXELS: i32 = 16;
 // The queue's first edge word (words 0 and 1 count its medium and large edges).
 const QUEUE_START: u32 = 2u;
+// The floor's key (edges are 1 + their instance).
+const FLOOR_KEY: u32 = 0xFFFFFFFFu;
+// The glow's fixed point: 2^16 per unit of rim weight and sample (a pixel overflows past 2^16
+// samples of full weight: 16,384 layers of skin at 4 samples).
+const GLOW_SCALE: f32 = 65536.0;
+// Workgroups per glow triangle: a triangle that fills the image still spreads over the GPU.
+const GLOW_CHUNKS: u32 = 16u;
 
 // The unit ray from the camera through pixel position p (y down).
 fn pixel_ray(p: vec2<f32>) -> vec3<f32> {
@@ -211,8 +235,7 @@ fn cover_pixel(c: Cover, x: i32, y: i32) {
     }
     let base = (u32(y) * r.width + u32(x)) * r.samples;
     for (var k = 0u; k < r.samples; k++) {
-        let at = vec2<f32>(f32(x), f32(y)) + 0.5 + vec2<f32>(sample_offset(r.samples, k)) / 16.0;
-        let d = pixel_ray(at);
+        let d = pixel_ray(sample_at(vec2<u32>(u32(x), u32(y)), k));
         let t = visible_hit(d, capsule_span(o, d, c.e.from_pos, c.e.to_pos, view.thickness));
         let inverted = ~bitcast<u32>(t);
         if t > 0.0 {
@@ -269,6 +292,21 @@ fn cover_box(c: Cover, f: Footprint) -> vec4<i32> {
     return pixel_box(min(f.p0, f.p1) - f.radius - 0.5, max(f.p0, f.p1) + f.radius - 0.5);
 }
 
+// The part of `band` (an interval of x) where slope·x + offset lies within `limit`. (Called once
+// per limit rather than looping over an array of them: a dynamically indexed array lives in
+// local memory.)
+fn band_within(band: vec2<f32>, slope: f32, offset: f32, limit: vec2<f32>) -> vec2<f32> {
+    if abs(slope) > 1e-9 {
+        let a = (limit.x - offset) / slope;
+        let b = (limit.y - offset) / slope;
+        return vec2<f32>(max(band.x, min(a, b)), min(band.y, max(a, b)));
+    }
+    if offset < limit.x || offset > limit.y {
+        return vec2<f32>(1e30, -1e30);
+    }
+    return band;
+}
+
 // The pixels of row y whose centres lie in the footprint, as [first, last] within the box.
 fn footprint_row(f: Footprint, box: vec4<i32>, y: i32) -> vec2<i32> {
     if f.whole {
@@ -295,19 +333,8 @@ fn footprint_row(f: Footprint, box: vec4<i32>, y: i32) -> vec2<i32> {
         let u = axis / length;
         let n = vec2<f32>(-u.y, u.x);
         var band = vec2<f32>(-1e30, 1e30);
-        let limits = array<vec2<f32>, 2>(vec2<f32>(-f.radius, f.radius), vec2<f32>(0.0, length));
-        let slopes = vec2<f32>(n.x, u.x);
-        let offsets = vec2<f32>(n.y, u.y) * (cy - f.p0.y) - slopes * f.p0.x;
-        for (var i = 0u; i < 2u; i++) {
-            let limit = limits[i];
-            if abs(slopes[i]) > 1e-9 {
-                let a = (limit.x - offsets[i]) / slopes[i];
-                let b = (limit.y - offsets[i]) / slopes[i];
-                band = vec2<f32>(max(band.x, min(a, b)), min(band.y, max(a, b)));
-            } else if offsets[i] < limit.x || offsets[i] > limit.y {
-                band = vec2<f32>(1e30, -1e30);
-            }
-        }
+        band = band_within(band, n.x, n.y * (cy - f.p0.y) - n.x * f.p0.x, vec2<f32>(-f.radius, f.radius));
+        band = band_within(band, u.x, u.y * (cy - f.p0.y) - u.x * f.p0.x, vec2<f32>(0.0, length));
         if band.x <= band.y {
             lo = min(lo, band.x);
             hi = max(hi, band.y);
@@ -402,9 +429,136 @@ fn shade_edge(instance: u32, p: vec2<f32>) -> vec3<f32> {
     return tube_colour(n, centre + n * view.thickness, e.t);
 }
 
-// The edge key (1 + instance, 0: none) of sample word i.
+// The edge key (1 + instance, 0: none, FLOOR_KEY: the floor) of sample word i.
 fn key_at(i: u32) -> u32 {
     return u32(visibility_in[i] & 0xFFFFFFFFlu);
+}
+
+// The distance along the unit ray of sample word i's hit (infinite where it holds none).
+fn depth_at(i: u32) -> f32 {
+    let word = visibility_in[i];
+    return select(bitcast<f32>(~u32(word >> 32u)), 1e38, word == 0lu);
+}
+
+// Sample k of pixel (x, y): its position in pixel coordinates.
+fn sample_at(pixel: vec2<u32>, k: u32) -> vec2<f32> {
+    return vec2<f32>(pixel) + 0.5 + vec2<f32>(sample_offset(r.samples, k)) / 16.0;
+}
+
+// Where the unit ray d from the camera meets the floor square (y = 0, half size view.floor.w)
+// beyond the near plane; -1 where it does not.
+fn floor_hit(d: vec3<f32>) -> f32 {
+    let o = view.camera.xyz;
+    let t = -o.y / d.y;
+    let p = o + d * t;
+    let inside = abs(p.x) <= view.floor.w && abs(p.z) <= view.floor.w;
+    return select(-1.0, t, t > 0.0 && t < 1e30 && inside && beyond_near(d, t));
+}
+
+@compute @workgroup_size(8, 8)
+fn floor_fill(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= r.width || id.y >= r.height {
+        return;
+    }
+    let base = (id.y * r.width + id.x) * r.samples;
+    for (var k = 0u; k < r.samples; k++) {
+        let t = floor_hit(pixel_ray(sample_at(id.xy, k)));
+        visibility_out[base + k] = select(0lu, (u64(~bitcast<u32>(t)) << 32u) | u64(FLOOR_KEY), t > 0.0);
+    }
+}
+
+// The floor's colour at pixel centre `p` (where the pipeline interpolates it) — or, where the
+// centre ray passes above the horizon, at the hit of the sample whose word is i.
+fn shade_floor(p: vec2<f32>, i: u32, sample: vec2<f32>) -> vec3<f32> {
+    let o = view.camera.xyz;
+    let d = pixel_ray(p);
+    let t = -o.y / d.y;
+    if t > 0.0 && t < 1e30 {
+        return floor_colour(o + d * t);
+    }
+    return floor_colour(o + pixel_ray(sample) * depth_at(i));
+}
+
+// Where the unit ray (o, d) meets triangle a b c (either side), -1 where it misses.
+fn triangle_hit(o: vec3<f32>, d: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> f32 {
+    let e1 = b - a;
+    let e2 = c - a;
+    let p = cross(d, e2);
+    let det = dot(e1, p);
+    if det == 0.0 {
+        return -1.0;
+    }
+    let s = o - a;
+    let u = dot(s, p) / det;
+    let q = cross(s, e1);
+    let v = dot(d, q) / det;
+    let t = dot(e2, q) / det;
+    return select(-1.0, t, u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0);
+}
+
+// The box in pixels (x0, y0, x1, y1) of the part of triangle a b c beyond the near plane,
+// clipped to the image (empty, x0 > x1, where none is): the projections of its corners in front
+// of the plane and of the points where its sides cross it.
+fn triangle_box(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec4<i32> {
+    let pa = view.view_proj * vec4<f32>(a, 1.0);
+    let pb = view.view_proj * vec4<f32>(b, 1.0);
+    let pc = view.view_proj * vec4<f32>(c, 1.0);
+    var lo_hi = vec4<f32>(vec2<f32>(1e30), vec2<f32>(-1e30));
+    lo_hi = side_box(lo_hi, pa, pb);
+    lo_hi = side_box(lo_hi, pb, pc);
+    lo_hi = side_box(lo_hi, pc, pa);
+    return pixel_box(lo_hi.xy - 0.5, lo_hi.zw + 0.5);
+}
+
+// Box `lo_hi` (lo.xy, hi.xy in pixels) grown by clip position p where it lies beyond the near
+// plane and by the point where the side p–q crosses it.
+fn side_box(lo_hi: vec4<f32>, p: vec4<f32>, q: vec4<f32>) -> vec4<f32> {
+    var grown = lo_hi;
+    if p.w >= NEAR {
+        let at = to_pixels(p);
+        grown = vec4<f32>(min(grown.xy, at), max(grown.zw, at));
+    }
+    if (p.w >= NEAR) != (q.w >= NEAR) {
+        let at = to_pixels(mix(p, q, (NEAR - p.w) / (q.w - p.w)));
+        grown = vec4<f32>(min(grown.xy, at), max(grown.zw, at));
+    }
+    return grown;
+}
+
+@compute @workgroup_size(256)
+fn glow(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    let o = view.camera.xyz;
+    for (var triangle = group.x; triangle < r.triangles; triangle += groups.x) {
+        let a = skinned_vertex(mesh_indices[3u * triangle]);
+        let b = skinned_vertex(mesh_indices[3u * triangle + 1u]);
+        let c = skinned_vertex(mesh_indices[3u * triangle + 2u]);
+        let n = normalize(cross(b - a, c - a));
+        let box = triangle_box(a, b, c);
+        if box.x > box.z || box.y > box.w {
+            continue;
+        }
+        let width = box.z - box.x + 1;
+        let pixels = width * (box.w - box.y + 1);
+        for (var i = i32(group.y * 256u + lane); i < pixels; i += i32(256u * GLOW_CHUNKS)) {
+            let pixel = vec2<u32>(vec2<i32>(box.x + i % width, box.y + i / width));
+            let base = (pixel.y * r.width + pixel.x) * r.samples;
+            var count = 0u;
+            for (var k = 0u; k < r.samples; k++) {
+                let d = pixel_ray(sample_at(pixel, k));
+                let t = triangle_hit(o, d, a, b, c);
+                count += u32(t > 0.0 && beyond_near(d, t) && t < depth_at(base + k));
+            }
+            if count > 0u {
+                // Shaded once per pixel at its centre, as the pipeline's fragment is.
+                let weight = glow_weight(n, -pixel_ray(vec2<f32>(pixel) + 0.5));
+                atomicAdd(&glow_sum[pixel.y * r.width + pixel.x], u32(round(weight * f32(count) * GLOW_SCALE)));
+            }
+        }
+    }
 }
 
 @compute @workgroup_size(8, 8)
@@ -431,10 +585,16 @@ fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
             count += u32(key_at(base + j) == key);
         }
         var colour = r.background.rgb;
-        if key != 0u {
+        if key == FLOOR_KEY {
+            colour = shade_floor(centre, base + k, sample_at(id.xy, k));
+        } else if key != 0u {
             colour = shade_edge(key - 1u, centre);
         }
         sum += colour * f32(count);
+    }
+    if r.glow != 0u {
+        let glow = f32(glow_in[id.y * r.width + id.x]) / GLOW_SCALE;
+        sum += view.color.rgb * view.ghost * glow;
     }
     textureStore(image, id.xy, vec4<f32>(sum / f32(r.samples), 1.0));
 }
