@@ -113,11 +113,21 @@ fn capsule_span(o: vec3<f32>, d: vec3<f32>, a: vec3<f32>, b: vec3<f32>, radius: 
     let qc = baba * dot(oa, oa) - baoa * baoa - radius * radius * baba;
     let h = qb * qb - qa * qc;
     var span = vec2<f32>(1e30, -1e30);
-    if qa > 0.0 && h >= 0.0 {
+    if qa > 0.0 {
+        // The capsule lies inside the infinite cylinder round its axis: a ray that misses the
+        // cylinder misses it (most rays tested do).
+        if h < 0.0 {
+            return vec2<f32>(-1.0);
+        }
         // The side: kept where the hit lies between the end caps.
         let ts = (vec2<f32>(-qb) + vec2<f32>(-1.0, 1.0) * sqrt(h)) / qa;
         let along = vec2<f32>(baoa) + ts * bard;
         let inside = (along > vec2<f32>(0.0)) & (along < vec2<f32>(baba));
+        // Where the cylinder's entry and exit both lie between the caps they are the capsule's:
+        // it is convex and inside the cylinder.
+        if all(inside) {
+            return ts + start;
+        }
         span = select(span, ts, inside);
     }
     // The round ends (the whole capsule when the edge has no length yet).
