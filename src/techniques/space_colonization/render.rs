@@ -211,12 +211,17 @@ impl Renderer {
         compute.visibility().map(|(buffer, id)| (buffer.clone(), id))
     }
 
+    /// The compute draw and the view group of `state`'s buffers, where both exist.
+    fn compute_and_group(&self, state: &GrowthState) -> Option<(std::cell::RefMut<'_, ComputeDraw>, &wgpu::BindGroup)> {
+        let compute = self.compute.as_ref()?;
+        let group = self.groups.get(&(state.posed.id, state.nodes.id))?;
+        Some((compute.borrow_mut(), group))
+    }
+
     /// Records the compute draw's coverage of every grown edge.
     pub fn record_compute_raster(&self, encoder: &mut wgpu::CommandEncoder, state: &GrowthState) {
-        let (Some(compute), Some(group)) = (&self.compute, self.groups.get(&(state.posed.id, state.nodes.id))) else {
-            return;
-        };
-        compute.borrow_mut().record_raster(encoder, group, (&state.args.buffer, state.args.id));
+        let Some((mut compute, group)) = self.compute_and_group(state) else { return };
+        compute.record_raster(encoder, group, (&state.args.buffer, state.args.id));
     }
 
     /// The compute draw's glow sums and their graph id (after [`Self::prepare_compute`]).
@@ -227,10 +232,8 @@ impl Renderer {
 
     /// Records the compute draw's glow of the model's mesh over what the raster kept.
     pub fn record_compute_glow(&self, encoder: &mut wgpu::CommandEncoder, state: &GrowthState) {
-        let (Some(compute), Some(group)) = (&self.compute, self.groups.get(&(state.posed.id, state.nodes.id))) else {
-            return;
-        };
-        compute.borrow_mut().record_glow(encoder, group);
+        let Some((mut compute, group)) = self.compute_and_group(state) else { return };
+        compute.record_glow(encoder, group);
     }
 
     /// Records the compute draw's shading into `image` (its view and graph id).
@@ -240,10 +243,8 @@ impl Renderer {
         state: &GrowthState,
         image: (&wgpu::TextureView, u64),
     ) {
-        let (Some(compute), Some(group)) = (&self.compute, self.groups.get(&(state.posed.id, state.nodes.id))) else {
-            return;
-        };
-        compute.borrow_mut().record_resolve(encoder, group, image);
+        let Some((mut compute, group)) = self.compute_and_group(state) else { return };
+        compute.record_resolve(encoder, group, image);
     }
 
     /// Records the draw of every grown edge into `targets` (resolved if multisampled).
