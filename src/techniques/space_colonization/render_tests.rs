@@ -401,19 +401,19 @@ fn the_compute_floor_and_glow_match_the_pipeline() {
     // channel between the two draws. Far ends: the camera inside the figure (triangles cross the
     // near plane), low over the floor (the horizon inside pixels), one sample.
     let cases: &[Comparison] = &[
-        ("space_colonization_skinned", (203, 117), 160, &["growth.voxels=48"], 0.02),
-        ("space_colonization_skinned", (160, 96), 160, &["growth.voxels=48", "growth.msaa=off"], 0.03),
+        ("space_colonization_skinned", (203, 117), 40, &["growth.voxels=48"], 0.02),
+        ("space_colonization_skinned", (160, 96), 40, &["growth.voxels=48", "growth.msaa=off"], 0.03),
         (
             "space_colonization_skinned",
             (160, 96),
-            160,
+            40,
             &["growth.voxels=48", "growth.camera_position=[0.0, 1.2, -0.3]", "growth.fov=90.0"],
             0.05,
         ),
         (
             "space_colonization_skinned",
             (160, 96),
-            160,
+            40,
             &["growth.voxels=48", "growth.camera_position=[0.0, 0.06, -9.0]", "growth.camera_pitch=-2.0"],
             0.05,
         ),
@@ -456,7 +456,7 @@ fn the_glow_box_drops_no_sample() {
                 s.set_from_str(set).unwrap();
             }
             let mut r = OffscreenRenderer::new(common::gpu(), assets, s, Some((171, 97)), None, None).unwrap();
-            r.seek(120).unwrap();
+            r.seek(30).unwrap();
             r.render_next().unwrap().rgba
         });
         assert!(boxed == whole, "{sets:?}: the glow's box changed the image");
