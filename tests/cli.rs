@@ -153,6 +153,11 @@ fn bench_prints_pass_medians_and_frame_time() {
     assert!(t.contains("kleinian/limit_set") || t.contains("wall-clock only"), "{t}");
     assert!(t.contains("step + record (CPU median)"), "{t}");
     assert!(t.contains("first pass to last (GPU)") || t.contains("wall-clock only"), "{t}");
+    // One frame in flight: the same passes, timed as the interval between frames.
+    let o = indra(&["bench", "kleinian", "--size", "64x64", "--frames", "6", "--warmup", "2", "--pipelined"]);
+    let t = text(&o);
+    assert!(o.status.success() && t.contains("frame interval (median)") && !t.contains("frame wall time"), "{t}");
+    assert!(t.contains("kleinian/limit_set") || t.contains("wall-clock only"), "{t}");
 }
 
 #[test]

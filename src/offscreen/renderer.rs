@@ -33,6 +33,8 @@ pub struct OffscreenRenderer {
     size: (u32, u32),
     target: PersistentTexture,
     guard: GpuGuard,
+    /// The newest frame's submission, for callers that keep frames in flight (`bench`).
+    submitted: Option<wgpu::SubmissionIndex>,
     /// Which output is read back: 0 the scene's output, n its n-th extra output.
     shown: usize,
 }
@@ -61,7 +63,17 @@ impl OffscreenRenderer {
         let blit = Blit::new(&gpu.device);
         let target = display_target(&gpu, size);
         let guard = GpuGuard::new(DEFAULT_STALL_TIMEOUT);
-        Ok(Self { gpu, player: Player::new(instance, clock), runtime, blit, size, target, guard, shown: 0 })
+        Ok(Self {
+            gpu,
+            player: Player::new(instance, clock),
+            runtime,
+            blit,
+            size,
+            target,
+            guard,
+            submitted: None,
+            shown: 0,
+        })
     }
 
     /// Waits (within the watchdog's limit) for the last frame; reports a lost or stuck device,
@@ -168,9 +180,15 @@ impl OffscreenRenderer {
             return Err(crate::graph::GraphError::ReadOfUnwritten { pass: "<output>".into(), resource });
         }
         let index = self.gpu.queue.submit([encoder.finish()]);
+        self.submitted = Some(index.clone());
         self.guard.submitted(index);
         self.runtime.after_submit();
         Ok((time, output.stats))
+    }
+
+    /// The submission of the newest frame `render_only` recorded.
+    pub fn last_submission(&self) -> Option<wgpu::SubmissionIndex> {
+        self.submitted.clone()
     }
 
     /// Renders the next frame and reads it back.
