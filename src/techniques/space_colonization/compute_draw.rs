@@ -38,7 +38,7 @@ pub struct RasterUniforms {
     pub samples: u32,
     /// Edge slots (threads dispatched).
     pub capacity: u32,
-    /// Boxes of more pixels go to the large edges' queue (a workgroup each), fewer to the medium
+    /// Boxes of more pixels go to the large edges' queue (32 lanes each), fewer to the medium
     /// edges' (a thread each).
     pub large_pixels: i32,
     /// 1: the floor is drawn.
@@ -47,12 +47,24 @@ pub struct RasterUniforms {
     pub glow: u32,
     /// The model's triangles (the glow's).
     pub triangles: u32,
+    /// Boxes of more pixels go to the huge edges' queue (a workgroup each).
+    pub huge_pixels: i32,
+    /// Padding to the WGSL struct's 16-byte alignment.
+    pub _pad: [u32; 3],
 }
 
 /// Edge slots that fill an H200 one thread each (132 SMs × 2,048 threads, rounded up): with fewer
 /// edges, one thread per medium edge leaves the GPU idle and a workgroup per edge wins (measured:
 /// `space_colonization_tubes`, 10⁴ edges at 1080p, 0.30 against 0.59 ms).
 const EDGES_FOR_THREADS: u32 = 1 << 18;
+
+/// With that many edges, boxes of 16–128 px go to a thread each, 128–1,024 px to 32 lanes each
+/// and larger ones to a workgroup (64 lanes). Measured on the grown million, H200 (see
+/// `raster_large` in the shader): small edges want a thread, large ones lanes, and the huge
+/// edges of a camera inside the forest a whole workgroup.
+const MANY_EDGES_LARGE_PIXELS: i32 = 128;
+/// See [`MANY_EDGES_LARGE_PIXELS`].
+const MANY_EDGES_HUGE_PIXELS: i32 = 1024;
 
 impl RasterUniforms {
     /// The uniforms for a `size` image seen by `view_proj` from `eye` (a perspective camera),
@@ -80,10 +92,13 @@ impl RasterUniforms {
             height: size.1,
             samples,
             capacity,
-            large_pixels: if capacity >= EDGES_FOR_THREADS { 256 } else { 0 },
+            // With few edges every queued edge is huge (a workgroup each).
+            large_pixels: if capacity >= EDGES_FOR_THREADS { MANY_EDGES_LARGE_PIXELS } else { 0 },
+            huge_pixels: if capacity >= EDGES_FOR_THREADS { MANY_EDGES_HUGE_PIXELS } else { 0 },
             floor: 0,
             glow: 0,
             triangles: 0,
+            _pad: [0; 3],
         }
     }
 
@@ -101,7 +116,8 @@ pub struct ComputeDraw {
     device: wgpu::Device,
     raster: ComputeKernel,
     raster_medium: ComputeKernel,
-    raster_big: ComputeKernel,
+    raster_large: ComputeKernel,
+    raster_huge: ComputeKernel,
     floor_fill: ComputeKernel,
     glow: ComputeKernel,
     resolve: ComputeKernel,
@@ -173,7 +189,8 @@ impl ComputeDraw {
             device: device.clone(),
             raster: kernel("raster", &raster_layout)?,
             raster_medium: kernel("raster_medium", &big_layout)?,
-            raster_big: kernel("raster_big", &big_layout)?,
+            raster_large: kernel("raster_large", &big_layout)?,
+            raster_huge: kernel("raster_huge", &big_layout)?,
             floor_fill: kernel("floor_fill", &floor_layout)?,
             glow: kernel("glow", &glow_layout)?,
             resolve: kernel("resolve", &resolve_layout)?,
@@ -193,7 +210,7 @@ impl ComputeDraw {
                 device,
                 &wgpu::util::BufferInitDescriptor {
                     label: Some("sc_big_args"),
-                    contents: bytemuck::cast_slice(&[0u32, 1, 1, 0, 0, 1, 1, 0]),
+                    contents: bytemuck::cast_slice(&[0u32, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0]),
                     usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
                 },
             ),
@@ -216,7 +233,8 @@ impl ComputeDraw {
         if self.big_queue.as_ref().is_none_or(|(capacity, _)| *capacity < u.capacity) {
             let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("sc_big_queue"),
-                size: (u64::from(u.capacity) + 2) * 4,
+                // The counts, then the medium and large edges' region and the huge edges'.
+                size: (2 * u64::from(u.capacity) + 4) * 4,
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
@@ -296,9 +314,10 @@ impl ComputeDraw {
         if !floor {
             encoder.clear_buffer(&visibility.buffer, 0, None);
         }
-        encoder.clear_buffer(queue, 0, Some(8));
-        encoder.clear_buffer(big_args, 0, Some(4));
-        encoder.clear_buffer(big_args, 16, Some(4));
+        encoder.clear_buffer(queue, 0, Some(16));
+        for offset in [0, 16, 32] {
+            encoder.clear_buffer(big_args, offset, Some(4));
+        }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("space_colonization/raster"),
             timestamp_writes: None,
@@ -314,7 +333,7 @@ impl ComputeDraw {
         self.raster.dispatch(&mut pass, &[view, &groups[0]], [slots.min(row), slots.div_ceil(row), 1]);
         pass.set_bind_group(0, view, &[]);
         pass.set_bind_group(1, &groups[1], &[]);
-        for (kernel, offset) in [(&self.raster_medium, 0), (&self.raster_big, 16)] {
+        for (kernel, offset) in [(&self.raster_medium, 0), (&self.raster_large, 16), (&self.raster_huge, 32)] {
             pass.set_pipeline(&kernel.pipeline);
             pass.dispatch_workgroups_indirect(big_args, offset);
         }

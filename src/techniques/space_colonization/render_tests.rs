@@ -480,12 +480,16 @@ fn culling_by_footprint_drops_no_sample() {
         .source
         .replace(outline, "    if true || f.whole {\n        return box.xz;")
         .replace(near_miss, "    if false && dot(to_axis, to_axis) - along * along > reach * reach {");
-    // The medium edges' kernel runs only for a forest of 2^18 slots and more (too slow to grow
-    // here): a third copy sends every edge over 4×4 px to it.
-    let classify = "    if pixels > max(r.large_pixels, INLINE_PIXELS) {";
-    assert!(shader.source.contains(classify), "the classification moved");
-    let medium = shader.source.replace(classify, "    if pixels > 1000000 {");
+    // The medium and large edges' kernels run only for a forest of 2^18 slots and more (too slow
+    // to grow here): a third copy sends every edge over 4×4 px to the medium one, a fourth to
+    // the large one (32 lanes each).
+    let huge_line = "    if pixels > max(r.huge_pixels, INLINE_PIXELS) {";
+    let large_line = "    if pixels > max(r.large_pixels, INLINE_PIXELS) {";
+    assert!(shader.source.contains(huge_line) && shader.source.contains(large_line), "the classification moved");
+    let never = "    if pixels > 1000000 {";
+    let medium = shader.source.replace(huge_line, never).replace(large_line, never);
     let medium = assets.with_shader(Asset { source: medium, ..shader.clone() });
+    let large = assets.with_shader(Asset { source: shader.source.replace(huge_line, never), ..shader.clone() });
     let every_sample = assets.with_shader(Asset { source: exhaustive, ..shader });
     let cases: &[(&str, u64, &[&str])] = &[
         ("space_colonization_tubes", 90, &[]),
@@ -496,7 +500,7 @@ fn culling_by_footprint_drops_no_sample() {
     ];
     let size = (171, 97);
     for (scene, frame, sets) in cases {
-        let [culled, by_medium, exhaustive] = [&assets, &medium, &every_sample].map(|assets| {
+        let [culled, by_medium, by_large, exhaustive] = [&assets, &medium, &large, &every_sample].map(|assets| {
             let mut s = load_scene(assets, scene).unwrap();
             for set in *sets {
                 s.set_from_str(set).unwrap();
@@ -507,5 +511,6 @@ fn culling_by_footprint_drops_no_sample() {
         });
         assert!(culled == exhaustive, "{scene} {sets:?}: culling changed the image");
         assert!(by_medium == exhaustive, "{scene} {sets:?}: the medium edges' kernel changed the image");
+        assert!(by_large == exhaustive, "{scene} {sets:?}: the large edges' kernel changed the image");
     }
 }
