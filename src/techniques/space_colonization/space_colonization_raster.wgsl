@@ -181,15 +181,12 @@ fn pixel_box(lo: vec2<f32>, hi: vec2<f32>) -> vec4<i32> {
 fn capsule_box(a: vec3<f32>, b: vec3<f32>, radius: f32) -> vec4<i32> {
     let lo = min(a, b) - vec3<f32>(radius);
     let hi = max(a, b) + vec3<f32>(radius);
-    var box_lo = vec2<f32>(1e30);
-    var box_hi = vec2<f32>(-1e30);
+    var lo_hi = vec4<f32>(vec2<f32>(1e30), vec2<f32>(-1e30));
     for (var c = 0u; c < 8u; c++) {
         let corner = select(lo, hi, vec3<bool>((c & 1u) != 0u, (c & 2u) != 0u, (c & 4u) != 0u));
         let clip = view.view_proj * vec4<f32>(corner, 1.0);
         if clip.w >= NEAR {
-            let px = to_pixels(clip);
-            box_lo = min(box_lo, px);
-            box_hi = max(box_hi, px);
+            lo_hi = grow_by_point(lo_hi, clip);
             continue;
         }
         // Behind the plane: where each box edge from this corner to one in front crosses it.
@@ -199,15 +196,30 @@ fn capsule_box(a: vec3<f32>, b: vec3<f32>, radius: f32) -> vec4<i32> {
                 ((c ^ (1u << axis)) & 2u) != 0u,
                 ((c ^ (1u << axis)) & 4u) != 0u,
             ));
-            let other = view.view_proj * vec4<f32>(other_corner, 1.0);
-            if other.w > NEAR {
-                let px = to_pixels(mix(clip, other, (NEAR - clip.w) / (other.w - clip.w)));
-                box_lo = min(box_lo, px);
-                box_hi = max(box_hi, px);
-            }
+            lo_hi = grow_by_crossing(lo_hi, clip, view.view_proj * vec4<f32>(other_corner, 1.0));
         }
     }
-    return pixel_box(box_lo - 0.5, box_hi + 0.5);
+    return pixel_box(lo_hi.xy - 0.5, lo_hi.zw + 0.5);
+}
+
+// Box `lo_hi` (lo.xy, hi.xy in pixels) grown by clip position p where it lies beyond the near
+// plane.
+fn grow_by_point(lo_hi: vec4<f32>, p: vec4<f32>) -> vec4<f32> {
+    if p.w < NEAR {
+        return lo_hi;
+    }
+    let at = to_pixels(p);
+    return vec4<f32>(min(lo_hi.xy, at), max(lo_hi.zw, at));
+}
+
+// Box `lo_hi` grown by the point where the segment between clip positions p and q crosses the
+// near plane, where it does.
+fn grow_by_crossing(lo_hi: vec4<f32>, p: vec4<f32>, q: vec4<f32>) -> vec4<f32> {
+    if (p.w >= NEAR) == (q.w >= NEAR) {
+        return lo_hi;
+    }
+    let at = to_pixels(mix(p, q, (NEAR - p.w) / (q.w - p.w)));
+    return vec4<f32>(min(lo_hi.xy, at), max(lo_hi.zw, at));
 }
 
 // Whether a hit at distance t along unit ray d from the camera lies beyond the near plane (the
@@ -548,25 +560,10 @@ fn triangle_box(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec4<i32> {
     let pb = view.view_proj * vec4<f32>(b, 1.0);
     let pc = view.view_proj * vec4<f32>(c, 1.0);
     var lo_hi = vec4<f32>(vec2<f32>(1e30), vec2<f32>(-1e30));
-    lo_hi = side_box(lo_hi, pa, pb);
-    lo_hi = side_box(lo_hi, pb, pc);
-    lo_hi = side_box(lo_hi, pc, pa);
+    lo_hi = grow_by_crossing(grow_by_point(lo_hi, pa), pa, pb);
+    lo_hi = grow_by_crossing(grow_by_point(lo_hi, pb), pb, pc);
+    lo_hi = grow_by_crossing(grow_by_point(lo_hi, pc), pc, pa);
     return pixel_box(lo_hi.xy - 0.5, lo_hi.zw + 0.5);
-}
-
-// Box `lo_hi` (lo.xy, hi.xy in pixels) grown by clip position p where it lies beyond the near
-// plane and by the point where the side p–q crosses it.
-fn side_box(lo_hi: vec4<f32>, p: vec4<f32>, q: vec4<f32>) -> vec4<f32> {
-    var grown = lo_hi;
-    if p.w >= NEAR {
-        let at = to_pixels(p);
-        grown = vec4<f32>(min(grown.xy, at), max(grown.zw, at));
-    }
-    if (p.w >= NEAR) != (q.w >= NEAR) {
-        let at = to_pixels(mix(p, q, (NEAR - p.w) / (q.w - p.w)));
-        grown = vec4<f32>(min(grown.xy, at), max(grown.zw, at));
-    }
-    return grown;
 }
 
 @compute @workgroup_size(256)
