@@ -95,7 +95,7 @@ fn a_shader_edit_that_moves_a_binding_is_a_located_error_and_the_show_goes_on() 
     let (mut r, mut live) = renderer(&root);
     let before = shown(&mut r);
     let shader = root.join("shaders/kleinian.wgsl");
-    edit(&shader, "@group(0) @binding(1) var output", "@group(0) @binding(2) var output");
+    edit(&shader, "@group(0) @binding(1) var output", "@group(0) @binding(3) var output");
     let line = std::fs::read_to_string(&shader).unwrap().lines().position(|l| l.contains("var output")).unwrap() + 1;
     let report = wait_for_reload(&mut r, &mut live);
     assert_eq!(report.errors.len(), 1, "{report:?}");

@@ -307,10 +307,10 @@ fn feedback_sends_changed_values_to_the_controller() {
     listener.set_read_timeout(Some(Duration::from_secs(2))).unwrap();
     let feedback = OscFeedback::connect(&listener.local_addr().unwrap().to_string()).unwrap();
     let mut changes = ParamChanges::default();
-    assert_eq!(feedback.send(&changes.collect(instance.view())), 10, "everything once at first");
+    assert_eq!(feedback.send(&changes.collect(instance.view())), 11, "everything once at first");
     assert_eq!(feedback.send(&changes.collect(instance.view())), 0, "nothing changed");
     let mut buf = [0u8; 1024];
-    for _ in 0..10 {
+    for _ in 0..11 {
         listener.recv(&mut buf).unwrap();
     }
     let scale = instance.params(0).index("scale").unwrap();

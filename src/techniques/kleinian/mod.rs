@@ -49,6 +49,8 @@ crate::technique_params! {
         back_color: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([0.5, 0.5, 0.5, 1.0]), None, doc),
         /// jittered samples per pixel (anti-aliasing)
         samples: i32 = |n, doc| ParamDecl::new(n, ParamValue::Int(1), Some((1.0, 64.0)), doc),
+        /// from 4 samples up, take them all only near an edge of the set (the pixel's 4 × 4 neighbouring corners not all one class, or its first sample disagreeing); elsewhere one
+        adaptive: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(true), None, doc),
         /// invert the plane in a circle before the test
         circle_inversion: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(false), None, doc),
         /// inversion circle centre
@@ -118,42 +120,70 @@ impl KleinianUniforms {
     }
 }
 
+/// Fewest samples per pixel that adaptive sampling serves: it costs about two samples a pixel
+/// (the corners, the first sample) before the edges' own.
+pub const ADAPTIVE_MIN_SAMPLES: i32 = 4;
+
+/// Whether a frame samples adaptively.
+fn samples_adaptively(p: &ParamSet) -> bool {
+    let s = Settings::read(p);
+    s.adaptive && s.samples >= ADAPTIVE_MIN_SAMPLES
+}
+
+/// Bytes of the corner classes of a `size` image: (width + 3) × (height + 3) bits (the pixel
+/// corners and a margin of one), each row padded to whole 32-bit words
+/// (`kleinian.wgsl::corner_words`).
+pub fn corner_bits_bytes(size: (u32, u32)) -> u64 {
+    u64::from((size.0 + 34) / 32) * u64::from(size.1 + 3) * 4
+}
+
 /// A Kleinian limit-set node.
 pub struct Kleinian {
-    kernel: ComputeKernel,
+    /// Every sample of every pixel.
+    render: ComputeKernel,
+    /// Adaptive sampling: the corner classes, then samples where they differ.
+    corners: ComputeKernel,
+    render_edges: ComputeKernel,
+    /// (params, output), and the same with the corner classes.
     layout: wgpu::BindGroupLayout,
+    adaptive_layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
-    /// Bind groups by output texture id: steady-state frames create none.
-    bind_groups: BindGroupCache<u64>,
+    /// Bind groups by output texture id and, adaptive, corner buffer id: steady frames create none.
+    bind_groups: BindGroupCache<(u64, Option<u64>)>,
 }
 
 /// Bindings of `kleinian.wgsl` (checked against the WGSL by name at creation).
 const PARAMS_BINDING: u32 = 0;
 const OUTPUT_BINDING: u32 = 1;
+const CORNERS_BINDING: u32 = 2;
 
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let device = &setup.gpu.device;
+    let params_entry = crate::gpu::uniform_entry::<KleinianUniforms>(PARAMS_BINDING, wgpu::ShaderStages::COMPUTE);
+    let output_entry = crate::gpu::output_image_entry(OUTPUT_BINDING, OUTPUT_FORMAT);
+    let corners_entry = crate::gpu::storage_entry(CORNERS_BINDING, wgpu::ShaderStages::COMPUTE, false);
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("kleinian_layout"),
-        entries: &[
-            crate::gpu::uniform_entry::<KleinianUniforms>(PARAMS_BINDING, wgpu::ShaderStages::COMPUTE),
-            wgpu::BindGroupLayoutEntry {
-                binding: OUTPUT_BINDING,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: OUTPUT_FORMAT,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                },
-                count: None,
-            },
-        ],
+        entries: &[params_entry, output_entry],
     });
-    let (origin, source) =
-        setup.shader_source("kleinian.wgsl", &[("params", PARAMS_BINDING), ("output", OUTPUT_BINDING)])?;
-    let kernel = ComputeKernel::new(device, &origin, &source, "render", &[&layout])?;
-    let uniforms = crate::gpu::uniform_buffer::<KleinianUniforms>(device, "kleinian_uniforms");
-    Ok(Box::new(Kleinian { kernel, layout, uniforms, bind_groups: BindGroupCache::default() }))
+    let adaptive_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("kleinian_adaptive_layout"),
+        entries: &[params_entry, output_entry, corners_entry],
+    });
+    let (origin, source) = setup.shader_source(
+        "kleinian.wgsl",
+        &[("params", PARAMS_BINDING), ("output", OUTPUT_BINDING), ("corner_bits", CORNERS_BINDING)],
+    )?;
+    let kernel = |entry, layout| ComputeKernel::new(device, &origin, &source, entry, &[layout]);
+    Ok(Box::new(Kleinian {
+        render: kernel("render", &layout)?,
+        corners: kernel("corners", &adaptive_layout)?,
+        render_edges: kernel("render_edges", &adaptive_layout)?,
+        layout,
+        adaptive_layout,
+        uniforms: crate::gpu::uniform_buffer::<KleinianUniforms>(device, "kleinian_uniforms"),
+        bind_groups: BindGroupCache::default(),
+    }))
 }
 
 impl Technique for Kleinian {
@@ -168,26 +198,48 @@ impl Technique for Kleinian {
         let size = graph.texture_size(output);
         let uniforms = KleinianUniforms::from_params(params, time, size);
         self.bind_groups.begin_frame();
-        graph.add_pass("kleinian/limit_set").write(output).record(move |ctx| {
+        let corners =
+            samples_adaptively(params).then(|| graph.create_buffer("kleinian/corner_bits", corner_bits_bytes(size)));
+        let mut pass = graph.add_pass("kleinian/limit_set").write(output);
+        if let Some(buffer) = corners {
+            pass = pass.write_buffer(buffer);
+        }
+        pass.record(move |ctx| {
             ctx.queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(&uniforms));
-            let bind_group = self.bind_groups.get_or_create(ctx.texture_id(output), || {
+            let key = (ctx.texture_id(output), corners.map(|b| ctx.buffer_id(b)));
+            let bind_group = self.bind_groups.get_or_create(key, || {
+                let mut entries = vec![
+                    wgpu::BindGroupEntry { binding: PARAMS_BINDING, resource: self.uniforms.as_entire_binding() },
+                    wgpu::BindGroupEntry {
+                        binding: OUTPUT_BINDING,
+                        resource: wgpu::BindingResource::TextureView(ctx.view(output)),
+                    },
+                ];
+                let layout = match corners {
+                    Some(b) => {
+                        let resource = ctx.buffer(b).as_entire_binding();
+                        entries.push(wgpu::BindGroupEntry { binding: CORNERS_BINDING, resource });
+                        &self.adaptive_layout
+                    }
+                    None => &self.layout,
+                };
                 ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("kleinian_bind_group"),
-                    layout: &self.layout,
-                    entries: &[
-                        wgpu::BindGroupEntry { binding: PARAMS_BINDING, resource: self.uniforms.as_entire_binding() },
-                        wgpu::BindGroupEntry {
-                            binding: OUTPUT_BINDING,
-                            resource: wgpu::BindingResource::TextureView(ctx.view(output)),
-                        },
-                    ],
+                    layout,
+                    entries: &entries,
                 })
             });
             let mut pass = ctx.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("kleinian/limit_set"),
                 timestamp_writes: None,
             });
-            self.kernel.dispatch(&mut pass, &[bind_group], [size.0, size.1, 1]);
+            if corners.is_some() {
+                // wgpu orders the two dispatches: the second reads what the first wrote.
+                self.corners.dispatch(&mut pass, &[bind_group], [size.0 + 3, size.1 + 3, 1]);
+                self.render_edges.dispatch(&mut pass, &[bind_group], [size.0, size.1, 1]);
+            } else {
+                self.render.dispatch(&mut pass, &[bind_group], [size.0, size.1, 1]);
+            }
         });
         output
     }

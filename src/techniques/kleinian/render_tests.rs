@@ -142,3 +142,39 @@ fn the_separation_band_changes_no_pixel() {
         assert!(banded.chunks(4).any(|p| p[0] > 128) || t[0] < 1.5, "t = {t:?}: nothing drawn, nothing tested");
     }
 }
+
+#[test]
+fn adaptive_sampling_holds_the_image_at_odd_sizes() {
+    // Adaptive sampling takes the samples only where a pixel's 4 × 4 neighbourhood of corners
+    // is not all one class. Against every pixel sampled: the pixels it samples are the same
+    // bytes, the rest are the pure colours, and what it can miss (a feature slipping between
+    // all 16 corners and past the first sample) stays rare. Sizes that are no multiple of the
+    // 32-corner words or the 8 × 8 workgroups check the packing and the margin.
+    let full_sampled = CLASSIC_BINARY.replace("\"t\": (2.0, 0.0)", "\"t\": (1.98795, 0.005859)").replace(
+        "\"iterations\": 200, \"scale\": 2.0, \"offset\": (-1.0, 0.0), \"samples\": 1",
+        "\"iterations\": 200, \"scale\": 1.9, \"offset\": (0.0, 0.0), \"samples\": 10, \"adaptive\": false",
+    );
+    assert!(full_sampled.contains("\"adaptive\": false"), "the template moved");
+    let adaptive = full_sampled.replace("\"adaptive\": false", "\"adaptive\": true");
+    for size in [(256, 256), (97, 61), (30, 41), (291, 37)] {
+        let [every, edges] = [&full_sampled, &adaptive].map(|src| render_text(src, size));
+        let pixels = every.rgba.chunks(4).zip(edges.rgba.chunks(4));
+        let (mut same, mut mixed_every, mut mixed_edges) = (0usize, 0usize, 0usize);
+        for (a, b) in pixels {
+            same += usize::from(a == b);
+            mixed_every += usize::from(a[0] != 0 && a[0] != 255);
+            mixed_edges += usize::from(b[0] != 0 && b[0] != 255);
+        }
+        let total = (size.0 * size.1) as usize;
+        let differ = total - same;
+        assert!(differ * 100 <= total, "{size:?}: {differ} of {total} pixels differ");
+        assert!(mixed_every > 0, "{size:?}: no edge in the picture, nothing tested");
+        assert!(mixed_edges * 10 >= mixed_every * 9, "{size:?}: {mixed_edges} of {mixed_every} edge pixels kept");
+        // FLIP spreads one pixel's change over its neighbours: only a picture of some size says
+        // what a viewer would see.
+        if size.0 >= 128 && size.1 >= 128 {
+            let (score, _) = indra::offscreen::flip_score(&every.rgba, &edges.rgba, (size.0, size.1), 0.99);
+            assert!(score.mean < 0.005, "{size:?}: mean FLIP {}", score.mean);
+        }
+    }
+}
