@@ -2,9 +2,8 @@
 // the cube field's cubes, the cloth's triangles), for GPUs whose raster path is narrow (the
 // H100/H200: a 4× multisampled 4K target with depth costs ~8 ms to clear and resolve before
 // anything is drawn).
-// The bindings and the steps the technique's kernels share (`techniques/splat_draw.rs` binds
-// and dispatches them); the technique's raster shader extends this file and its own, binds its
-// primitives at group 1 binding 1, and has three entry points:
+// The bindings, the steps and the three entry points of the technique's kernels
+// (`techniques/splat_draw.rs` binds and dispatches them):
 //   raster      one thread per primitive (`splat_index`): a box of up to INLINE_PIXELS it
 //               covers itself (`covers_inline`), larger ones are queued;
 //   raster_big  dispatched from the queue (`big_job`, `job_span`): a workgroup per CHUNK_PIXELS
@@ -13,6 +12,18 @@
 //   resolve     one thread per pixel (`Resolve`): each sample's primitive shaded at the pixel
 //               centre once per run of equal keys, stored at the multisampled target's precision
 //               (`as_stored`) and averaged as the multisample resolve does.
+// The technique's raster shader extends this file and its own, binds its primitives at group 1
+// binding 1, and defines the hooks the entry points call, for its primitive type P:
+//   splat_primitive(index: u32) -> P     primitive `index` in the form the other hooks take
+//   splat_box(p: P) -> PixelBox          the pixels it may cover
+//   cover(p: P, b: PixelBox, index: u32, first: i32, step: i32, end: i32)
+//                                        keeps (`keep`) its samples in pixels first, first +
+//                                        step, … below end of the box
+//   splat_shade(key: u32, centre: vec2<f32>) -> vec3<f32>
+//                                        the primitive a sample key names, shaded at a pixel
+//                                        centre
+// This file alone is no whole shader: `indra check` and live reload validate it through the
+// files that extend it.
 // Each sample keeps the nearest primitive with one 64-bit atomicMax of (depth key, key)
 // (`keep`): the same image whatever order the threads run in. Key 0 is the background.
 // extends: msaa_samples.wgsl
@@ -231,4 +242,41 @@ fn resolve_end(r: Resolve) {
     if r.inside {
         textureStore(image, r.pixel, vec4<f32>(r.sum / f32(splat.samples), 1.0));
     }
+}
+
+@compute @workgroup_size(64)
+fn raster(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let index = splat_index(id, groups);
+    if index >= splat.count {
+        return;
+    }
+    let p = splat_primitive(index);
+    let b = splat_box(p);
+    if covers_inline(index, b.size.x * b.size.y) {
+        cover(p, b, index, 0, 1, INLINE_PIXELS);
+    }
+}
+
+@compute @workgroup_size(64)
+fn raster_big(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    let job = big_job(group, groups, lane);
+    if job.index < splat.count {
+        let p = splat_primitive(job.index);
+        let b = splat_box(p);
+        let span = job_span(job, b.size.x * b.size.y);
+        cover(p, b, job.index, span.first, span.step, span.end);
+    }
+}
+
+@compute @workgroup_size(16, 16)
+fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
+    var r = resolve_begin(id.xy);
+    while resolve_next(&r) {
+        resolve_shade(&r, splat_shade(r.key, r.centre));
+    }
+    resolve_end(r);
 }

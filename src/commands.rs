@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use clap::Args;
 use indra::assets::{AssetKind, Assets};
-use indra::gpu::{Gpu, GpuOptions, JoinedSource};
+use indra::gpu::{Gpu, GpuOptions, validate_as_used};
 use indra::offscreen::{OffscreenRenderer, RenderedFrame, VideoSettings, VideoWriter, write_png};
 use indra::scene::{Scene, load_scene};
 
@@ -598,17 +598,19 @@ pub fn check(assets: &Assets, files: &[PathBuf]) -> Result<(), String> {
             targets.push((kind, name));
         }
     }
+    let shaders = assets.names(AssetKind::Shader);
     let mut failures = 0;
     for (kind, name) in &targets {
         let result = match kind {
             AssetKind::Scene | AssetKind::Show => load_scene(assets, name).map(|_| ()).map_err(|e| e.to_string()),
             AssetKind::Shader => read_shader(assets, name).and_then(|(origin, source)| {
-                // A base is looked for beside the file first, then among the project's shaders.
+                // A base is looked for beside the file first, then among the project's shaders;
+                // a file they extend is checked through them.
                 let beside = |base: &str| Path::new(name).with_file_name(base).display().to_string();
-                let joined = JoinedSource::with_bases(&origin, &source, |base| {
-                    read_shader(assets, &beside(base)).or_else(|_| read_shader(assets, base))
-                })?;
-                joined.validate().map(|_| ()).map_err(|e| e.to_string())
+                let file = Path::new(name).file_name().map_or(name.clone(), |f| f.to_string_lossy().into_owned());
+                validate_as_used(&file, (&origin, &source), &shaders, |n| {
+                    read_shader(assets, &beside(n)).or_else(|_| read_shader(assets, n))
+                })
             }),
         };
         match result {

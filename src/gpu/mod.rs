@@ -24,5 +24,7 @@ pub use context::{BackendChoice, Gpu, GpuError, GpuOptions, instance_descriptor}
 pub use prefix_sum::{PrefixSum, SCAN_BINDINGS, SCAN_BLOCK, ScanTarget};
 pub use raster::{GrowableBuffer, RasterDesc, UniformBlock, raster_pipeline};
 pub use readback::{ReadbackError, read_buffer, read_texture_bytes, read_texture_rgba8};
-pub use shader::{JoinedSource, ShaderError, compile_wgsl, validate_module, validate_wgsl, validated};
+pub use shader::{
+    JoinedSource, ShaderError, compile_wgsl, validate_as_used, validate_module, validate_wgsl, validated,
+};
 pub use watchdog::{DEFAULT_STALL_TIMEOUT, Stall, Watchdog};

@@ -144,6 +144,47 @@ impl JoinedSource {
     }
 }
 
+impl JoinedSource {
+    /// Whether the file named `name` (as `// extends:` lines name it) is one of those joined.
+    pub fn joins(&self, name: &str) -> bool {
+        self.parts.iter().any(|(origin, _)| std::path::Path::new(origin).file_name().is_some_and(|f| f == name))
+    }
+}
+
+/// Validates shader file `name` (read from `origin` as `source`) as the engine uses it. A file
+/// that other shaders extend may call hooks only they define, so it is validated through each
+/// of them that nothing extends in turn, with this text in place of the stored one; any other
+/// file after its own bases. `shaders` names every shader that might extend it; `load` reads
+/// one by name as `(origin, source)`. Errors are located in their own file.
+pub fn validate_as_used(
+    name: &str,
+    (origin, source): (&str, &str),
+    shaders: &[String],
+    load: impl Fn(&str) -> Result<(String, String), String>,
+) -> Result<(), String> {
+    let edited = |n: &str| if n == name { Ok((origin.to_string(), source.to_string())) } else { load(n) };
+    // Another file's own broken chain is its error, reported when it is checked.
+    let extenders: Vec<(&str, JoinedSource)> = shaders
+        .iter()
+        .filter(|n| n.as_str() != name)
+        .filter_map(|n| {
+            let (o, s) = load(n).ok()?;
+            extended_files(&s).next()?;
+            let joined = JoinedSource::with_bases(&o, &s, edited).ok()?;
+            joined.joins(name).then_some((n.as_str(), joined))
+        })
+        .collect();
+    if extenders.is_empty() {
+        let joined = JoinedSource::with_bases(origin, source, &load)?;
+        return joined.validate().map(|_| ()).map_err(|e| e.to_string());
+    }
+    let extended = |n: &str| extenders.iter().any(|(other, joined)| *other != n && joined.joins(n));
+    for (_, joined) in extenders.iter().filter(|(n, _)| !extended(n)) {
+        joined.validate().map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
 /// Files deeper than this are taken for a circle.
 const MAX_EXTENDS_DEPTH: usize = 6;
 
@@ -225,6 +266,42 @@ mod tests {
         let missing = JoinedSource::with_bases("top.wgsl", &top.replace("base.wgsl", "gone.wgsl"), files);
         assert!(missing.unwrap_err().contains("extends gone.wgsl: no gone.wgsl"));
         assert!(JoinedSource::with_bases("top.wgsl", "fn alone() {}", files).unwrap().validate().is_ok());
+    }
+
+    #[test]
+    fn a_base_with_hooks_is_validated_through_the_files_that_extend_it() {
+        // base.wgsl calls hook(), which only its extenders define; mid.wgsl extends it and is
+        // itself extended by top.wgsl, so only top.wgsl and side.wgsl are whole shaders.
+        let stored = |name: &str| -> Result<(String, String), String> {
+            let text = match name {
+                "base.wgsl" => "fn twice() -> f32 {\n    return hook() * 2.0;\n}\n",
+                "mid.wgsl" => "// extends: base.wgsl\nfn plus() -> f32 {\n    return twice() + 1.0;\n}\n",
+                "top.wgsl" => {
+                    "// extends: mid.wgsl\nfn hook() -> f32 {\n    return 1.0;\n}\nfn four() -> f32 {\n    return plus() + 1.0;\n}\n"
+                }
+                "side.wgsl" => "// extends: base.wgsl\nfn hook() -> f32 {\n    return 3.0;\n}\n",
+                "alone.wgsl" => "fn alone() -> f32 {\n    return 1.0;\n}\n",
+                other => return Err(format!("no {other}")),
+            };
+            Ok((format!("dir/{name}"), text.to_string()))
+        };
+        let names: Vec<String> =
+            ["alone.wgsl", "base.wgsl", "mid.wgsl", "side.wgsl", "top.wgsl"].map(String::from).to_vec();
+        let check = |name: &str, text: &str| validate_as_used(name, (&format!("dir/{name}"), text), &names, stored);
+        let base = stored("base.wgsl").unwrap().1;
+        assert!(JoinedSource::with_bases("dir/base.wgsl", &base, stored).unwrap().validate().is_err(), "not alone");
+        assert_eq!(check("base.wgsl", &base), Ok(()));
+        assert_eq!(check("mid.wgsl", &stored("mid.wgsl").unwrap().1), Ok(()));
+        // The edited text is the one checked, its error located in it.
+        let broken = base.replace("hook() * 2.0", "hook() * true");
+        let error = check("base.wgsl", &broken).unwrap_err();
+        assert!(error.starts_with("dir/base.wgsl:2:"), "{error}");
+        // A hook one extender lacks is that extender's error, found through the base.
+        let renamed = base.replace("hook()", "hooked()");
+        assert!(check("base.wgsl", &renamed).unwrap_err().contains("hooked"));
+        // A file nothing extends is checked after its own bases, as before.
+        assert_eq!(check("alone.wgsl", "fn alone() -> f32 {\n    return 2.0;\n}\n"), Ok(()));
+        assert!(check("side.wgsl", "// extends: base.wgsl\nfn other() {}\n").is_err(), "side no longer hooks");
     }
 
     #[test]

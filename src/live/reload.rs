@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use super::watcher::{Watcher, read_stable};
 use crate::assets::{Asset, AssetKind, Assets};
-use crate::gpu::{Gpu, JoinedSource};
+use crate::gpu::{Gpu, validate_as_used};
 use crate::params::Remap;
 use crate::scene::show::parse_show;
 use crate::scene::{Player, SceneInstance, load_scene, parse_scene_with};
@@ -157,11 +157,10 @@ impl LiveReload {
         self.stalled.remove(path);
         let origin = path.display().to_string();
         let running = &self.running;
-        JoinedSource::with_bases(&origin, &source, |base| {
-            running.load(AssetKind::Shader, base).map(|a| (a.origin, a.source))
-        })?
-        .validate()
-        .map_err(|e| e.to_string())?;
+        let shaders = running.names(AssetKind::Shader);
+        validate_as_used(&name, (&origin, &source), &shaders, |n| {
+            running.load(AssetKind::Shader, n).map(|a| (a.origin, a.source))
+        })?;
         let next = self.running.with_shader(Asset { name: name.clone(), origin, source: source.clone() });
         let used = instance.rebuild_nodes_using(&name, gpu, &next, size).map_err(|e| e.to_string())?;
         let previous = self.running.load(AssetKind::Shader, &name).ok();

@@ -263,3 +263,42 @@ fn a_shader_that_extends_another_reloads_live_and_its_errors_point_into_it() {
     assert!(report.errors[0].contains(&format!("tessellation_raster.wgsl:{line}:")), "{}", report.errors[0]);
     assert!(green(&shown(&mut r)) > 500, "the last good shader still runs");
 }
+
+#[test]
+fn an_edit_to_a_shared_base_is_checked_through_the_shaders_that_extend_it() {
+    // splat_draw.wgsl holds the compute draw's entry points over hooks each technique's raster
+    // shader defines: alone it is no whole shader, so reload validates it through them.
+    let root = sandbox("base");
+    let assets = Assets::new(Some(root.clone()));
+    let mut live = LiveReload::new(&assets).unwrap();
+    let scene = load_scene(&assets, "poisson_2d").unwrap();
+    let size = (96, 64);
+    let mut r = OffscreenRenderer::new(common::gpu(), &assets, scene, Some(size), None, None).unwrap();
+    let as_shipped =
+        |frame: u64| common::render_scene(load_scene(&common::assets(), "poisson_2d").unwrap(), size, frame).rgba;
+    r.render_next().unwrap();
+
+    let base = root.join("shaders/splat_draw.wgsl");
+    let call = "resolve_shade(&r, splat_shade(r.key, r.centre));";
+    edit(&base, call, "resolve_shade(&r, vec3<f32>(1.0) - splat_shade(r.key, r.centre));");
+    let report = wait_for_reload(&mut r, &mut live);
+    assert!(report.errors.is_empty() && !report.applied.is_empty(), "{report:?}");
+    let inverted = r.render_next().unwrap();
+    assert!(inverted.rgba != as_shipped(inverted.time.frame), "the edited base is live");
+
+    // A hook no extender defines is an error located in the base; the show goes on.
+    edit(&base, "vec3<f32>(1.0) - splat_shade(", "splat_shaded(");
+    let line = std::fs::read_to_string(&base).unwrap().lines().position(|l| l.contains("splat_shaded(")).unwrap() + 1;
+    let report = wait_for_reload(&mut r, &mut live);
+    assert_eq!(report.errors.len(), 1, "{report:?}");
+    assert!(report.errors[0].contains(&format!("splat_draw.wgsl:{line}:")), "{}", report.errors[0]);
+    let still = r.render_next().unwrap();
+    assert!(still.rgba != as_shipped(still.time.frame), "the last good base still runs");
+
+    edit(&base, "splat_shaded(", "splat_shade(");
+    let report = wait_for_reload(&mut r, &mut live);
+    assert!(report.errors.is_empty() && !report.applied.is_empty(), "{report:?}");
+    let fixed = r.render_next().unwrap();
+    assert!(fixed.rgba == as_shipped(fixed.time.frame), "the shipped base again");
+    std::fs::remove_dir_all(root).unwrap();
+}

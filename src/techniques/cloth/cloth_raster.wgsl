@@ -73,7 +73,7 @@ fn depth_of(p: vec3<f32>) -> f32 {
 }
 
 // The pixels with a sample the triangle may cover: its corners' box on screen.
-fn triangle_box(tr: Triangle) -> PixelBox {
+fn splat_box(tr: Triangle) -> PixelBox {
     var b = box_start();
     box_add(&b, view.view_proj * vec4<f32>(tr.a, 1.0));
     box_add(&b, view.view_proj * vec4<f32>(tr.b, 1.0));
@@ -98,49 +98,18 @@ fn cover(tr: Triangle, b: PixelBox, index: u32, first: i32, step: i32, end: i32)
     }
 }
 
-@compute @workgroup_size(64)
-fn raster(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    let index = splat_index(id, groups);
-    if index >= splat.count {
-        return;
-    }
-    let tr = triangle(index);
-    let b = triangle_box(tr);
-    if covers_inline(index, b.size.x * b.size.y) {
-        cover(tr, b, index, 0, 1, INLINE_PIXELS);
-    }
-}
+// The hooks of `splat_draw.wgsl`'s entry points (and `splat_box`, `cover` above).
 
-@compute @workgroup_size(64)
-fn raster_big(
-    @builtin(workgroup_id) group: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) lane: u32,
-) {
-    let job = big_job(group, groups, lane);
-    if job.index < splat.count {
-        let tr = triangle(job.index);
-        let b = triangle_box(tr);
-        let span = job_span(job, b.size.x * b.size.y);
-        cover(tr, b, job.index, span.first, span.step, span.end);
-    }
+fn splat_primitive(index: u32) -> Triangle {
+    return triangle(index);
 }
 
 // Triangle `key - 1` shaded at pixel position `centre`.
-fn shade_triangle(key: u32, centre: vec2<f32>) -> vec3<f32> {
+fn splat_shade(key: u32, centre: vec2<f32>) -> vec3<f32> {
     let tr = triangle(key - 1u);
     let hit = plane_hit(tr, pixel_ray(centre));
     let world = tr.a + (tr.b - tr.a) * hit.y + (tr.c - tr.a) * hit.z;
     let normal = tr.na * (1.0 - hit.y - hit.z) + tr.nb * hit.y + tr.nc * hit.z;
     let albedo = select(view.color.rgb, view.sphere_color.rgb, tr.sphere);
     return shade(world, normal, albedo).rgb;
-}
-
-@compute @workgroup_size(16, 16)
-fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
-    var r = resolve_begin(id.xy);
-    while resolve_next(&r) {
-        resolve_shade(&r, shade_triangle(r.key, r.centre));
-    }
-    resolve_end(r);
 }

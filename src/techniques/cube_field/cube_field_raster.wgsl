@@ -73,7 +73,7 @@ fn cube_hit(c: Cube, d: vec3<f32>) -> Hit {
 }
 
 // The pixels with a sample the cube may cover: its corners' box on screen.
-fn cube_box(c: Cube) -> PixelBox {
+fn splat_box(c: Cube) -> PixelBox {
     var b = box_start();
     for (var k = 0u; k < 8u; k++) {
         let corner = vec3<f32>(f32(k & 1u), f32((k >> 1u) & 1u), f32(k >> 2u)) - 0.5;
@@ -96,48 +96,18 @@ fn cover(c: Cube, b: PixelBox, index: u32, first: i32, step: i32, end: i32) {
     }
 }
 
-@compute @workgroup_size(64)
-fn raster(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    let index = splat_index(id, groups);
-    if index >= splat.count {
-        return;
-    }
-    let c = cubes[index];
-    let b = cube_box(c);
-    if covers_inline(index, b.size.x * b.size.y) {
-        cover(c, b, index, 0, 1, INLINE_PIXELS);
-    }
+// The hooks of `splat_draw.wgsl`'s entry points (and `splat_box`, `cover` above).
+
+fn splat_primitive(index: u32) -> Cube {
+    return cubes[index];
 }
 
-@compute @workgroup_size(64)
-fn raster_big(
-    @builtin(workgroup_id) group: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) lane: u32,
-) {
-    let job = big_job(group, groups, lane);
-    if job.index < splat.count {
-        let c = cubes[job.index];
-        let b = cube_box(c);
-        let span = job_span(job, b.size.x * b.size.y);
-        cover(c, b, job.index, span.first, span.step, span.end);
-    }
-}
-
-// The cube face a sample key names (cube × 8 + face + 1), shaded: faces are flat.
-fn shade(key: u32) -> vec3<f32> {
+// The cube face a sample key names (cube × 8 + face + 1), shaded: faces are flat, so the
+// pixel centre does not matter.
+fn splat_shade(key: u32, centre: vec2<f32>) -> vec3<f32> {
     let c = cubes[(key - 1u) / 8u];
     let face = i32((key - 1u) % 8u);
     var normal = vec3<f32>(0.0);
     normal[face / 2] = select(1.0, -1.0, (face & 1) == 1);
     return face_colour(rotate(c.rotation, normal));
-}
-
-@compute @workgroup_size(16, 16)
-fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
-    var r = resolve_begin(id.xy);
-    while resolve_next(&r) {
-        resolve_shade(&r, shade(r.key));
-    }
-    resolve_end(r);
 }

@@ -39,7 +39,7 @@ fn corner_at(f: Footprint, p: vec2<f32>) -> vec2<f32> {
 }
 
 // The pixels with a sample the disc may cover.
-fn disc_box(f: Footprint) -> PixelBox {
+fn splat_box(f: Footprint) -> PixelBox {
     if !f.drawn {
         return PixelBox(vec2<i32>(0), vec2<i32>(0));
     }
@@ -60,45 +60,14 @@ fn cover(f: Footprint, b: PixelBox, index: u32, first: i32, step: i32, end: i32)
     }
 }
 
-@compute @workgroup_size(64)
-fn raster(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    let index = splat_index(id, groups);
-    if index >= splat.count {
-        return;
-    }
-    let f = footprint(discs[index]);
-    let b = disc_box(f);
-    if covers_inline(index, b.size.x * b.size.y) {
-        cover(f, b, index, 0, 1, INLINE_PIXELS);
-    }
-}
+// The hooks of `splat_draw.wgsl`'s entry points (and `splat_box`, `cover` above).
 
-@compute @workgroup_size(64)
-fn raster_big(
-    @builtin(workgroup_id) group: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) lane: u32,
-) {
-    let job = big_job(group, groups, lane);
-    if job.index < splat.count {
-        let f = footprint(discs[job.index]);
-        let b = disc_box(f);
-        let span = job_span(job, b.size.x * b.size.y);
-        cover(f, b, job.index, span.first, span.step, span.end);
-    }
+fn splat_primitive(index: u32) -> Footprint {
+    return footprint(discs[index]);
 }
 
 // The disc a sample key names, shaded at a pixel centre.
-fn shade(key: u32, centre: vec2<f32>) -> vec3<f32> {
+fn splat_shade(key: u32, centre: vec2<f32>) -> vec3<f32> {
     let disc = discs[~key];
     return disc_colour(corner_at(footprint(disc), centre), order_of(disc.w));
-}
-
-@compute @workgroup_size(16, 16)
-fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
-    var r = resolve_begin(id.xy);
-    while resolve_next(&r) {
-        resolve_shade(&r, shade(r.key, r.centre));
-    }
-    resolve_end(r);
 }
