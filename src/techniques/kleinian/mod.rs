@@ -100,7 +100,11 @@ pub struct KleinianUniforms {
 impl KleinianUniforms {
     /// All per-frame precomputation: colours to linear, bools to flags.
     pub fn from_params(p: &ParamSet, time: &FrameTime, size: (u32, u32)) -> Self {
-        let s = Settings::read(p);
+        Self::from_settings(&Settings::read(p), time, size)
+    }
+
+    /// [`Self::from_params`] from settings already read.
+    fn from_settings(s: &Settings, time: &FrameTime, size: (u32, u32)) -> Self {
         Self {
             t: s.t,
             scale: s.scale,
@@ -125,15 +129,14 @@ impl KleinianUniforms {
 pub const ADAPTIVE_MIN_SAMPLES: i32 = 4;
 
 /// Whether a frame samples adaptively.
-fn samples_adaptively(p: &ParamSet) -> bool {
-    let s = Settings::read(p);
+fn samples_adaptively(s: &Settings) -> bool {
     s.adaptive && s.samples >= ADAPTIVE_MIN_SAMPLES
 }
 
 /// Bytes of the corner classes of a `size` image: (width + 3) × (height + 3) bits (the pixel
 /// corners and a margin of one), each row padded to whole 32-bit words
 /// (`kleinian.wgsl::corner_words`).
-pub fn corner_bits_bytes(size: (u32, u32)) -> u64 {
+fn corner_bits_bytes(size: (u32, u32)) -> u64 {
     u64::from((size.0 + 34) / 32) * u64::from(size.1 + 3) * 4
 }
 
@@ -196,10 +199,11 @@ impl Technique for Kleinian {
     ) -> TextureHandle {
         let output = graph.create_texture("kleinian/image", TextureDesc::full(OUTPUT_FORMAT));
         let size = graph.texture_size(output);
-        let uniforms = KleinianUniforms::from_params(params, time, size);
+        let settings = Settings::read(params);
+        let uniforms = KleinianUniforms::from_settings(&settings, time, size);
         self.bind_groups.begin_frame();
         let corners =
-            samples_adaptively(params).then(|| graph.create_buffer("kleinian/corner_bits", corner_bits_bytes(size)));
+            samples_adaptively(&settings).then(|| graph.create_buffer("kleinian/corner_bits", corner_bits_bytes(size)));
         let mut pass = graph.add_pass("kleinian/limit_set").write(output);
         if let Some(buffer) = corners {
             pass = pass.write_buffer(buffer);
