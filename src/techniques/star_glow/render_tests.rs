@@ -112,6 +112,40 @@ fn a_bright_texel_streaks_with_weights_att_pow_k_opposite_to_the_offset() {
 }
 
 #[test]
+fn both_layouts_clamp_taps_to_the_edge_alike() {
+    // A bright texel in a corner: taps past the edge read the edge texel again (Unity's
+    // clamp-to-edge render textures), so the streaks along the border pile up. The book layout
+    // taps one texture per direction, the fused layout one layer of an array per direction:
+    // whole-texel steps (angle 0) and blended ones (angle 17) must agree texel for texel, and the
+    // pile-up must be there (a repeating sampler would wrap the taps onto black texels).
+    let gpu = gpu();
+    let image = single_texel((63, 0), 2.0);
+    for angle in ["0", "17"] {
+        let run = |layout| {
+            let mut s = STREAK_ONLY.to_vec();
+            s.extend([("layout", layout), ("streaks", "4"), ("iteration", "3"), ("angle", angle)]);
+            glow(&gpu, &image, &s)
+        };
+        let (book, fused) = (run("Book"), run("Fused"));
+        for (i, (b, f)) in book.iter().zip(&fused).enumerate() {
+            let (x, y) = (i as u32 % SIZE.0, i as u32 / SIZE.0);
+            assert!(
+                (b[0] - f[0]).abs() <= 2e-3 * b[0].abs().max(1.0),
+                "angle {angle}, ({x}, {y}): book {} fused {}",
+                b[0],
+                f[0]
+            );
+        }
+        if angle == "0" {
+            // The first streak taps to the right (+x), past the edge: the corner texel, then three
+            // taps clamped onto it.
+            let corner = fused[63][0];
+            assert!(corner > 2.0 + 2.0 * 0.5, "the taps past the edge read the corner again: {corner}");
+        }
+    }
+}
+
+#[test]
 fn composite_formulas_on_known_pixels() {
     let gpu = gpu();
     let s = [0.5f32, 0.25, 0.125];
