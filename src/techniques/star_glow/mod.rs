@@ -2,6 +2,11 @@
 //! accumulation and a final composite — as a node that takes any HDR texture and can end any
 //! scene.
 //!
+//! Three pass layouts give one image: the book's (a pass per level per direction), the fused
+//! (a pass per level for every direction), and, where the streaks step whole texels along the
+//! axes and reach past the image, a scan: the cascade's weights multiply out to att^k for the
+//! k-th texel along a streak, so one exponential suffix sum per line replaces the levels.
+//!
 //! Book: [UGP4 ch.4] "StarGlow" (xjine); [Kawase 2003] "Frame Buffer Postprocessing Effects in
 //! DOUBLE-S.T.E.A.L", GDC. Shader: `star_glow.wgsl`. Goldens: `golden/`, made by `render_tests.rs`.
 //!
@@ -27,7 +32,7 @@ use super::{NodeSetup, Technique, TechniqueInfo};
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "star_glow",
     chapter: "4: StarGlow",
-    summary: "Kawase streak glow on any HDR input, book layout or fused",
+    summary: "Kawase streak glow on any HDR input: book layout, fused, or one scan per line",
     params,
     inputs: &["source"],
     shaders: &["star_glow.wgsl"],
@@ -65,7 +70,8 @@ crate::param_enum! {
 crate::param_enum! {
     /// The `layout` parameter: which pass layout to use.
     pub enum LayoutChoice {
-        /// Fused (same output, fewer passes).
+        /// The scan where the streaks step whole texels along the axes and reach past the image
+        /// (the book's defaults at 1080p and 4K), else Fused: the same image, the fewest passes.
         Auto = "Auto",
         /// The book's pass layout.
         Book = "Book",
@@ -96,7 +102,7 @@ crate::technique_params! {
         composite: Composite = |n, doc| ParamDecl::choice(n, Composite::OPTIONS, 0, doc),
         /// tint of the coloured composite types
         color: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Color([1.0, 1.0, 1.0, 1.0]), None, doc),
-        /// pass layout; Auto is Fused (same output, fewer passes)
+        /// pass layout; Auto is the scan where it applies, else Fused (same output, fewer passes)
         layout: LayoutChoice = |n, doc| ParamDecl::choice(n, LayoutChoice::OPTIONS, 0, doc),
         /// streak length relative to the image (as the book at 1080p) instead of in texels
         resolution_independent: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(true), None, doc),
@@ -154,15 +160,19 @@ pub enum Layout {
     /// One pass per level for every direction at once (layered textures), the accumulation
     /// folded into the last level: iteration + 2 passes, the same arithmetic.
     Fused,
+    /// Axis-aligned whole-texel streaks that reach past the image: the levels' product of
+    /// weights as one suffix scan per line and direction, then the accumulation: 4 passes.
+    Scan,
 }
 
 impl Layout {
-    /// The layout the `layout` parameter asks for (`Auto` is `Fused`).
+    /// The layout the `layout` parameter asks for before the frame's size is known (`Auto` is
+    /// `Fused`; the plan takes the scan for it where the size allows).
     pub fn choose(p: &ParamSet) -> Self {
         Self::of(Settings::read(p).layout)
     }
 
-    /// The layout `choice` stands for.
+    /// The layout `choice` stands for where the scan does not apply.
     pub fn of(choice: LayoutChoice) -> Self {
         match choice {
             LayoutChoice::Book => Layout::Book,
@@ -198,6 +208,8 @@ struct Kernels {
     level_first: Kernel,
     level_next: Kernel,
     level_last: Kernel,
+    streak_scan: Kernel,
+    streak_screen: Kernel,
 }
 
 /// The texture bindings of `star_glow.wgsl` besides the uniform (0) and sampler (1).
@@ -265,6 +277,8 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         level_first: kernel("level_first", &[TexA, DstLayers])?,
         level_next: kernel("level_next", &[SrcLayers, DstLayers])?,
         level_last: kernel("level_last", &[SrcLayers, Dst])?,
+        streak_scan: kernel("streak_scan", &[TexA, DstLayers])?,
+        streak_screen: kernel("streak_screen", &[SrcLayers, Dst])?,
     };
     // Clamp to edge, as Unity's render textures: streaks smear the border texel, never wrap.
     let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
@@ -292,7 +306,7 @@ impl Technique for StarGlow {
         if settings.intensity <= 0.0 {
             return source;
         }
-        let plan = passes::Plan::new(&settings, Layout::of(settings.layout));
+        let plan = passes::Plan::new(&settings);
         self.bind_groups.get_mut().begin_frame();
         let this: &'r StarGlow = self;
         plan.declare(this, graph, source)

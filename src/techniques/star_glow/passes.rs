@@ -2,13 +2,25 @@
 //! output, so the frame graph's pool reuses them (a book-layout frame of N streaks needs a handful
 //! of physical textures, not N × iteration).
 
-use super::{Binding, FORMAT, Kernel, Layout, Settings, StarGlow, StarGlowUniforms, streak_step};
+use super::{Binding, FORMAT, Kernel, Layout, LayoutChoice, Settings, StarGlow, StarGlowUniforms, streak_step};
 use crate::graph::{Extent, FrameGraph, PassContext, TextureDesc, TextureHandle};
 use crate::techniques::srgb_to_linear;
+
+/// Invocations of one scan workgroup, each a texel of a chunk of a line (`SCAN_WIDTH` in the
+/// shader).
+const SCAN_WIDTH: u32 = 256;
+
+/// Longest line the scan layout takes (`SCAN_MAX_CHUNKS` chunks in the shader).
+const SCAN_MAX_LINE: u32 = 16 * SCAN_WIDTH;
+
+/// Longest whole-texel step the scan takes (a chunk must hold at least one step).
+const SCAN_MAX_STEP: f32 = 64.0;
 
 /// One frame's worth of StarGlow work, decided from the parameters.
 pub(super) struct Plan {
     layout: Layout,
+    /// `layout: Auto`: the scan where it applies.
+    auto: bool,
     base: StarGlowUniforms,
     streaks: u32,
     iteration: u32,
@@ -19,7 +31,7 @@ pub(super) struct Plan {
 }
 
 /// A pass to declare: its kernel, what it reads and writes at which binding, and how many
-/// invocations (x, y, directions) it runs.
+/// invocations it runs: (x, y, directions) over the texture it writes, or `threads`.
 struct PassSpec<'k> {
     name: String,
     kernel: &'k Kernel,
@@ -27,10 +39,11 @@ struct PassSpec<'k> {
     write: (Binding, TextureHandle),
     uniforms: StarGlowUniforms,
     layers: u32,
+    threads: Option<[u32; 3]>,
 }
 
 impl Plan {
-    pub fn new(p: &Settings, layout: Layout) -> Self {
+    pub fn new(p: &Settings) -> Self {
         let c = p.color;
         // Scenes may give their own ranges: the shader's limits are kept here.
         let base = StarGlowUniforms {
@@ -48,7 +61,8 @@ impl Plan {
             steps: [[0.0; 4]; 16],
         };
         Self {
-            layout,
+            layout: Layout::of(p.layout),
+            auto: p.layout == LayoutChoice::Auto,
             base,
             streaks: base.directions,
             iteration: p.iteration.clamp(1, 5) as u32,
@@ -70,6 +84,9 @@ impl Plan {
         }
         let small =
             TextureDesc { extent: Extent::Relative(1, self.base.divide), format: FORMAT, layers: None, samples: 1 };
+        if self.auto && self.scan_applies(small.extent.resolve(graph.output_size())) {
+            self.layout = Layout::Scan;
+        }
         let mut passes = Vec::new();
         let k = &node.kernels;
         let bright = graph.create_texture("star_glow/bright", small);
@@ -77,6 +94,7 @@ impl Plan {
         let glow = match self.layout {
             Layout::Book => self.book(node, graph, small, bright, &mut passes),
             Layout::Fused => self.fused(node, graph, small, bright, &mut passes),
+            Layout::Scan => self.scan(node, graph, small, bright, &mut passes),
         };
         let out = graph.create_texture("star_glow/image", TextureDesc::full(FORMAT));
         let reads = [(Binding::TexA, source), (Binding::TexB, glow)];
@@ -125,6 +143,32 @@ impl Plan {
             acc = Some(next);
         }
         acc.expect("at least one streak")
+    }
+
+    /// One scan per line and direction into a layered texture, then the accumulation.
+    fn scan<'k>(
+        &self,
+        node: &'k StarGlow,
+        graph: &mut FrameGraph<'_>,
+        small: TextureDesc,
+        bright: TextureHandle,
+        passes: &mut Vec<PassSpec<'k>>,
+    ) -> TextureHandle {
+        let k = &node.kernels;
+        let streaks = graph.create_texture("star_glow/streaks", small.with_layers(self.streaks));
+        // The streak's length in taps rides in `power`; the steps are the level-1 steps.
+        let taps = 4f32.powi(self.iteration as i32);
+        let mut spec =
+            self.spec("star_glow/scan", &k.streak_scan, &[(Binding::TexA, bright)], (Binding::DstLayers, streaks), 1.0);
+        spec.uniforms.power = taps;
+        // One workgroup per line (rows for the x streaks, columns for the y streaks).
+        let (w, h) = small.extent.resolve(graph.output_size());
+        spec.threads = Some([SCAN_WIDTH * w.max(h), self.streaks, 1]);
+        passes.push(spec);
+        let glow = graph.create_texture("star_glow/glow", small);
+        let reads = [(Binding::SrcLayers, streaks)];
+        passes.push(self.spec("star_glow/screen", &k.streak_screen, &reads, (Binding::Dst, glow), 1.0));
+        glow
     }
 
     /// Per level: every direction at once on layered textures; the last level accumulates.
@@ -195,7 +239,31 @@ impl Plan {
             let s = power * self.step_scale;
             uniforms.steps[i as usize] = [x * s, y * s, 0.0, 0.0];
         }
-        PassSpec { name: name.into(), kernel, reads: reads.to_vec(), write, uniforms, layers: 1 }
+        PassSpec { name: name.into(), kernel, reads: reads.to_vec(), write, uniforms, layers: 1, threads: None }
+    }
+
+    /// Whether the scan gives what the cascade gives at this small size: every streak steps
+    /// whole texels along an axis (angle a multiple of 90°, 1, 2 or 4 streaks, the step scale a
+    /// whole number) and its 4^iteration taps reach past the end of every line it runs along.
+    fn scan_applies(&self, (w, h): (u32, u32)) -> bool {
+        let s = self.step_scale;
+        if s < 1.0 || s.fract() != 0.0 || s > SCAN_MAX_STEP {
+            return false;
+        }
+        let reach = 4f32.powi(self.iteration as i32) * s;
+        (1..=self.streaks).all(|i| {
+            let [x, y] = streak_step(i, self.streaks, self.angle);
+            // f32 sines of multiples of 90° up to 720° miss by < 1e-6.
+            let axis = |a: f32, b: f32| (a.abs() - 1.0).abs() < 1e-5 && b.abs() < 1e-5;
+            let line = if axis(x, y) {
+                w
+            } else if axis(y, x) {
+                h
+            } else {
+                return false;
+            };
+            reach >= line as f32 && line <= SCAN_MAX_LINE
+        })
     }
 }
 
@@ -208,14 +276,15 @@ fn declare<'r>(graph: &mut FrameGraph<'r>, node: &'r StarGlow, slot: usize, spec
     for &(_, t) in &spec.reads {
         pass = pass.read(t);
     }
-    let (kernel, reads, write, layers) = (spec.kernel, spec.reads, spec.write, spec.layers);
+    let threads = spec.threads.unwrap_or([w, h, spec.layers]);
+    let (kernel, reads, write) = (spec.kernel, spec.reads, spec.write);
     pass.write(write.1).record(move |ctx| {
         ctx.queue.write_buffer(&node.uniforms[slot], 0, bytemuck::bytes_of(&uniforms));
         let bind_group = node.bind_group(ctx, kernel, slot, &reads, write);
         let mut compute = ctx
             .encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("star_glow"), timestamp_writes: None });
-        kernel.compute.dispatch(&mut compute, &[&bind_group], [w, h, layers]);
+        kernel.compute.dispatch(&mut compute, &[&bind_group], threads);
     });
 }
 

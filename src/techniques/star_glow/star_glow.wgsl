@@ -9,6 +9,11 @@
 // texture (one layer per direction), and the last level screen-accumulates the directions
 // itself: bright -> level 1 .. level `iteration` -> composite (iteration + 2 passes). The
 // arithmetic is the book's, tap for tap.
+// Scan layout, where every streak steps whole texels along an axis and reaches past the image
+// (the book's defaults at 1080p and 4K): the cascade's weights multiply out to att^k for the
+// k-th texel along the streak (k < 4^iteration, one tap per level: the base-4 digits of k), so
+// one exponential suffix scan per line and direction gives what the levels give, and the
+// directions are screen-accumulated after: bright -> scan -> screen -> composite (4 passes).
 
 const MAX_DIRECTIONS: u32 = 16u;
 
@@ -34,6 +39,14 @@ struct StarGlowUniforms {
 @group(0) @binding(4) var dst: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(5) var src_layers: texture_2d_array<f32>;
 @group(0) @binding(6) var dst_layers: texture_storage_2d_array<rgba16float, write>;
+
+// Invocations of one scan workgroup: one per texel of a chunk of a line.
+const SCAN_WIDTH: u32 = 256u;
+// Longest line a scan takes (16 chunks; the engine uses the cascade beyond).
+const SCAN_MAX_CHUNKS: u32 = 16u;
+// The chunk being scanned, and the finished sums of the chunk scanned before it (further along).
+var<workgroup> scan_sums: array<vec3<f32>, 256>;
+var<workgroup> scan_carry: array<vec3<f32>, 256>;
 
 fn uv_of(id: vec2<u32>) -> vec2<f32> {
     return (vec2<f32>(id) + 0.5) / vec2<f32>(u.dst_size);
@@ -162,6 +175,97 @@ fn level_single(@builtin(global_invocation_id) id: vec3<u32>) {
     var acc = vec3<f32>(0.0);
     for (var d = 0u; d < min(u.directions, MAX_DIRECTIONS); d = d + 1u) {
         acc = screen(acc, taps_2d(uv, u.steps[d].xy));
+    }
+    textureStore(dst, vec2<i32>(id.xy), vec4<f32>(acc, 1.0));
+}
+
+// The texel at distance t along line `line`, for taps stepping along `axis_x` (else y) in the
+// `forward` (+) direction or against it; t = n - 1 is the far end, where the taps clamp.
+fn scan_texel(line: u32, t: u32, n: u32, axis_x: bool, forward: bool) -> vec2<i32> {
+    let along = select(n - 1u - t, t, forward);
+    return select(vec2<i32>(i32(line), i32(along)), vec2<i32>(i32(along), i32(line)), axis_x);
+}
+
+// Weight of the taps past the far end, k0 .. taps - 1, which all read the end texel:
+// sum of att^k.
+fn past_end_weight(k0: f32, taps: f32) -> f32 {
+    if (k0 >= taps) {
+        return 0.0;
+    }
+    if (u.attenuation == 1.0) {
+        return taps - k0;
+    }
+    return (pow(u.attenuation, k0) - pow(u.attenuation, taps)) / (1.0 - u.attenuation);
+}
+
+// One line (workgroup x) of one direction (workgroup y) of the bright texture (tex_a) into layer
+// y of dst_layers: out(t) = sum over k < taps of att^k bright(min(t + k s, n - 1)), taps =
+// u.power = 4^iteration, s = the whole-texel step. With taps * s >= n every streak runs off the
+// far end, so out(t) is the suffix sum S(t) = bright(t) + att S(t + s) plus the end texel times
+// the weights of the taps past it. The line is scanned in chunks of 256 from the far end back,
+// each chunk by doubling steps in workgroup memory, its sums completed from the chunk before.
+@compute @workgroup_size(256, 1, 1)
+fn streak_scan(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) i: u32) {
+    let step = u.steps[group.y].xy;
+    let axis_x = abs(step.x) > abs(step.y);
+    let forward = select(step.y, step.x, axis_x) > 0.0;
+    let s = u32(round(max(abs(step.x), abs(step.y))));
+    let n = select(u.dst_size.y, u.dst_size.x, axis_x);
+    let line = group.x;
+    if (line >= select(u.dst_size.x, u.dst_size.y, axis_x) || group.y >= u.directions) {
+        return;
+    }
+    let chunks = min((n + SCAN_WIDTH - 1u) / SCAN_WIDTH, SCAN_MAX_CHUNKS);
+    // Every load of the line first, so their latencies overlap.
+    var texels: array<vec3<f32>, SCAN_MAX_CHUNKS>;
+    for (var c = 0u; c < chunks; c = c + 1u) {
+        let t = i32(n) - i32(SCAN_WIDTH * (c + 1u)) + i32(i);
+        texels[c] = vec3<f32>(0.0);
+        if (t >= 0) {
+            texels[c] = textureLoad(tex_a, scan_texel(line, u32(t), n, axis_x, forward), 0).rgb;
+        }
+    }
+    let end = textureLoad(tex_a, scan_texel(line, n - 1u, n, axis_x, forward), 0).rgb;
+    for (var c = 0u; c < chunks; c = c + 1u) {
+        scan_sums[i] = texels[c];
+        workgroupBarrier();
+        // After the step of offset o: the sum over j < 2 o / s of att^j bright(t + j s).
+        for (var o = s; o < SCAN_WIDTH; o = o * 2u) {
+            var further = vec3<f32>(0.0);
+            if (i + o < SCAN_WIDTH) {
+                further = scan_sums[i + o];
+            }
+            workgroupBarrier();
+            scan_sums[i] += pow(u.attenuation, f32(o / s)) * further;
+            workgroupBarrier();
+        }
+        // The chunk's first q terms are in hand; the rest is S at the first texel past it.
+        var sum = scan_sums[i];
+        if (c > 0u) {
+            let q = (SCAN_WIDTH - i + s - 1u) / s;
+            sum += pow(u.attenuation, f32(q)) * scan_carry[i + q * s - SCAN_WIDTH];
+        }
+        workgroupBarrier();
+        scan_carry[i] = sum;
+        let t = i32(n) - i32(SCAN_WIDTH * (c + 1u)) + i32(i);
+        if (t >= 0) {
+            let k0 = f32((n - 1u - u32(t)) / s + 1u);
+            let out = sum + end * past_end_weight(k0, u.power);
+            textureStore(dst_layers, scan_texel(line, u32(t), n, axis_x, forward), i32(group.y), vec4<f32>(out, 1.0));
+        }
+        workgroupBarrier();
+    }
+}
+
+// Scan layout: every direction's streak (src_layers), screen-accumulated in order into dst.
+@compute @workgroup_size(16, 16, 1)
+fn streak_screen(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (any(id.xy >= u.dst_size)) {
+        return;
+    }
+    var acc = vec3<f32>(0.0);
+    for (var d = 0u; d < min(u.directions, MAX_DIRECTIONS); d = d + 1u) {
+        acc = screen(acc, textureLoad(src_layers, vec2<i32>(id.xy), d, 0).rgb);
     }
     textureStore(dst, vec2<i32>(id.xy), vec4<f32>(acc, 1.0));
 }
