@@ -269,7 +269,9 @@ impl Scene {
     }
 
     /// Applies `node.param=value` (value: numbers separated by commas, or true/false), as the
-    /// CLI's `--set` does. The value is typed and clamped like any other.
+    /// CLI's `--set` does. The value is typed and clamped like any other, and it holds: the
+    /// scene's tracks, LFOs and sound mappings on that parameter (or on that component, or on the
+    /// whole of the vector it is part of) are dropped. MIDI and OSC can still move it.
     pub fn set_from_str(&mut self, assignment: &str) -> Result<(), String> {
         let (target, value) =
             assignment.split_once('=').ok_or_else(|| format!("'{assignment}' is not of the form node.param=value"))?;
@@ -292,6 +294,15 @@ impl Scene {
             return Err(format!("'{value}' is not a finite number ({target})"));
         }
         params.snap();
+        // Otherwise an LFO or a track overwrites the value from the first frame on, silently.
+        let moves_it = |node: usize, param: usize, component: Option<usize>| {
+            node == t.node
+                && param == t.param
+                && (component.is_none() || t.component.is_none() || component == t.component)
+        };
+        self.tracks.retain(|b| !moves_it(b.node, b.param, b.component));
+        self.lfos.retain(|l| !moves_it(l.target.node, l.target.param, l.target.component));
+        self.audio.retain(|a| !moves_it(a.target.node, a.target.param, a.target.component));
         Ok(())
     }
 }

@@ -152,3 +152,31 @@ fn a_trigger_fires_for_exactly_one_fixed_step() {
     inst.advance(&clock.now());
     assert!(!inst.params(0).fired("reset"));
 }
+
+#[test]
+fn a_value_given_with_set_holds_against_lfos_and_tracks() {
+    // kleinian_star_glow: an LFO turns glow.angle, tracks move limit_set.t.x and t.y.
+    let gpu = common::gpu();
+    let run = |sets: &[&str]| {
+        let mut scene = load_scene(&common::assets(), "kleinian_star_glow").unwrap();
+        for s in sets {
+            scene.set_from_str(s).unwrap();
+        }
+        let mut inst = SceneInstance::new(&gpu, &common::assets(), scene, SIZE).unwrap();
+        let mut clock = FixedClock::new(1.0 / 60.0, 1);
+        let mut seen = Vec::new();
+        for _ in 0..90 {
+            inst.advance(&clock.now());
+            clock.step();
+            let (glow, limit_set) = (inst.params(1), inst.params(0));
+            seen.push((glow.float("angle"), limit_set.vec2("t")));
+        }
+        seen
+    };
+    let free = run(&[]);
+    assert!(free.iter().any(|&(angle, _)| angle > 5.0), "the LFO turns the streaks");
+    let held = run(&["glow.angle=0", "limit_set.t.x=1.95"]);
+    assert!(held.iter().all(|&(angle, t)| angle == 0.0 && t[0] == 1.95), "the given values hold");
+    let ys: Vec<f32> = held.iter().map(|&(_, t)| t[1]).collect();
+    assert!(ys.windows(2).any(|w| w[0] != w[1]), "the track on the other component still plays");
+}
