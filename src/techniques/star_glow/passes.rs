@@ -84,7 +84,8 @@ impl Plan {
         }
         let small =
             TextureDesc { extent: Extent::Relative(1, self.base.divide), format: FORMAT, layers: None, samples: 1 };
-        if self.auto && self.scan_applies(small.extent.resolve(graph.output_size())) {
+        let small_size = small.extent.resolve(graph.output_size());
+        if self.auto && self.scan_applies(small_size) {
             self.layout = Layout::Scan;
         }
         let mut passes = Vec::new();
@@ -94,7 +95,7 @@ impl Plan {
         let glow = match self.layout {
             Layout::Book => self.book(node, graph, small, bright, &mut passes),
             Layout::Fused => self.fused(node, graph, small, bright, &mut passes),
-            Layout::Scan => self.scan(node, graph, small, bright, &mut passes),
+            Layout::Scan => self.scan(node, graph, (small, small_size), bright, &mut passes),
         };
         let out = graph.create_texture("star_glow/image", TextureDesc::full(FORMAT));
         let reads = [(Binding::TexA, source), (Binding::TexB, glow)];
@@ -145,12 +146,13 @@ impl Plan {
         acc.expect("at least one streak")
     }
 
-    /// One scan per line and direction into a layered texture, then the accumulation.
+    /// One scan per line and direction into a layered texture, then the accumulation; `small`
+    /// with its size at this output.
     fn scan<'k>(
         &self,
         node: &'k StarGlow,
         graph: &mut FrameGraph<'_>,
-        small: TextureDesc,
+        (small, (w, h)): (TextureDesc, (u32, u32)),
         bright: TextureHandle,
         passes: &mut Vec<PassSpec<'k>>,
     ) -> TextureHandle {
@@ -162,7 +164,6 @@ impl Plan {
             self.spec("star_glow/scan", &k.streak_scan, &[(Binding::TexA, bright)], (Binding::DstLayers, streaks), 1.0);
         spec.uniforms.power = taps;
         // One workgroup per line (rows for the x streaks, columns for the y streaks).
-        let (w, h) = small.extent.resolve(graph.output_size());
         spec.threads = Some([SCAN_WIDTH * w.max(h), self.streaks, 1]);
         passes.push(spec);
         let glow = graph.create_texture("star_glow/glow", small);
