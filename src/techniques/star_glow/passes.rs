@@ -325,3 +325,61 @@ impl StarGlow {
             .clone()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::ParamSet;
+
+    /// A plan with the book's defaults (4 streaks at 0°, 5 iterations) and `step_scale`.
+    fn book_plan(step_scale: f32) -> Plan {
+        let mut plan = Plan::new(&Settings::read(&ParamSet::new(Settings::decls())));
+        plan.step_scale = step_scale;
+        plan
+    }
+
+    #[test]
+    fn the_scan_takes_the_book_defaults_at_1080p_and_4k_only() {
+        // Divide 3: 1080p's intermediates are 640×360 at step 1, 4K's 1280×720 at step 2; 1440p
+        // steps 4/3 of a texel, so its taps fall between texels.
+        assert!(book_plan(1.0).scan_applies((640, 360)));
+        assert!(book_plan(2.0).scan_applies((1280, 720)));
+        assert!(!book_plan(1440.0 / 1080.0).scan_applies((854, 480)));
+        assert!(!book_plan(0.5).scan_applies((320, 180)));
+    }
+
+    #[test]
+    fn the_scan_stops_at_the_shaders_limits() {
+        // Lines up to SCAN_MAX_LINE texels: the shader holds that many in registers.
+        assert!(book_plan(4.0).scan_applies((SCAN_MAX_LINE, 1440)));
+        assert!(!book_plan(4.0).scan_applies((SCAN_MAX_LINE + 1, 1440)));
+        assert!(!book_plan(4.0).scan_applies((2560, SCAN_MAX_LINE + 1)));
+        // Steps up to SCAN_MAX_STEP texels.
+        assert!(book_plan(SCAN_MAX_STEP).scan_applies((640, 360)));
+        assert!(!book_plan(SCAN_MAX_STEP + 1.0).scan_applies((640, 360)));
+        // The limits are the shader's own.
+        let shader = include_str!("star_glow.wgsl");
+        assert!(shader.contains(&format!("const SCAN_WIDTH: u32 = {SCAN_WIDTH}u;")));
+        assert!(shader.contains(&format!("const SCAN_MAX_CHUNKS: u32 = {}u;", SCAN_MAX_LINE / SCAN_WIDTH)));
+    }
+
+    #[test]
+    fn the_scan_needs_taps_past_the_line_and_streaks_on_the_axes() {
+        // Two iterations at step 1 reach 16 texels: a line of 16 is covered, one of 17 is not.
+        let mut plan = book_plan(1.0);
+        plan.iteration = 2;
+        assert!(plan.scan_applies((16, 16)));
+        assert!(!plan.scan_applies((17, 16)));
+        assert!(!plan.scan_applies((16, 17)));
+        // Any multiple of 90° keeps the streaks on the axes; anything else does not.
+        for (angle, on_axes) in [(90.0, true), (270.0, true), (360.0, true), (45.0, false), (0.01, false)] {
+            let mut plan = book_plan(1.0);
+            plan.angle = angle;
+            assert_eq!(plan.scan_applies((640, 360)), on_axes, "angle {angle}");
+        }
+        // Six streaks are 60° apart: four of them are diagonal.
+        let mut plan = book_plan(1.0);
+        plan.streaks = 6;
+        assert!(!plan.scan_applies((640, 360)));
+    }
+}
