@@ -167,14 +167,14 @@ fn golden_frames(scene: &str, frames: &[u64], sets: &[&str]) {
     let mut r =
         indra::offscreen::OffscreenRenderer::new(common::gpu(), &common::assets(), s, Some((256, 256)), None, None)
             .unwrap();
-    let last = *frames.iter().max().unwrap();
-    for f in 0..=last {
+    // Seeking steps every frame between without drawing it (the same bytes as drawing them all,
+    // which the seek tests check).
+    for &f in frames {
+        r.seek(f).unwrap();
         let frame = r.render_next().unwrap();
-        if frames.contains(&f) {
-            common::golden_beside(file!(), 0.01, 0.3)
-                .check(&format!("{scene}_f{f:04}"), (256, 256), &frame.rgba)
-                .unwrap_or_else(|e| panic!("{e}"));
-        }
+        common::golden_beside(file!(), 0.01, 0.3)
+            .check(&format!("{scene}_f{f:04}"), (256, 256), &frame.rgba)
+            .unwrap_or_else(|e| panic!("{e}"));
     }
 }
 
