@@ -22,9 +22,20 @@ pub fn assets() -> Assets {
 
 /// Renders frame `frame` of `scene` at `size`.
 pub fn render_scene(scene: Scene, size: (u32, u32), frame: u64) -> RenderedFrame {
+    render_frames(scene, size, &[frame]).pop().expect("one frame")
+}
+
+/// Renders `frames` (ascending) of `scene` at `size` in one run, seeking between them: the frames
+/// between are stepped, not drawn (the same bytes as playing them, which the seek tests check).
+pub fn render_frames(scene: Scene, size: (u32, u32), frames: &[u64]) -> Vec<RenderedFrame> {
     let mut r = OffscreenRenderer::new(gpu(), &assets(), scene, Some(size), None, None).expect("scene builds");
-    r.seek(frame).expect("seek reaches the frame");
-    r.render_next().expect("frame renders")
+    frames
+        .iter()
+        .map(|&frame| {
+            r.seek(frame).expect("seek reaches the frame");
+            r.render_next().expect("frame renders")
+        })
+        .collect()
 }
 
 /// Renders a bundled scene by name.

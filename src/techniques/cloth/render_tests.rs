@@ -164,14 +164,7 @@ fn golden_frames(scene: &str, frames: &[u64], sets: &[&str]) {
     for set in sets {
         s.set_from_str(set).unwrap();
     }
-    let mut r =
-        indra::offscreen::OffscreenRenderer::new(common::gpu(), &common::assets(), s, Some((256, 256)), None, None)
-            .unwrap();
-    // Seeking steps every frame between without drawing it (the same bytes as drawing them all,
-    // which the seek tests check).
-    for &f in frames {
-        r.seek(f).unwrap();
-        let frame = r.render_next().unwrap();
+    for (frame, f) in common::render_frames(s, (256, 256), frames).iter().zip(frames) {
         common::golden_beside(file!(), 0.01, 0.3)
             .check(&format!("{scene}_f{f:04}"), (256, 256), &frame.rgba)
             .unwrap_or_else(|e| panic!("{e}"));
