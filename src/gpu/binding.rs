@@ -4,18 +4,66 @@
 //! number of each resource by name (so layouts and shaders cannot drift apart, also when a
 //! performer edits a shader live).
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use super::ShaderError;
+
+/// Whether parameter blocks are bound as read-only storage buffers instead of uniform buffers
+/// (see [`blocks_in_storage`]).
+static BLOCKS_IN_STORAGE: AtomicBool = AtomicBool::new(false);
+
+/// Whether this process binds its parameter blocks (WGSL `var<uniform>`) as read-only storage
+/// buffers: on Mesa's lavapipe. Its Vulkan driver "inlines" uniform values that steer loops and
+/// branches by compiling a new shader variant at every dispatch that binds such a pipeline —
+/// and keeps every variant until the pipeline is destroyed: Mesa 22.3 (Debian 12) grew by ~33 KB
+/// per dispatch (17 MB/s at 320×180) in StarGlow's fused passes, the tessellation and space
+/// colonization. It inlines only values read from uniform buffers; storage buffers hold the same
+/// bytes in the same layout (the WGSL layout rules are one for both) and are never inlined.
+/// Set once when a device is made ([`super::Gpu`]); every device of a process is the same kind.
+pub fn blocks_in_storage() -> bool {
+    BLOCKS_IN_STORAGE.load(Ordering::Relaxed)
+}
+
+/// Binds parameter blocks as storage from now on (`true`: a lavapipe device was made).
+pub(super) fn set_blocks_in_storage(on: bool) {
+    BLOCKS_IN_STORAGE.store(on, Ordering::Relaxed);
+}
+
+/// The binding type of a parameter block: a uniform buffer, or where [`blocks_in_storage`] a
+/// read-only storage buffer.
+pub fn block_binding(has_dynamic_offset: bool, min_binding_size: Option<wgpu::BufferSize>) -> wgpu::BindingType {
+    let ty = if blocks_in_storage() {
+        wgpu::BufferBindingType::Storage { read_only: true }
+    } else {
+        wgpu::BufferBindingType::Uniform
+    };
+    wgpu::BindingType::Buffer { ty, has_dynamic_offset, min_binding_size }
+}
+
+/// The usages of a parameter block's buffer: bound as a uniform or (lavapipe) a storage buffer,
+/// written from the CPU.
+pub const BLOCK_USAGE: wgpu::BufferUsages =
+    wgpu::BufferUsages::UNIFORM.union(wgpu::BufferUsages::STORAGE).union(wgpu::BufferUsages::COPY_DST);
+
+/// `module` with its uniform globals moved to read-only storage where [`blocks_in_storage`]
+/// (the shader side of [`block_binding`]); otherwise as it is.
+pub fn with_blocks_bound(mut module: naga::Module) -> naga::Module {
+    if blocks_in_storage() {
+        for (_, global) in module.global_variables.iter_mut() {
+            if global.space == naga::AddressSpace::Uniform {
+                global.space = naga::AddressSpace::Storage { access: naga::StorageAccess::LOAD };
+            }
+        }
+    }
+    module
+}
 
 /// A bind-group layout entry for a uniform block of `T` at `binding`.
 pub fn uniform_entry<T>(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: wgpu::BufferSize::new(size_of::<T>() as u64),
-        },
+        ty: block_binding(false, wgpu::BufferSize::new(size_of::<T>() as u64)),
         count: None,
     }
 }
@@ -87,7 +135,7 @@ pub fn uniform_buffer<T>(device: &wgpu::Device, label: &str) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size: size_of::<T>() as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        usage: BLOCK_USAGE,
         mapped_at_creation: false,
     })
 }

@@ -56,11 +56,7 @@ impl Blit {
                 wgpu::BindGroupLayoutEntry {
                     binding: 1,
                     visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
+                    ty: super::block_binding(false, None),
                     count: None,
                 },
             ],
@@ -68,7 +64,7 @@ impl Blit {
         let uniform = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("display_uniform"),
             size: 16,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: super::BLOCK_USAGE,
             mapped_at_creation: false,
         });
         Self { layout, module, pipelines: HashMap::new(), uniform, compute: None }

@@ -128,6 +128,9 @@ impl Gpu {
             }
         });
         log::debug!("adapter: {} ({:?}, {:?})", info.name, info.backend, info.device_type);
+        // Lavapipe compiles and keeps a shader variant per dispatch of values it can inline
+        // from uniform buffers: bind parameter blocks as storage there (see `blocks_in_storage`).
+        super::binding::set_blocks_in_storage(is_lavapipe(&info));
         Ok(Self { instance, adapter, device, queue, uncaptured, lost, options: options.clone() })
     }
 
@@ -200,4 +203,9 @@ async fn pick_adapter(
     let mut usable = usable;
     usable.sort_by_key(rank);
     Ok(usable.remove(0))
+}
+
+/// Whether `info` is Mesa's lavapipe: the CPU Vulkan driver (llvmpipe behind Vulkan).
+fn is_lavapipe(info: &wgpu::AdapterInfo) -> bool {
+    info.backend == wgpu::Backend::Vulkan && info.device_type == wgpu::DeviceType::Cpu
 }

@@ -14,8 +14,9 @@ mod shader;
 mod watchdog;
 
 pub use binding::{
-    buffer_entry, check_bindings, output_image_entry, sampled_texture_entries, storage_entry, texture_entry,
-    uniform_buffer, uniform_entry, wgsl_struct_size,
+    BLOCK_USAGE, block_binding, blocks_in_storage, buffer_entry, check_bindings, output_image_entry,
+    sampled_texture_entries, storage_entry, texture_entry, uniform_buffer, uniform_entry, wgsl_struct_size,
+    with_blocks_bound,
 };
 pub use blit::{Blit, BlitTarget, DISPLAY_FORMAT, display_target};
 pub use cache::{BindGroupCache, DEFAULT_MAX_AGE};

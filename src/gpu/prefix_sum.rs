@@ -56,7 +56,7 @@ impl PrefixSum {
         let info = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("prefix_sum_info"),
             contents: bytemuck::bytes_of(&ScanInfo { len, blocks, _pad: [0; 2] }),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: super::BLOCK_USAGE,
         });
         let sums = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("prefix_sum_block_sums"),

@@ -78,10 +78,13 @@ pub fn compile_wgsl(
 ) -> Result<(wgpu::ShaderModule, naga::Module), ShaderError> {
     let reflection = validate_wgsl(origin, source)?;
     let module = validated(device, origin, || {
-        device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(origin),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        })
+        // On lavapipe the parameter blocks are storage buffers (see `blocks_in_storage`).
+        let source = if super::blocks_in_storage() {
+            wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(super::with_blocks_bound(reflection.clone())))
+        } else {
+            wgpu::ShaderSource::Wgsl(source.into())
+        };
+        device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(origin), source })
     })?;
     Ok((module, reflection))
 }

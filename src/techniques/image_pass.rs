@@ -57,11 +57,7 @@ impl ImageKernel {
             wgpu::BindGroupLayoutEntry {
                 binding: 0,
                 visibility: stage,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: wgpu::BufferSize::new(uniform_size),
-                },
+                ty: crate::gpu::block_binding(false, wgpu::BufferSize::new(uniform_size)),
                 count: None,
             },
             wgpu::BindGroupLayoutEntry {
@@ -108,7 +104,7 @@ impl ImagePass {
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("image_pass_uniforms"),
             size: kernel.uniform_size,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: crate::gpu::BLOCK_USAGE,
             mapped_at_creation: false,
         });
         Self { uniforms, groups: BindGroupCache::new(DEFAULT_MAX_AGE) }

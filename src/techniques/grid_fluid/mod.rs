@@ -122,11 +122,7 @@ impl GridFluid {
         let uniform = wgpu::BindGroupLayoutEntry {
             binding: 0,
             visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: true,
-                min_binding_size: wgpu::BufferSize::new(size_of::<FluidDispatch>() as u64),
-            },
+            ty: crate::gpu::block_binding(true, wgpu::BufferSize::new(size_of::<FluidDispatch>() as u64)),
             count: None,
         };
         let fields = crate::gpu::storage_entry(1, wgpu::ShaderStages::COMPUTE, false);
@@ -220,7 +216,7 @@ fn uniform_blocks(device: &wgpu::Device, blocks: u64) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("grid_fluid_dispatches"),
         size: blocks * BLOCK,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        usage: crate::gpu::BLOCK_USAGE,
         mapped_at_creation: false,
     })
 }

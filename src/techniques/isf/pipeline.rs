@@ -49,11 +49,7 @@ pub fn build_pipelines(device: &wgpu::Device, origin: &str, compiled: &Compiled)
         wgpu::BindGroupLayoutEntry {
             binding: UNIFORM_BINDING,
             visibility,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: wgpu::BufferSize::new(u64::from(compiled.program.uniforms.size)),
-            },
+            ty: crate::gpu::block_binding(false, wgpu::BufferSize::new(u64::from(compiled.program.uniforms.size))),
             count: None,
         },
         wgpu::BindGroupLayoutEntry {
@@ -68,7 +64,7 @@ pub fn build_pipelines(device: &wgpu::Device, origin: &str, compiled: &Compiled)
     let module = |m: &naga::Module, label: &str| {
         device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(label),
-            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(m.clone())),
+            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(crate::gpu::with_blocks_bound(m.clone()))),
         })
     };
     let by_format = crate::gpu::validated(device, origin, || {

@@ -59,11 +59,7 @@ impl Kernels {
         let mut entries = vec![wgpu::BindGroupLayoutEntry {
             binding: 0,
             visibility: compute,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: true,
-                min_binding_size: wgpu::BufferSize::new(size_of::<GrowthUniforms>() as u64),
-            },
+            ty: crate::gpu::block_binding(true, wgpu::BufferSize::new(size_of::<GrowthUniforms>() as u64)),
             count: None,
         }];
         entries.extend((1..=9).map(storage));

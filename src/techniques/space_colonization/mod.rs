@@ -161,7 +161,7 @@ fn uniform_blocks(device: &wgpu::Device, blocks: u64) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("sc_growth_uniforms"),
         size: blocks.max(1) * BLOCK,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        usage: crate::gpu::BLOCK_USAGE,
         mapped_at_creation: false,
     })
 }
