@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use super::spares::Build;
+use super::spares::{Build, Finished};
 use super::state::Clock;
 use super::{ClipPolicy, Mixer, Show, ShowState, Spares};
 use crate::assets::Assets;
@@ -131,8 +131,8 @@ impl ShowRuntime {
         nodes: &mut [Box<dyn Technique>],
     ) -> Vec<String> {
         let mut messages = Vec::new();
-        for (clip, result) in self.spares.finished() {
-            self.install(clip, result, nodes, &mut messages);
+        for done in self.spares.finished() {
+            self.install(done, nodes, &mut messages);
         }
         let clock = Clock { frame: time.frame, seconds: time.seconds, beats };
         let changes = self.state.step(&self.plan, clock);
@@ -144,9 +144,10 @@ impl ShowRuntime {
                 None => log::info!("frame {}: layer {} '{name}' is empty", time.frame, layer + 1),
             }
         }
+        let wait = self.assets.load_wait();
         for &c in &changes.started {
             let (plan, gpu, assets, size) = (&self.plan, &self.gpu, &self.assets, self.output_size);
-            let result = self.spares.take_for_start(c, || clip_build(plan, gpu, assets, size, c, scene, params));
+            let result = self.spares.take_for_start(c, wait, || clip_build(plan, gpu, assets, size, c, scene, params));
             match result {
                 Ok(Some(fresh)) => self.swap_in(c, fresh, nodes),
                 Ok(None) => {}
@@ -217,23 +218,21 @@ impl ShowRuntime {
     ) {
         let build = self.build(clip, scene, params);
         if let Some(result) = self.spares.prepare(clip, build, self.assets.load_wait()) {
-            self.install(clip, result, nodes, messages);
+            self.install(Finished { clip, result, restart: false }, nodes, messages);
         }
     }
 
-    fn install(
-        &mut self,
-        clip: usize,
-        result: Result<Vec<Box<dyn Technique>>, ShaderError>,
-        nodes: &mut [Box<dyn Technique>],
-        messages: &mut Vec<String>,
-    ) {
-        match result {
+    fn install(&mut self, done: Finished, nodes: &mut [Box<dyn Technique>], messages: &mut Vec<String>) {
+        let clip = done.clip;
+        match done.result {
             Ok(fresh) if !self.state.visible(clip) => {
                 self.swap_in(clip, fresh, nodes);
                 self.spares.mark_fresh(clip);
             }
-            // Triggered while it was built: the trigger took its own copy.
+            // Retriggered while it was built: it restarts on these nodes from now (its clock
+            // restarted at the trigger); they run, so the slot stays stale.
+            Ok(fresh) if done.restart => self.swap_in(clip, fresh, nodes),
+            // Shown again while it was built, without a restart: it plays on.
             Ok(_) => {}
             Err(e) => messages.push(format!("clip '{}' could not be prepared: {e}", self.plan.clips[clip].id)),
         }

@@ -2,9 +2,14 @@
 //! its first frame the moment it is triggered, but building its nodes (pipelines, buffers) takes
 //! up to seconds for the costly scenes. So when a restart clip leaves the screen, a fresh copy is
 //! built — on a worker thread in a live show, at once in renders — and swapped in while it is
-//! hidden; the trigger then finds it ready. Only retriggering the clip that is playing, or a
-//! trigger within moments of its leaving, waits for a build.
+//! hidden; the trigger then finds it ready. In a live show the render thread never builds nor
+//! waits: retriggering the clip that is playing, or a trigger within moments of its leaving,
+//! restarts the clip's clock at once and swaps its fresh nodes in when their build is done (a
+//! few frames later); at most [`MAX_BUILDS_IN_FLIGHT`] builds run at once, one per clip, and the
+//! rest wait in line, so a flood of triggers costs a bounded number of threads and buffers.
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc;
 
 use crate::assets::Assets;
@@ -55,29 +60,51 @@ impl Build {
     }
 }
 
-/// Where a clip's fresh copy stands.
+/// Clip builds running on worker threads at once, over the whole show. A build holds a clip's
+/// pipelines and buffers while it runs, so this also bounds what a trigger flood allocates.
+pub const MAX_BUILDS_IN_FLIGHT: usize = 2;
+
+/// Where a clip's fresh copy stands. `restart` marks a copy the clip waits for while it plays
+/// (it was retriggered meanwhile): it is swapped in on arrival, on screen or not.
 enum Slot {
     /// The clip's nodes have not run since they were built.
     Fresh,
     /// They have run; no copy is on its way.
     Stale,
+    /// A copy waits for a place among the builds in flight.
+    Queued { build: Box<Build>, restart: bool },
     /// A copy is being built on a worker thread.
-    Building(mpsc::Receiver<Result<Nodes, ShaderError>>),
+    Building { receive: mpsc::Receiver<Result<Nodes, ShaderError>>, restart: bool },
+}
+
+/// A finished copy: its clip, the nodes (or why not), and whether the clip waits for it while
+/// it plays.
+pub struct Finished {
+    /// The clip.
+    pub clip: usize,
+    /// Its fresh nodes, or the build's error.
+    pub result: Result<Nodes, ShaderError>,
+    /// Swap it in even on screen: the clip was retriggered while it was built.
+    pub restart: bool,
 }
 
 /// One slot per clip of the show.
 pub struct Spares {
     slots: Vec<Slot>,
+    /// Builds running on worker threads (each thread counts itself out when it ends, so a
+    /// copy dropped by a reload still holds its place until its thread is done).
+    in_flight: Arc<AtomicUsize>,
 }
 
 impl Spares {
     /// Every clip fresh (just built).
     pub fn new(clips: usize) -> Self {
-        Self { slots: (0..clips).map(|_| Slot::Fresh).collect() }
+        Self { slots: (0..clips).map(|_| Slot::Fresh).collect(), in_flight: Arc::default() }
     }
 
-    /// Starts building a fresh copy of `clip` (it just left the screen): at once when `wait` is
-    /// [`LoadWait::Finish`] (renders, tests), else on a worker thread. Returns nodes built at once.
+    /// Starts a fresh copy of `clip` (it just left the screen): built at once when `wait` is
+    /// [`LoadWait::Finish`] (renders, tests), else queued for a worker thread. Returns nodes
+    /// built at once.
     pub fn prepare(&mut self, clip: usize, build: Build, wait: LoadWait) -> Option<Result<Nodes, ShaderError>> {
         let slot = self.slots.get_mut(clip)?;
         if !matches!(slot, Slot::Stale) {
@@ -86,18 +113,9 @@ impl Spares {
         if wait == LoadWait::Finish {
             return Some(build.run());
         }
-        let (send, receive) = mpsc::channel();
-        let spawned = std::thread::Builder::new().name("indra-clip-prepare".into()).spawn(move || {
-            let _ = send.send(build.run());
-        });
-        match spawned {
-            Ok(_) => {
-                *slot = Slot::Building(receive);
-                None
-            }
-            // No thread to be had: the clip restarts from its running state.
-            Err(_) => Some(Err(failure("no thread to prepare a clip on"))),
-        }
+        *slot = Slot::Queued { build: Box::new(build), restart: false };
+        self.launch();
+        None
     }
 
     /// Marks `clip`'s nodes as fresh (a copy was just swapped in).
@@ -107,43 +125,95 @@ impl Spares {
         }
     }
 
-    /// Marks every clip stale (its nodes ran, or were rebuilt for another device).
+    /// Marks `clip` stale (its nodes ran, or were rebuilt for another device); a copy on its way
+    /// is dropped.
     pub fn mark_stale(&mut self, clip: usize) {
         if let Some(slot) = self.slots.get_mut(clip) {
             *slot = Slot::Stale;
         }
     }
 
-    /// Copies finished on worker threads since the last call: (clip, nodes or error).
-    pub fn finished(&mut self) -> Vec<(usize, Result<Nodes, ShaderError>)> {
+    /// Builds in flight now (for tests and the soak's report).
+    pub fn in_flight(&self) -> usize {
+        self.in_flight.load(Ordering::Relaxed)
+    }
+
+    /// Copies finished on worker threads since the last call; queued copies take the places
+    /// that freed.
+    pub fn finished(&mut self) -> Vec<Finished> {
         let mut done = Vec::new();
         for (clip, slot) in self.slots.iter_mut().enumerate() {
-            if let Slot::Building(receive) = slot {
-                match receive.try_recv() {
-                    Ok(result) => done.push((clip, result)),
-                    Err(mpsc::TryRecvError::Empty) => continue,
-                    Err(mpsc::TryRecvError::Disconnected) => {
-                        done.push((clip, Err(failure("a clip's preparation stopped"))));
-                    }
-                }
-                *slot = Slot::Stale;
-            }
+            let Slot::Building { receive, restart } = slot else { continue };
+            let result = match receive.try_recv() {
+                Ok(result) => result,
+                Err(mpsc::TryRecvError::Empty) => continue,
+                Err(mpsc::TryRecvError::Disconnected) => Err(failure("a clip's preparation stopped")),
+            };
+            done.push(Finished { clip, result, restart: *restart });
+            *slot = Slot::Stale;
         }
+        self.launch();
         done
     }
 
-    /// `clip` starts now: `Ok(None)` if its nodes are fresh; else fresh nodes — the copy on its
-    /// way (waited for) or one built now by `build`.
-    pub fn take_for_start(&mut self, clip: usize, build: impl FnOnce() -> Build) -> Result<Option<Nodes>, ShaderError> {
+    /// `clip` starts now. `Ok(None)` when its nodes are fresh, or (live) when its copy is on its
+    /// way: the clip runs on its nodes until [`Spares::finished`] hands the copy over marked
+    /// `restart`. Under [`LoadWait::Finish`] the copy is waited for or built now by `build`.
+    pub fn take_for_start(
+        &mut self,
+        clip: usize,
+        wait: LoadWait,
+        build: impl FnOnce() -> Build,
+    ) -> Result<Option<Nodes>, ShaderError> {
         let Some(slot) = self.slots.get_mut(clip) else { return Ok(None) };
-        let previous = std::mem::replace(slot, Slot::Stale);
-        match previous {
+        if wait == LoadWait::Background {
+            match slot {
+                Slot::Fresh => *slot = Slot::Stale,
+                Slot::Queued { restart, .. } | Slot::Building { restart, .. } => *restart = true,
+                Slot::Stale => {
+                    *slot = Slot::Queued { build: Box::new(build()), restart: true };
+                    self.launch();
+                }
+            }
+            return Ok(None);
+        }
+        match std::mem::replace(slot, Slot::Stale) {
             Slot::Fresh => Ok(None),
-            Slot::Building(receive) => match receive.recv() {
+            Slot::Building { receive, .. } => match receive.recv() {
                 Ok(result) => result.map(Some),
                 Err(_) => build().run().map(Some),
             },
+            Slot::Queued { build, .. } => build.run().map(Some),
             Slot::Stale => build().run().map(Some),
+        }
+    }
+
+    /// Starts queued copies on worker threads while fewer than [`MAX_BUILDS_IN_FLIGHT`] run.
+    fn launch(&mut self) {
+        for slot in &mut self.slots {
+            if self.in_flight.load(Ordering::Relaxed) >= MAX_BUILDS_IN_FLIGHT {
+                return;
+            }
+            if !matches!(slot, Slot::Queued { .. }) {
+                continue;
+            }
+            let Slot::Queued { build, restart } = std::mem::replace(slot, Slot::Stale) else { continue };
+            let (send, receive) = mpsc::channel();
+            let in_flight = self.in_flight.clone();
+            in_flight.fetch_add(1, Ordering::Relaxed);
+            let spawned = std::thread::Builder::new().name("indra-clip-prepare".into()).spawn(move || {
+                let _ = send.send(build.run());
+                in_flight.fetch_sub(1, Ordering::Relaxed);
+            });
+            if spawned.is_err() {
+                // No thread to be had: the clip runs on from its state; told when it ends.
+                self.in_flight.fetch_sub(1, Ordering::Relaxed);
+                let (send, failed) = mpsc::channel();
+                let _ = send.send(Err(failure("no thread to prepare a clip on")));
+                *slot = Slot::Building { receive: failed, restart };
+                continue;
+            }
+            *slot = Slot::Building { receive, restart };
         }
     }
 }

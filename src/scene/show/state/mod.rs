@@ -81,6 +81,8 @@ pub struct ShowState {
     layers: Vec<LayerState>,
     pending: Vec<Pending>,
     requests: Vec<ShowCommand>,
+    /// Commands dropped since the last step (past [`MAX_COMMANDS_PER_STEP`]).
+    dropped: usize,
     cue: Option<usize>,
     cue_since: Clock,
     /// Per clip: the frame its own clock starts at (restart clips; 0 for the others).
@@ -96,6 +98,7 @@ impl ShowState {
             layers: vec![LayerState::default(); show.layers.len()],
             pending: Vec::new(),
             requests: Vec::new(),
+            dropped: 0,
             cue: None,
             cue_since: Clock::default(),
             started: vec![0; show.clips.len()],
@@ -118,8 +121,30 @@ impl ShowState {
         if !ok {
             return Err(format!("{command:?}: the show has no such layer, clip, column or cue"));
         }
-        self.requests.push(command);
+        match command {
+            // A column is its layers' triggers, so that they coalesce with the others.
+            ShowCommand::Column(n) => {
+                for layer in (0..show.layers.len()).filter(|&l| show.clip_at(l, n).is_some()) {
+                    self.queue(ShowCommand::Trigger { layer, clip: Some(n) });
+                }
+            }
+            command => self.queue(command),
+        }
         Ok(())
+    }
+
+    /// Queues `command` for the next step. Of the triggers one layer gets in a step only the
+    /// last counts (any earlier one is dropped: the layer would have left it in the same step),
+    /// and at most [`MAX_COMMANDS_PER_STEP`] commands wait; the rest are dropped and counted.
+    fn queue(&mut self, command: ShowCommand) {
+        if let ShowCommand::Trigger { layer, .. } = command {
+            self.requests.retain(|r| !matches!(r, ShowCommand::Trigger { layer: l, .. } if *l == layer));
+        }
+        if self.requests.len() < MAX_COMMANDS_PER_STEP {
+            self.requests.push(command);
+        } else {
+            self.dropped += 1;
+        }
     }
 
     /// The current cue, if one has gone.
@@ -179,6 +204,12 @@ impl ShowState {
                 self.go_cue(show, 0, clock, &mut changes);
             }
         }
+        if self.dropped > 0 {
+            let dropped = std::mem::take(&mut self.dropped);
+            changes
+                .messages
+                .push(format!("{dropped} show commands past {MAX_COMMANDS_PER_STEP} in one frame were dropped"));
+        }
         for command in std::mem::take(&mut self.requests) {
             match command {
                 ShowCommand::Trigger { layer, clip } => {
@@ -211,6 +242,9 @@ impl ShowState {
             }
         }
         changes.hidden = (0..show.clips.len()).filter(|&c| before[c] && !self.visible(c)).collect();
+        // A clip started twice in one step (two cues that retrigger it) needs one fresh copy.
+        changes.started.sort_unstable();
+        changes.started.dedup();
         changes
     }
 
@@ -335,6 +369,10 @@ impl ShowState {
         }
     }
 }
+
+/// Show commands one step takes at most, after triggers coalesce per layer: a flood of cue
+/// commands past it is dropped, not queued.
+pub const MAX_COMMANDS_PER_STEP: usize = 64;
 
 /// Beats in a bar (4/4, as Ableton Link's default quantum).
 pub const BEATS_PER_BAR: f64 = 4.0;

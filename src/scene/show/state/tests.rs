@@ -138,3 +138,48 @@ fn a_column_triggers_one_clip_per_layer_and_bad_numbers_are_refused() {
     assert!(state.request(&show, ShowCommand::Trigger { layer: 2, clip: None }).is_err());
     assert!(state.request(&show, ShowCommand::CueGo).is_err(), "no cues");
 }
+
+#[test]
+fn a_flood_of_triggers_on_a_layer_is_one_switch_to_the_last() {
+    let cut = Transition { kind: None, length: Length::Seconds(0.0), quantize: Quantize::Off };
+    let show = show(cut, Vec::new());
+    let mut state = ShowState::new(&show);
+    state.step(&show, clock(0));
+    // A 1,000-message bundle retriggering the playing clip: one restart, not a thousand.
+    for _ in 0..1000 {
+        state.request(&show, ShowCommand::Trigger { layer: 0, clip: Some(0) }).unwrap();
+    }
+    let changes = state.step(&show, clock(1));
+    assert_eq!((changes.started, changes.switched.len()), (vec![0], 1));
+    // Alternating clips: the last one wins, and the other layer's trigger stays.
+    for i in 0..1001 {
+        state.request(&show, ShowCommand::Trigger { layer: 0, clip: Some(i % 2) }).unwrap();
+        if i == 500 {
+            state.request(&show, ShowCommand::Trigger { layer: 1, clip: Some(0) }).unwrap();
+        }
+    }
+    let changes = state.step(&show, clock(2));
+    assert_eq!(changes.switched, [(1, Some(2)), (0, Some(0))]);
+    assert_eq!(changes.started, [0]);
+    // A column is its layers' triggers: a later trigger on one layer replaces its part.
+    state.request(&show, ShowCommand::Column(0)).unwrap();
+    state.request(&show, ShowCommand::Trigger { layer: 0, clip: Some(1) }).unwrap();
+    state.step(&show, clock(3));
+    assert_eq!((state.playing(0), state.playing(1)), (Some(1), Some(2)));
+}
+
+#[test]
+fn cue_commands_past_the_cap_in_one_step_are_dropped_and_told() {
+    let cue = Cue { name: String::new(), column: None, clips: vec![(0, Some(1))], transition: None, hold: None };
+    let show = show(fade(1.0, Quantize::Off), vec![cue.clone(), cue]);
+    let mut state = ShowState::new(&show);
+    state.step(&show, clock(0));
+    for _ in 0..10_000 {
+        state.request(&show, ShowCommand::CueGo).unwrap();
+    }
+    assert_eq!(state.requests.len(), MAX_COMMANDS_PER_STEP);
+    let changes = state.step(&show, clock(1));
+    let told = format!("{} show commands past {MAX_COMMANDS_PER_STEP}", 10_000 - MAX_COMMANDS_PER_STEP);
+    assert!(changes.messages.iter().any(|m| m.starts_with(&told)), "{:?}", changes.messages);
+    assert!(state.step(&show, clock(2)).messages.is_empty(), "told once");
+}
