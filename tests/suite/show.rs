@@ -385,6 +385,11 @@ fn a_broken_clip_is_left_out_and_the_rest_plays() {
     assert!(before.chunks(4).any(|p| p[0] > 100), "the good clip is not on screen");
 }
 
+/// A layer of `n` clips, each of its own id, as a show file writes them.
+fn crowded_layer(n: usize) -> String {
+    (0..n).map(|i| format!(r#"(scene: "kleinian_classic", id: "c{i}")"#)).collect::<Vec<_>>().join(", ")
+}
+
 #[test]
 fn a_show_refuses_what_it_cannot_play_with_located_errors() {
     let cases = [
@@ -393,6 +398,9 @@ fn a_show_refuses_what_it_cannot_play_with_located_errors() {
         (TWO_COLOURS.replace(r#"id: "blue""#, r#"id: "layer""#), "reserved"),
         (TWO_COLOURS.replace("layers: [(clips", r#"cues: [(clips: [(2, 1)])], layers: [(clips"#), "layer 2"),
         (TWO_COLOURS.replace("layers: [(clips", r#"layers: [(blend: "overlay", clips"#), "blend 'overlay'"),
+        // A layer past the clip cap after a good one: it was skipped, and the blend nodes were
+        // then indexed by the file's layer number (a panic that took a reloading show down).
+        (TWO_COLOURS.replace("    ])],", &format!("    ]), (clips: [{}])],", crowded_layer(65))), "65 clips"),
     ];
     for (text, expected) in cases {
         let e = parse_show(&assets(), "bad.ron", &text, false).err().map(|e| e.to_string()).unwrap_or_default();

@@ -98,11 +98,14 @@ impl Builder<'_> {
         let mut ids = BTreeSet::new();
         for (l, layer) in file.layers.iter().enumerate() {
             let anchor = ["layers", "clips"];
+            let name = if layer.name.is_empty() { format!("layer {}", l + 1) } else { layer.name.clone() };
             if layer.clips.len() > MAX_CLIPS_PER_LAYER {
                 self.error(
                     &anchor,
                     format!("layer {} has {} clips; at most {MAX_CLIPS_PER_LAYER}", l + 1, layer.clips.len()),
                 );
+                // The layer stays, empty, so that every later index by layer holds.
+                layers.push(Layer { name, node: usize::MAX, clips: Vec::new(), start: None });
                 continue;
             }
             let layer_transition = match &layer.transition {
@@ -188,12 +191,7 @@ impl Builder<'_> {
                 None if file.cues.is_empty() && !in_layer.is_empty() => Some(0),
                 None => None,
             };
-            layers.push(Layer {
-                name: if layer.name.is_empty() { format!("layer {}", l + 1) } else { layer.name.clone() },
-                node: usize::MAX,
-                clips: in_layer,
-                start,
-            });
+            layers.push(Layer { name, node: usize::MAX, clips: in_layer, start });
         }
         if nodes.len() + layers.len() + 1 > MAX_NODES {
             let message = format!("the clips have {} nodes in all; a show may have at most {MAX_NODES}", nodes.len());
