@@ -55,7 +55,9 @@ pub fn compile(sources: &Sources<'_>) -> Result<Compiled, ShaderError> {
 
 /// The size expressions of every pass, evaluated at 1920×1080 with the inputs' defaults: one
 /// that does not parse, names an unknown variable, or gives 0, a negative or a non-finite
-/// number is refused with the file (the node checks again each frame, against the device).
+/// number is refused with the file, and so are targets that take more than
+/// [`MAX_NODE_TARGET_BYTES`](super::targets::MAX_NODE_TARGET_BYTES) together (the node checks
+/// again at its render size, against the device).
 fn check_sizes(header: &Header) -> Result<(), String> {
     let defaults: Vec<(String, f64)> =
         header.inputs.iter().filter_map(|i| Some((i.name.clone(), i.number(i.decl()?.default)?))).collect();
@@ -64,17 +66,11 @@ fn check_sizes(header: &Header) -> Result<(), String> {
         "HEIGHT" => Some(1080.0),
         _ => defaults.iter().find(|(n, _)| n == name).map(|d| d.1),
     };
-    for (i, pass) in header.passes.iter().enumerate() {
-        for (axis, text) in [("WIDTH", &pass.width), ("HEIGHT", &pass.height)] {
-            let Some(text) = text else { continue };
-            let v = super::expr::evaluate(text, &var).map_err(|e| format!("{axis} of pass {i}: {e}"))?;
-            if !v.is_finite() || v <= 0.0 || v > 65_536.0 {
-                return Err(format!("{axis} of pass {i}, '{text}', is {v} at 1920×1080; it must be a size in pixels"));
-            }
-        }
-    }
-    Ok(())
+    super::targets::pass_sizes(&header.passes, (1920, 1080), CHECK_MAX_SIDE, &var).map(|_| ())
 }
+
+/// The largest side a pass may ask for where no device is at hand (what desktop GPUs allow).
+const CHECK_MAX_SIDE: u32 = 16_384;
 
 fn stage_module(origin: &str, stage: &Stage, kind: naga::ShaderStage) -> Result<naga::Module, ShaderError> {
     let relocate = |mut e: ShaderError| {

@@ -159,12 +159,19 @@ impl Header {
         };
         if let Some(inputs) = top.get("INPUTS") {
             let list = inputs.as_array().ok_or_else(|| (at("INPUTS"), "INPUTS must be a list".to_string()))?;
+            if list.len() > MAX_INPUTS {
+                return Err((at("INPUTS"), format!("{} INPUTS; at most {MAX_INPUTS}", list.len())));
+            }
+            let mut names = std::collections::HashSet::new();
             for item in list {
-                let name = item.get("NAME").and_then(Value::as_str).unwrap_or_default();
-                let line = first_line + json.find(&format!("\"{name}\"")).map_or(0, |i| line_of(json, i) - 1);
-                let input = parse_input(item).map_err(|m| (line, m))?;
-                if header.inputs.iter().any(|i| i.name == input.name) {
-                    return Err((line, format!("input '{}' is declared twice", input.name)));
+                // Located only on error: a search of the text per input made a long header quadratic.
+                let line = || {
+                    let name = item.get("NAME").and_then(Value::as_str).unwrap_or_default();
+                    first_line + json.find(&format!("\"{name}\"")).map_or(0, |i| line_of(json, i) - 1)
+                };
+                let input = parse_input(item).map_err(|m| (line(), m))?;
+                if !names.insert(input.name.clone()) {
+                    return Err((line(), format!("input '{}' is declared twice", input.name)));
                 }
                 header.inputs.push(input);
             }
@@ -231,6 +238,10 @@ impl Input {
         })
     }
 }
+
+/// The most inputs a shader may declare: each is a parameter on the panel, OSC and MIDI, and a
+/// field of the uniform block (Vidvox's 64 declare at most 17).
+pub const MAX_INPUTS: usize = 256;
 
 /// The longest input name indra takes (names become OSC addresses and GLSL identifiers).
 const MAX_NAME: usize = 64;

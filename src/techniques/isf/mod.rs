@@ -23,6 +23,7 @@ mod pipeline;
 #[cfg(test)]
 mod render_tests;
 mod sound;
+pub mod targets;
 pub mod translate;
 
 use crate::assets::Assets;

@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 
 use super::compile::Compiled;
-use super::header::{InputKind, Pass};
+use super::header::InputKind;
 use super::pipeline::{BYTE_FORMAT, FLOAT_FORMAT, FormatKey, OUTPUT_FORMAT, Pipeline, Pipelines, build_pipelines};
 use super::sound::{AUDIO_WIDTH, AudioTexture};
 use super::translate::{FIRST_TEXTURE_BINDING, SAMPLER_BINDING, TextureSource, UNIFORM_BINDING, storage_binding};
@@ -16,10 +16,6 @@ use crate::params::{AudioSnapshot, ParamSet, ParamValue};
 use crate::techniques::image_pass::{self, ImageKernel, ImagePass};
 use crate::techniques::{NodeSetup, Technique};
 use crate::time::FrameTime;
-
-/// The most texture memory one node's pass targets may take (a size expression that asks for
-/// more is refused): an eighth of the scene's whole budget.
-pub const MAX_TARGET_BYTES: u64 = 1 << 30;
 
 /// The largest imported image file read.
 const IMPORTED_FILE_LIMIT: u64 = 64 << 20;
@@ -79,6 +75,9 @@ pub struct IsfNode {
     messages: Vec<String>,
     /// The last size-expression problem told, so it is told once.
     size_problem: Option<String>,
+    /// The pass sizes of the last frame whose sizes were good: what the passes keep while a
+    /// live value asks for sizes that cannot be made.
+    sizes: Vec<(u32, u32)>,
     /// Per input: whether an event fired in the latest step (triggers are seen in the step they
     /// fire in; the frame drawn after it shows them).
     fired: Vec<bool>,
@@ -101,7 +100,7 @@ impl IsfNode {
                 uniforms: device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some(&format!("{}/pass{i}/uniforms", setup.id)),
                     size: u64::from(compiled.program.uniforms.size),
-                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    usage: crate::gpu::BLOCK_USAGE,
                     mapped_at_creation: false,
                 }),
                 groups: BindGroupCache::new(DEFAULT_MAX_AGE),
@@ -164,18 +163,20 @@ impl IsfNode {
             id: setup.id.to_string(),
             messages: Vec::new(),
             size_problem: None,
+            sizes: Vec::new(),
             fired: Vec::new(),
         };
         node.fired = vec![false; node.compiled.header.inputs.len()];
-        // A size expression that fails with the defaults fails the node (a located error).
-        for pass in &node.compiled.header.passes {
-            node.pass_size(pass, setup.params, setup.output_size).map_err(|message| ShaderError {
-                origin: origin.to_string(),
-                line: 1,
-                column: 1,
-                message,
-            })?;
+        let fail = |message: String| ShaderError { origin: origin.to_string(), line: 1, column: 1, message };
+        // A block past the device's limit would fail validation every frame: refuse it here.
+        let block = u64::from(node.compiled.program.uniforms.size);
+        let limit = device.limits().max_uniform_buffer_binding_size;
+        if block > limit {
+            return Err(fail(format!("the inputs need a {block}-byte uniform block; this GPU binds at most {limit}")));
         }
+        // Sizes that fail with the defaults, or targets too large together, fail the node (a
+        // located error; a reload keeps the last good version).
+        node.sizes = node.pass_sizes(setup.params, setup.output_size).map_err(fail)?;
         node.import_images(setup, files)?;
         Ok(node)
     }
@@ -223,8 +224,9 @@ impl IsfNode {
         }
     }
 
-    /// A pass's size: its expressions over `$WIDTH`, `$HEIGHT` and the inputs, or the render size.
-    fn pass_size(&self, pass: &Pass, params: &ParamSet, output: (u32, u32)) -> Result<(u32, u32), String> {
+    /// Every pass's size: its expressions over `$WIDTH`, `$HEIGHT` and the inputs, or the render
+    /// size; refused past the device's side or the node's target bytes.
+    fn pass_sizes(&self, params: &ParamSet, output: (u32, u32)) -> Result<Vec<(u32, u32)>, String> {
         let var = |name: &str| -> Option<f64> {
             match name {
                 "WIDTH" => Some(f64::from(output.0)),
@@ -236,21 +238,7 @@ impl IsfNode {
             }
         };
         let max_side = self.device.limits().max_texture_dimension_2d;
-        let side = |expression: &Option<String>, full: u32, axis: &str| -> Result<u32, String> {
-            let Some(text) = expression else { return Ok(full) };
-            let v = super::expr::evaluate(text, &var).map_err(|e| format!("{axis} of a pass: {e}"))?;
-            // A fraction of a pixel (a small render of `$WIDTH / 100`) is one pixel, as in GL hosts.
-            if !v.is_finite() || v <= 0.0 || v > f64::from(max_side) {
-                return Err(format!("{axis} of a pass, '{text}', is {v}; it must be above 0 and at most {max_side}"));
-            }
-            Ok(v.max(1.0) as u32)
-        };
-        let size = (side(&pass.width, output.0, "WIDTH")?, side(&pass.height, output.1, "HEIGHT")?);
-        let bytes = crate::graph::texture_bytes(size, if pass.float { FLOAT_FORMAT } else { BYTE_FORMAT });
-        if bytes > MAX_TARGET_BYTES {
-            return Err(format!("a pass of {}×{} takes {bytes} bytes; at most {MAX_TARGET_BYTES}", size.0, size.1));
-        }
-        Ok(size)
+        super::targets::pass_sizes(&self.compiled.header.passes, output, max_side, &var)
     }
 
     /// The uniform block's bytes for one pass.
@@ -356,20 +344,17 @@ impl Technique for IsfNode {
         // The compiled shader is shared, not copied, while the node's state changes below.
         let compiled = std::sync::Arc::clone(&self.compiled);
         let header_passes = &compiled.header.passes;
-        // Sizes first: a bad size (an input driven out of range) keeps the render size, told once.
-        let mut sizes = Vec::with_capacity(header_passes.len());
-        for pass in header_passes {
-            match self.pass_size(pass, params, output) {
-                Ok(size) => sizes.push(size),
-                Err(problem) => {
-                    if self.size_problem.as_ref() != Some(&problem) {
-                        self.messages.push(format!("{}: {problem}; the pass keeps the render size", self.id));
-                        self.size_problem = Some(problem);
-                    }
-                    sizes.push(output);
+        // Sizes first: bad sizes (an input driven out of range) keep the last good ones, told once.
+        match self.pass_sizes(params, output) {
+            Ok(sizes) => self.sizes = sizes,
+            Err(problem) => {
+                if self.size_problem.as_ref() != Some(&problem) {
+                    self.messages.push(format!("{}: {problem}; the passes keep their sizes", self.id));
+                    self.size_problem = Some(problem);
                 }
             }
         }
+        let sizes = self.sizes.clone();
         // Persistent targets, (re)made to their size; both halves imported.
         let mut feedback_handles: BTreeMap<String, [TextureHandle; 2]> = BTreeMap::new();
         for (pass, size) in header_passes.iter().zip(&sizes) {
