@@ -75,8 +75,10 @@ impl VideoTrack {
 pub fn read_video_track(file: &mut (impl Read + Seek), len: u64) -> Result<VideoTrack, String> {
     let moov = find_moov(file, len)?;
     let mut tracks = Atoms::new(&moov).filter(|a| a.kind == *b"trak");
-    let track =
-        tracks.find_map(|trak| parse_track(trak.body).transpose()).transpose()?.ok_or("the file has no video track")?;
+    let track = tracks
+        .find_map(|trak| parse_track(trak.body, len).transpose())
+        .transpose()?
+        .ok_or("the file has no video track")?;
     for sample in &track.samples {
         if sample.offset.checked_add(u64::from(sample.size)).is_none_or(|end| end > len) {
             return Err(format!(
@@ -106,7 +108,8 @@ fn find_moov(file: &mut (impl Read + Seek), len: u64) -> Result<Vec<u8>, String>
             }
             n => (u64::from(n), 8),
         };
-        if size < header || at + size > len {
+        // Checked: a 64-bit size that wraps the offset walked back and forth for ever.
+        if size < header || at.checked_add(size).is_none_or(|end| end > len) {
             return Err(format!(
                 "not a QuickTime/MP4 file, or truncated: the '{}' atom at byte {at} claims {size} bytes of {len}",
                 String::from_utf8_lossy(&kind)
@@ -191,8 +194,8 @@ fn table<'a>(body: &'a [u8], skip: usize, width: usize, what: &str) -> Result<(u
     Ok((count, entries))
 }
 
-/// A `trak` atom's frames, or `None` when it is not a video track.
-fn parse_track(trak: &[u8]) -> Result<Option<VideoTrack>, String> {
+/// A `trak` atom's frames, or `None` when it is not a video track (in a file of `len` bytes).
+fn parse_track(trak: &[u8], len: u64) -> Result<Option<VideoTrack>, String> {
     let missing = |what: &str| format!("its video track has no {what}");
     let Some(mdia) = child(trak, b"mdia") else { return Ok(None) };
     let handler = child(mdia, b"hdlr").and_then(|h| h.get(8..12));
@@ -214,7 +217,7 @@ fn parse_track(trak: &[u8]) -> Result<Option<VideoTrack>, String> {
     let width = u32::from(be16(entry, 32).ok_or("its sample description is damaged")?);
     let height = u32::from(be16(entry, 34).ok_or("its sample description is damaged")?);
 
-    let sizes = sample_sizes(child(stbl, b"stsz").ok_or_else(|| missing("sample size table"))?)?;
+    let sizes = sample_sizes(child(stbl, b"stsz").ok_or_else(|| missing("sample size table"))?, len)?;
     let chunks = chunk_offsets(stbl)?;
     let stsc = child(stbl, b"stsc").ok_or_else(|| missing("sample-to-chunk table"))?;
     let samples = place_samples(&sizes, &chunks, stsc)?;
@@ -222,15 +225,16 @@ fn parse_track(trak: &[u8]) -> Result<Option<VideoTrack>, String> {
     Ok(Some(VideoTrack { codec, width, height, timescale, samples, starts }))
 }
 
-fn sample_sizes(stsz: &[u8]) -> Result<Vec<u32>, String> {
+/// Each frame's size; frames of one uniform size must fit in the file's `len` bytes before a
+/// table of them is made (a 343-byte file claiming 67 million frames took 1.8 GB).
+fn sample_sizes(stsz: &[u8], len: u64) -> Result<Vec<u32>, String> {
     let uniform = be32(stsz, 4).ok_or("its sample size table is damaged")?;
     if uniform != 0 {
-        let count = be32(stsz, 8).ok_or("its sample size table is damaged")? as usize;
-        // A uniform size needs no table, so the count alone is bounded by what a frame can be.
-        if count > (MOOV_LIMIT as usize) {
-            return Err(format!("its sample size table claims {count} frames"));
+        let count = be32(stsz, 8).ok_or("its sample size table is damaged")?;
+        if u64::from(count) * u64::from(uniform) > len {
+            return Err(format!("its sample size table claims {count} frames of {uniform} bytes in a file of {len}"));
         }
-        return Ok(vec![uniform; count]);
+        return Ok(vec![uniform; count as usize]);
     }
     let (_, entries) = table(stsz, 4, 4, "sample size")?;
     Ok(entries.chunks_exact(4).map(|e| u32::from_be_bytes(e.try_into().unwrap())).collect())
@@ -262,7 +266,7 @@ fn place_samples(sizes: &[u32], chunks: &[u64], stsc: &[u8]) -> Result<Vec<Sampl
             for _ in 0..per_chunk {
                 let Some(&size) = sizes.get(samples.len()) else { return Ok(samples) };
                 samples.push(Sample { offset, size });
-                offset += u64::from(size);
+                offset = offset.checked_add(u64::from(size)).ok_or("its chunk offset table is damaged")?;
             }
         }
     }
@@ -317,5 +321,41 @@ mod tests {
         let file = atom(b"moov", &trak);
         let e = read_video_track(&mut std::io::Cursor::new(&file), file.len() as u64).unwrap_err();
         assert!(e.contains("media header"), "{e}");
+    }
+
+    #[test]
+    fn an_atom_size_that_wraps_the_offset_is_an_error_not_an_endless_walk() {
+        // 48 bytes: a `free` atom whose 64-bit size brings the offset back to 8 when added.
+        let mut file = [0u8, 0, 0, 8].to_vec();
+        file.extend(b"skip");
+        file.extend([0, 0, 0, 1]);
+        file.extend(b"free");
+        file.extend((u64::MAX - 7).to_be_bytes());
+        file.resize(48, 0);
+        let e = read_video_track(&mut std::io::Cursor::new(&file), 48).unwrap_err();
+        assert!(e.contains("'free' atom at byte 8 claims"), "{e}");
+    }
+
+    #[test]
+    fn a_frame_count_larger_than_the_file_is_refused_before_any_table_is_made() {
+        // A video track whose uniform-size `stsz` claims 67 million frames of 16 bytes.
+        let full = |kind: &[u8; 4], body: &[u8]| atom(kind, &[&[0u8; 4][..], body].concat());
+        let mut stsd_entry = vec![0u8; 36];
+        stsd_entry[4..8].copy_from_slice(b"Hap1");
+        let stbl = [
+            full(b"stsd", &[&1u32.to_be_bytes()[..], &stsd_entry].concat()),
+            full(b"stsz", &[16u32.to_be_bytes(), (1u32 << 26).to_be_bytes()].concat()),
+            full(b"stco", &1u32.to_be_bytes()),
+            full(b"stsc", &0u32.to_be_bytes()),
+            full(b"stts", &0u32.to_be_bytes()),
+        ]
+        .concat();
+        let mdhd = full(b"mdhd", &[[0u8; 8].as_slice(), &600u32.to_be_bytes()].concat());
+        let hdlr = atom(b"hdlr", b"\0\0\0\0mhlrvide");
+        let mdia = atom(b"mdia", &[mdhd, hdlr, atom(b"minf", &atom(b"stbl", &stbl))].concat());
+        let file = atom(b"moov", &atom(b"trak", &mdia));
+        assert!(file.len() < 400, "{} bytes", file.len());
+        let e = read_video_track(&mut std::io::Cursor::new(&file), file.len() as u64).unwrap_err();
+        assert!(e.contains("claims 67108864 frames of 16 bytes"), "{e}");
     }
 }
