@@ -20,6 +20,22 @@ pub const FFPROBE_ENV: &str = "INDRA_FFPROBE";
 /// How far ahead (in frames) a forward jump reads on instead of starting a new process.
 const READ_ON_LIMIT: usize = 48;
 
+/// The containers a clip may be (ffmpeg's demuxer names): those that hold their media and name
+/// no other file. Playlists (HLS, DASH, concat, ffconcat) are not among them: a `.mov` that is
+/// really an HLS playlist made ffmpeg open files outside every allowed folder — FIFOs too.
+pub const CLIP_FORMATS: &str = "mov,mp4,matroska,webm,avi,mpegts,mpeg,flv,ivf,gif,apng,yuv4mpegpipe,asf,ogg,mxf,\
+     h264,hevc,m4v,mjpeg,image2,png_pipe,jpeg_pipe,webp_pipe,exr_pipe";
+
+/// The input options every clip is opened with: the containers above, and the `file` protocol
+/// alone (no network, no pipes, no protocol a name could smuggle in).
+pub fn clip_input_guard() -> [&'static str; 4] {
+    ["-format_whitelist", CLIP_FORMATS, "-protocol_whitelist", "file"]
+}
+
+/// How long a probe may take before it is ended and the clip refused (ffprobe has no timeout
+/// of its own, and a file that reads for ever would hold the load for ever).
+pub const PROBE_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(10);
+
 /// The ffmpeg (or ffprobe) program to run.
 pub fn program(env: &str, default: &str) -> std::ffi::OsString {
     std::env::var_os(env).unwrap_or_else(|| default.into())
@@ -56,23 +72,65 @@ pub struct Probe {
     pub alpha: bool,
 }
 
-/// Probes `path` with ffprobe.
+/// Probes `path` with ffprobe, within [`PROBE_TIMEOUT`].
 pub fn probe(path: &Path) -> Result<Probe, String> {
-    let ffprobe = program(FFPROBE_ENV, "ffprobe");
-    let output = Command::new(&ffprobe)
-        .args(["-v", "error", "-select_streams", "v:0", "-show_entries"])
+    probe_with(&program(FFPROBE_ENV, "ffprobe"), path, PROBE_TIMEOUT)
+}
+
+/// Probes `path` with the program `ffprobe`, ending it after `timeout`.
+fn probe_with(ffprobe: &std::ffi::OsStr, path: &Path, timeout: std::time::Duration) -> Result<Probe, String> {
+    let child = Command::new(ffprobe)
+        .args(["-v", "error"])
+        .args(clip_input_guard())
+        .args(["-select_streams", "v:0", "-show_entries"])
         .arg("stream=width,height,r_frame_rate,avg_frame_rate,nb_frames,duration,pix_fmt,codec_name:format=duration")
         .args(["-of", "json"])
         .arg(file_arg(path))
         .stdin(Stdio::null())
-        .output()
-        .map_err(|e| not_found(&ffprobe, &e))?;
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| not_found(ffprobe, &e))?;
+    let output = output_within(child, timeout)
+        .ok_or_else(|| format!("ffprobe gave no answer within {timeout:?}; the file is refused"))?;
     if !output.status.success() {
         let said = String::from_utf8_lossy(&output.stderr);
         let said = said.lines().last().unwrap_or("it could not be read").trim();
         return Err(format!("not a video ffmpeg can read: {said}"));
     }
     parse_probe(&String::from_utf8_lossy(&output.stdout))
+}
+
+/// The output of `child` once it exits, read as it comes (so a full pipe never stalls it), or
+/// `None` when it runs past `timeout` (it is then killed). Each pipe keeps its first 1 MiB.
+fn output_within(mut child: Child, timeout: std::time::Duration) -> Option<std::process::Output> {
+    let drain = |pipe: Option<Box<dyn Read + Send>>| {
+        std::thread::spawn(move || {
+            let mut bytes = Vec::new();
+            if let Some(pipe) = pipe {
+                let mut pipe = pipe.take(1 << 20);
+                let _ = pipe.read_to_end(&mut bytes);
+            }
+            bytes
+        })
+    };
+    let stdout = drain(child.stdout.take().map(|p| Box::new(p) as Box<dyn Read + Send>));
+    let stderr = drain(child.stderr.take().map(|p| Box::new(p) as Box<dyn Read + Send>));
+    let deadline = std::time::Instant::now() + timeout;
+    let status = loop {
+        match child.try_wait() {
+            Ok(Some(status)) => break status,
+            Ok(None) if std::time::Instant::now() < deadline => {
+                std::thread::sleep(std::time::Duration::from_millis(10))
+            }
+            _ => {
+                let _ = child.kill();
+                let _ = child.wait();
+                return None;
+            }
+        }
+    };
+    Some(std::process::Output { status, stdout: stdout.join().ok()?, stderr: stderr.join().ok()? })
 }
 
 /// Reads ffprobe's JSON.
@@ -198,6 +256,7 @@ impl FfmpegClip {
             if index > 0 {
                 input.extend(["-ss".to_string(), format!("{seconds:.6}")]);
             }
+            input.extend(clip_input_guard().map(String::from));
             input.extend(["-i".to_string(), file_arg(&self.path)]);
             self.pipe = Some((RawPipe::start(&input, self.probe.width, self.probe.height)?, index));
         }
@@ -233,5 +292,21 @@ mod tests {
         assert_eq!((p.frames, p.fps, p.alpha), (7, 25.0, false));
         assert!(parse_probe(r#"{"streams":[]}"#).unwrap_err().contains("no video"));
         assert!(parse_probe("nonsense").is_err());
+    }
+
+    #[test]
+    fn a_probe_that_never_answers_is_ended_and_the_file_refused() {
+        let dir = std::env::temp_dir().join(format!("indra-probe-timeout-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let stuck = dir.join("ffprobe");
+        std::fs::write(&stuck, "#!/bin/sh\nexec sleep 30\n").unwrap();
+        #[cfg(unix)]
+        std::fs::set_permissions(&stuck, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
+        let started = std::time::Instant::now();
+        let e =
+            probe_with(stuck.as_os_str(), &dir.join("clip.mov"), std::time::Duration::from_millis(500)).unwrap_err();
+        assert!(e.contains("no answer within"), "{e}");
+        assert!(started.elapsed() < std::time::Duration::from_secs(5), "the probe was waited for");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

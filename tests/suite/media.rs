@@ -158,3 +158,31 @@ fn truncated_lying_and_non_video_files_are_clean_errors() {
     let e = Clip::open(&good, 32, LIMIT).err().unwrap();
     assert!(e.contains("64×16") && e.contains("at most 32"), "{e}");
 }
+
+#[test]
+fn a_playlist_saved_as_a_clip_opens_nothing_it_names() {
+    // An H.264 clip outside the folder of the "clip" that names it, and a FIFO beside it.
+    let outside = make_clip("outside_h264.mp4", &counter_source(25, 0.4), &["-c:v", "libx264", "-pix_fmt", "yuv420p"]);
+    let dir = crate::common::clips::clip_dir().join("playlists");
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("never-written.fifo");
+    let _ = std::fs::remove_file(&fifo);
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status().expect("mkfifo runs");
+    assert!(made.success());
+    for (name, target) in [("hls.mov", outside.clone()), ("fifo.mov", fifo.clone())] {
+        let playlist = dir.join(name);
+        std::fs::write(
+            &playlist,
+            format!("#EXTM3U\n#EXT-X-TARGETDURATION:1\n#EXTINF:1,\n{}\n#EXT-X-ENDLIST\n", target.display()),
+        )
+        .unwrap();
+        // ffmpeg reads HLS by content, whatever the name: it opened the file (or blocked on the
+        // FIFO for ever). Only containers that name no other file are taken.
+        let started = std::time::Instant::now();
+        let e = Clip::open(&playlist, 16384, LIMIT).err().unwrap_or_else(|| panic!("{name} was played"));
+        assert!(e.contains("not a video"), "{name}: {e}");
+        assert!(started.elapsed() < std::time::Duration::from_secs(10), "{name} held the probe");
+    }
+    // The same clip named directly still plays.
+    assert!(Clip::open(&outside, 16384, LIMIT).is_ok());
+}
