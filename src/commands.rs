@@ -65,6 +65,16 @@ pub struct RunArgs {
     /// start: for a bookmarked URL or a printed QR code at an installation.
     #[arg(long, value_name = "TOKEN", requires = "web")]
     pub web_token: Option<String>,
+    /// One more name the OSCQuery server and the browser surface answer as (repeatable): a DNS
+    /// name of the venue's network that points here. Its own addresses, `localhost` and the
+    /// machine's name are always answered; any other `Host` is refused (DNS rebinding).
+    #[arg(long = "web-host", value_name = "NAME")]
+    pub web_hosts: Vec<String>,
+    /// Let a third-party OSCQuery web client served from ORIGIN (`http://host:port`, repeatable)
+    /// read the tree and open a WebSocket; it controls the show only with the access token.
+    /// Pages of any other origin are refused.
+    #[arg(long = "oscquery-cors", value_name = "ORIGIN", value_parser = parse_origin)]
+    pub oscquery_cors: Vec<String>,
     /// WebSocket sessions open at once: browser pages and OSCQuery clients together (1–256).
     #[arg(long, value_name = "N", default_value_t = 16, value_parser = parse_web_sessions)]
     pub web_sessions: usize,
@@ -148,6 +158,8 @@ impl Default for RunArgs {
             web_read_only: false,
             web_token: None,
             web_sessions: 16,
+            web_hosts: Vec::new(),
+            oscquery_cors: Vec::new(),
             midi: None,
             no_midi: false,
             audio_in: None,
@@ -409,8 +421,20 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         learn_file: args.midi_learn.clone(),
         audio_learn_file: args.audio_learn.clone(),
         link: args.link,
+        sites: indra::control::site::SiteRules { hosts: args.web_hosts.clone(), cors: args.oscquery_cors.clone() },
     };
     indra::app::run(assets.clone(), gpu.clone(), scene, options, control, notices)
+}
+
+/// `--oscquery-cors`: an origin as a browser sends it, `http(s)://host[:port]` with no path.
+fn parse_origin(text: &str) -> Result<String, String> {
+    let site = text.strip_prefix("http://").or_else(|| text.strip_prefix("https://"));
+    match site.map(|s| s.trim_end_matches('/')) {
+        Some(site) if !site.is_empty() && !site.contains('/') => Ok(text.trim_end_matches('/').to_string()),
+        _ => Err(format!(
+            "{text}: an origin is http://HOST:PORT or https://HOST:PORT, as the page's address bar shows it"
+        )),
+    }
 }
 
 /// `--web-sessions`: a count within [`indra::control::web::SESSIONS`].

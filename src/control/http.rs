@@ -15,6 +15,10 @@
 //!   server's socket handler, if it has one: at most [`Routes::max_sockets`] at once (`503` past
 //!   that), messages capped at [`MAX_SOCKET_MESSAGE`] bytes, reads polled every [`SOCKET_POLL`].
 //!
+//! - requests that name another host are `421` and WebSocket upgrades from another site's page
+//!   `403` ([`super::site`]: DNS rebinding and cross-site sockets); replies to a third-party
+//!   origin the performer allowed carry its CORS headers.
+//!
 //! It grew a page (the browser control surface) rather than giving way to hyper or axum: what a
 //! page needs on top is a content type, two headers and the request's headers for the access
 //! token — a few lines — while a server framework would bring an async runtime into the build
@@ -30,6 +34,8 @@ use std::time::{Duration, Instant};
 
 use tungstenite::WebSocket;
 use tungstenite::protocol::{Role, WebSocketConfig};
+
+use super::site::{Origin, SiteGuard, SiteRules};
 
 /// Largest request head (request line + headers) read.
 pub const MAX_HEAD: usize = 16 * 1024;
@@ -139,8 +145,9 @@ pub type Handler = dyn Fn(&Request<'_>) -> Reply + Send + Sync;
 
 /// Serves one upgraded WebSocket session; it owns the connection until it returns. Reads time
 /// out every [`SOCKET_POLL`] (an `Io` error of kind `WouldBlock` or `TimedOut`), so the session
-/// can send between reads. It gets the request that asked for the upgrade (for its access token).
-pub type SocketHandler = dyn Fn(&Request<'_>, WebSocket<TcpStream>) + Send + Sync;
+/// can send between reads. It gets the request that asked for the upgrade (for its access token)
+/// and where the page that asked comes from (never [`Origin::Foreign`]: those are refused).
+pub type SocketHandler = dyn Fn(&Request<'_>, Origin, WebSocket<TcpStream>) + Send + Sync;
 
 /// What the server answers: GETs, and optionally WebSocket sessions.
 #[derive(Clone)]
@@ -151,6 +158,8 @@ pub struct Routes {
     pub socket: Option<Arc<SocketHandler>>,
     /// WebSocket sessions open at once (default [`MAX_SOCKETS`]); more are answered `503`.
     pub max_sockets: usize,
+    /// Names and origins opened beyond the server's own.
+    pub sites: SiteRules,
 }
 
 /// A running server; stops when dropped.
@@ -171,7 +180,7 @@ impl HttpServer {
             let stop = stop.clone();
             std::thread::Builder::new()
                 .name(format!("indra-{name}"))
-                .spawn(move || accept_loop(&listener, &stop, &routes))
+                .spawn(move || accept_loop(&listener, &stop, &routes, &SiteGuard::new(local, &routes.sites)))
                 .map_err(|e| e.to_string())?
         };
         Ok(Self { local, stop, thread: Some(thread) })
@@ -192,7 +201,7 @@ impl Drop for HttpServer {
     }
 }
 
-fn accept_loop(listener: &TcpListener, stop: &AtomicBool, routes: &Routes) {
+fn accept_loop(listener: &TcpListener, stop: &AtomicBool, routes: &Routes, guard: &SiteGuard) {
     let active = Arc::new(AtomicUsize::new(0));
     let peers: Arc<Mutex<HashMap<IpAddr, usize>>> = Arc::default();
     let sockets = Arc::new(AtomicUsize::new(0));
@@ -208,8 +217,9 @@ fn accept_loop(listener: &TcpListener, stop: &AtomicBool, routes: &Routes) {
         }
         active.fetch_add(1, Ordering::Relaxed);
         let (active, peers, sockets, routes) = (active.clone(), peers.clone(), sockets.clone(), routes.clone());
+        let guard = guard.clone();
         let spawned = std::thread::Builder::new().name("indra-http-conn".into()).spawn(move || {
-            serve(stream, &routes, &sockets);
+            serve(stream, &routes, &guard, &sockets);
             active.fetch_sub(1, Ordering::Relaxed);
             leave_place(&peers, from.ip());
         });
@@ -242,7 +252,7 @@ fn leave_place(peers: &Mutex<HashMap<IpAddr, usize>>, ip: IpAddr) {
 }
 
 /// Answers one request on `stream`, within the limits, or serves the WebSocket it upgrades to.
-fn serve(mut stream: TcpStream, routes: &Routes, sockets: &AtomicUsize) {
+fn serve(mut stream: TcpStream, routes: &Routes, guard: &SiteGuard, sockets: &AtomicUsize) {
     let _ = stream.set_nonblocking(false);
     let _ = stream.set_read_timeout(Some(TIMEOUT));
     let _ = stream.set_write_timeout(Some(TIMEOUT));
@@ -254,10 +264,15 @@ fn serve(mut stream: TcpStream, routes: &Routes, sockets: &AtomicUsize) {
         }
     };
     let (method, request) = parse(&head);
-    let reply = match (&routes.socket, websocket_key(method, &request)) {
+    if !guard.host_ok(&request) {
+        let _ = write_reply(&mut stream, &Reply::status(421));
+        return;
+    }
+    let mut reply = match (&routes.socket, websocket_key(method, &request)) {
+        (Some(_), Some(_)) if guard.origin(&request) == Origin::Foreign => Reply::status(403),
         (Some(handler), Some(key)) => {
             if sockets.fetch_add(1, Ordering::Relaxed) < routes.max_sockets {
-                upgrade(stream, &request, key, handler);
+                upgrade(stream, &request, guard.origin(&request), key, handler);
                 sockets.fetch_sub(1, Ordering::Relaxed);
                 return;
             }
@@ -266,6 +281,7 @@ fn serve(mut stream: TcpStream, routes: &Routes, sockets: &AtomicUsize) {
         }
         _ => answer(method, &request, &routes.get),
     };
+    reply.headers.extend(guard.cors_headers(&request));
     let _ = write_reply(&mut stream, &reply);
 }
 
@@ -275,6 +291,8 @@ fn write_reply(stream: &mut TcpStream, reply: &Reply) -> std::io::Result<()> {
     let reason = match status {
         200 => "OK",
         401 => "Unauthorized",
+        403 => "Forbidden",
+        421 => "Misdirected Request",
         404 => "Not Found",
         405 => "Method Not Allowed",
         408 => "Request Timeout",
@@ -313,7 +331,7 @@ fn parse(head: &str) -> (&str, Request<'_>) {
 }
 
 /// Completes the handshake and hands the session to `handler`.
-fn upgrade(mut stream: TcpStream, request: &Request<'_>, key: &str, handler: &Arc<SocketHandler>) {
+fn upgrade(mut stream: TcpStream, request: &Request<'_>, origin: Origin, key: &str, handler: &Arc<SocketHandler>) {
     let accept = tungstenite::handshake::derive_accept_key(key.as_bytes());
     let answered = write!(
         stream,
@@ -324,7 +342,7 @@ fn upgrade(mut stream: TcpStream, request: &Request<'_>, key: &str, handler: &Ar
     }
     let config =
         WebSocketConfig::default().max_message_size(Some(MAX_SOCKET_MESSAGE)).max_frame_size(Some(MAX_SOCKET_MESSAGE));
-    handler(request, WebSocket::from_raw_socket(stream, Role::Server, Some(config)));
+    handler(request, origin, WebSocket::from_raw_socket(stream, Role::Server, Some(config)));
 }
 
 /// The request head (up to the blank line), or the status to answer with: `408` when it has

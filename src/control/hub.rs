@@ -12,6 +12,7 @@ use super::osc::{OscReceiver, OscRouter, RecordRequest, Routed};
 use super::oscquery::OscQueryServer;
 use super::presets::PresetStore;
 use super::record::Recorder;
+use super::site::SiteRules;
 use super::tempo::TempoInput;
 use super::web::WebOptions;
 use crate::params::{ControlEvent, Remap, Target};
@@ -46,6 +47,8 @@ pub struct ControlOptions {
     pub audio_in: Option<Option<String>>,
     /// Join the Ableton Link session (builds with the `link` feature).
     pub link: bool,
+    /// Host names and third-party origins the OSCQuery server answers beyond its own.
+    pub sites: SiteRules,
 }
 
 impl Default for ControlOptions {
@@ -63,6 +66,7 @@ impl Default for ControlOptions {
             audio_learn_file: "audio-learn.ron".into(),
             audio_in: Some(None),
             link: false,
+            sites: SiteRules::default(),
         }
     }
 }
@@ -136,8 +140,9 @@ impl ControlHub {
             (web.clone(), inlet)
         });
         let query_addr = options.web.as_ref().map(|w| w.addr.as_str()).or(options.oscquery.as_deref());
-        let oscquery =
-            query_addr.and_then(|a| OscQueryServer::start_with(a, osc_port, surface).map_err(|e| report(Err(e))).ok());
+        let oscquery = query_addr.and_then(|a| {
+            OscQueryServer::start_with(a, osc_port, surface, &options.sites).map_err(|e| report(Err(e))).ok()
+        });
         let web_urls = match (&options.web, &oscquery) {
             (Some(web), Some(server)) => {
                 let urls = super::web::urls(server.local_addr(), &web.token);

@@ -20,6 +20,7 @@ mod osc_guard;
 pub mod oscquery;
 pub mod presets;
 pub mod record;
+pub mod site;
 pub mod tempo;
 pub mod web;
 

@@ -14,6 +14,7 @@ use super::discovery::Advertisement;
 use super::http::{HttpServer, Reply, Request, Routes};
 use super::listen::Listeners;
 use super::osc::OscInlet;
+use super::site::SiteRules;
 use super::web::WebOptions;
 use crate::params::{ParamDecl, ParamType, ParamValue};
 use crate::scene::SceneView;
@@ -229,12 +230,18 @@ impl OscQueryServer {
     /// over mDNS unless `addr` is loopback. The server has hard limits (see [`super::http`]):
     /// no request can exhaust memory or hold up the others. mDNS that cannot start is logged.
     pub fn start(addr: &str, osc_port: u16) -> Result<Self, String> {
-        Self::start_with(addr, osc_port, None)
+        Self::start_with(addr, osc_port, None, &SiteRules::default())
     }
 
     /// [`OscQueryServer::start`], serving the browser control surface too when `surface` is
-    /// given: its page, and OSC from the WebSocket sessions it admits into the inlet.
-    pub fn start_with(addr: &str, osc_port: u16, surface: Option<(WebOptions, OscInlet)>) -> Result<Self, String> {
+    /// given: its page, and OSC from the WebSocket sessions it admits into the inlet; `sites`
+    /// adds host names and third-party origins to those answered.
+    pub fn start_with(
+        addr: &str,
+        osc_port: u16,
+        surface: Option<(WebOptions, OscInlet)>,
+        sites: &SiteRules,
+    ) -> Result<Self, String> {
         let snapshot: Arc<RwLock<Option<Value>>> = Arc::default();
         let tree = snapshot.clone();
         let web = surface.as_ref().map(|(options, _)| options.clone());
@@ -257,11 +264,11 @@ impl OscQueryServer {
         let listeners = Arc::new(Listeners::default());
         let sessions = listeners.clone();
         let max_sockets = surface.as_ref().map_or(super::http::MAX_SOCKETS, |(web, _)| web.sessions);
-        let socket = Arc::new(move |request: &Request<'_>, socket| {
-            let control = surface.as_ref().filter(|(web, _)| web.controls(request)).map(|(_, inlet)| inlet);
+        let socket = Arc::new(move |request: &Request<'_>, origin, socket| {
+            let control = surface.as_ref().filter(|(web, _)| web.controls(request, origin)).map(|(_, inlet)| inlet);
             sessions.serve(socket, control);
         });
-        let routes = Routes { get: handler, socket: Some(socket), max_sockets };
+        let routes = Routes { get: handler, socket: Some(socket), max_sockets, sites: sites.clone() };
         let server = HttpServer::start(addr, "oscquery", routes)?;
         let local = server.local_addr();
         log::info!("OSCQuery on http://{local}/");

@@ -204,6 +204,8 @@ fn a_browser_controls_the_show_and_follows_every_other_source() {
     let file = dir.join("show.ron");
     std::fs::write(&file, SHOW).unwrap();
     let query = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap();
+    // Two other sites on this host: one the performer allows as an OSCQuery web client.
+    let (foreign, allowed) = (SitePage::start(query), SitePage::start(query));
     let recording = dir.join("controls.ron");
     let args: Vec<std::ffi::OsString> = vec![
         "--web".into(),
@@ -212,6 +214,8 @@ fn a_browser_controls_the_show_and_follows_every_other_source() {
         TOKEN.into(),
         "--record-controls".into(),
         recording.clone().into(),
+        "--oscquery-cors".into(),
+        allowed.origin().into(),
     ];
     let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
     let (mut show, osc_port) = Show::start(&display, &dir, file.to_str().unwrap(), &args);
@@ -294,6 +298,19 @@ fn a_browser_controls_the_show_and_follows_every_other_source() {
     assert_eq!(recorded.matches("CueGo").count(), 1, "{recorded}");
     assert!(recorded.contains(&path.rsplit('/').next().unwrap().to_string()), "{recorded}");
 
+    // Another site's page in the same browser (its cookie stored) cannot write: its socket is
+    // refused, and it cannot read the tree; an allowed client reads the tree and LISTENs, and
+    // its socket, without the token, writes nothing.
+    let before = published(query, &path);
+    let mut attacker = browser.open(&foreign.url(&path, hi));
+    attacker.wait_until("document.title.startsWith('done')");
+    assert_eq!(attacker.eval("document.title"), "done socket:refused tree:blocked");
+    let mut client = browser.open(&allowed.url(&path, hi));
+    client.wait_until("document.title.startsWith('done')");
+    assert_eq!(client.eval("document.title"), "done socket:closed tree:read");
+    std::thread::sleep(Duration::from_secs(1));
+    assert_eq!(published(query, &path), before, "another site's page changed {path}");
+
     // The page fits a phone: 375 px wide with nothing to scroll sideways.
     page.call(
         "Emulation.setDeviceMetricsOverride",
@@ -306,6 +323,66 @@ fn a_browser_controls_the_show_and_follows_every_other_source() {
     let image = image::load_from_memory(&png).unwrap();
     assert_eq!(image.width(), 750, "a 375-px screen at 2×");
     std::fs::write(screenshot_path(), png).unwrap();
+}
+
+/// A page of another site on this host (a port of its own) that tries what a hostile page
+/// would against the show's server: open a WebSocket and write a parameter, and read the tree
+/// with `fetch`. It says in its title what happened.
+struct SitePage {
+    addr: SocketAddr,
+}
+
+impl SitePage {
+    /// Serves the page on a free port, against the server at `target`, until the test ends.
+    fn start(target: SocketAddr) -> Self {
+        let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap();
+        let page = format!(
+            "<!doctype html><title>running</title><script>
+            const said = {{}};
+            const done = () => {{ if (said.socket && said.tree) document.title = `done socket:${{said.socket}} tree:${{said.tree}}`; }};
+            fetch('http://{target}/?HOST_INFO').then(r => r.json()).then(() => {{ said.tree = 'read'; done(); }},
+                () => {{ said.tree = 'blocked'; done(); }});
+            const ws = new WebSocket('ws://{target}/');
+            ws.binaryType = 'arraybuffer';
+            let opened = false;
+            ws.onopen = () => {{ opened = true;
+                // The address and value from the page's URL (`?path=/indra/…&value=0.5`), as OSC bytes.
+                const query = new URLSearchParams(location.search);
+                const [path, value] = [query.get('path'), query.get('value')];
+                const text = s => {{ const b = new TextEncoder().encode(s); const n = Math.ceil((b.length + 1) / 4) * 4;
+                    const o = new Uint8Array(n); o.set(b); return o; }};
+                const a = text(path), t = text(',f'), v = new Uint8Array(4);
+                new DataView(v.buffer).setFloat32(0, Number(value));
+                const m = new Uint8Array(a.length + t.length + 4); m.set(a); m.set(t, a.length); m.set(v, a.length + t.length);
+                ws.send(m.buffer); }};
+            ws.onclose = () => {{ said.socket = opened ? 'closed' : 'refused'; done(); }};
+            </script>"
+        );
+        std::thread::spawn(move || {
+            for stream in listener.incoming().flatten() {
+                let mut stream = stream;
+                let mut head = [0u8; 4096];
+                let _ = stream.read(&mut head);
+                let reply = format!(
+                    "HTTP/1.1 200 OK\r\nContent-Type: text/html\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{page}",
+                    page.len()
+                );
+                let _ = stream.write_all(reply.as_bytes());
+            }
+        });
+        Self { addr }
+    }
+
+    /// Its origin, as a browser names it.
+    fn origin(&self) -> String {
+        format!("http://{}", self.addr)
+    }
+
+    /// The page's URL, asking it to write `value` to `path`.
+    fn url(&self, path: &str, value: f64) -> String {
+        format!("{}/?path={path}&value={value}", self.origin())
+    }
 }
 
 /// Standard base64 (DevTools sends screenshots so); ten lines rather than a dependency.

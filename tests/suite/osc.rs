@@ -768,10 +768,15 @@ fn the_osc_queue_is_bounded_in_bytes_under_a_flood_of_large_datagrams() {
 
 /// A server with the browser surface: OSC from the sessions it admits goes into `rx`.
 fn surface(read_only: bool, rx: &OscReceiver) -> OscQueryServer {
+    surface_with(read_only, rx, &indra::control::site::SiteRules::default())
+}
+
+/// [`surface`] answering the names and third-party origins of `sites` too.
+fn surface_with(read_only: bool, rx: &OscReceiver, sites: &indra::control::site::SiteRules) -> OscQueryServer {
     use indra::control::web::{AccessToken, WebOptions};
     let token = AccessToken::chosen("socket-test-token").unwrap();
     let web = WebOptions { addr: "127.0.0.1:0".into(), read_only, token, sessions: 4 };
-    OscQueryServer::start_with("127.0.0.1:0", 0, Some((web, rx.inlet()))).unwrap()
+    OscQueryServer::start_with("127.0.0.1:0", 0, Some((web, rx.inlet())), sites).unwrap()
 }
 
 /// Whether the session was closed by the server within a few seconds.
@@ -850,4 +855,76 @@ fn websocket_osc_is_taken_only_with_the_token_and_within_the_limits_of_udp() {
     viewer.send(Message::binary(write)).unwrap();
     assert!(closed(&mut viewer));
     assert!(rx.drain(SystemTime::now()).is_empty());
+}
+
+/// The status and head of the reply to `request` (a whole request head).
+fn http_head(addr: std::net::SocketAddr, request: &str) -> (u16, String) {
+    use std::io::{Read, Write};
+    let mut s = std::net::TcpStream::connect(addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+    s.write_all(request.as_bytes()).unwrap();
+    let mut response = Vec::new();
+    // A WebSocket that was let in stays open: the head is all there is to read.
+    let mut chunk = [0u8; 4096];
+    while let Ok(n) = s.read(&mut chunk) {
+        response.extend_from_slice(&chunk[..n]);
+        if n == 0 || response.windows(4).any(|w| w == b"\r\n\r\n") {
+            break;
+        }
+    }
+    let text = String::from_utf8_lossy(&response).to_string();
+    let head = text.split("\r\n\r\n").next().unwrap_or_default().to_string();
+    (text.get(9..12).and_then(|c| c.parse().ok()).unwrap_or(0), head)
+}
+
+#[test]
+fn only_the_servers_own_names_and_pages_of_its_own_or_allowed_origins_are_answered() {
+    use tungstenite::Message;
+    let sites = indra::control::site::SiteRules { hosts: vec![], cors: vec!["http://127.0.0.1:5173".into()] };
+    let mut rx = OscReceiver::without_socket();
+    let server = surface_with(false, &rx, &sites);
+    let at = server.local_addr();
+    let upgrade = |host: &str, origin: &str| {
+        format!(
+            "GET /?token=socket-test-token HTTP/1.1\r\nHost: {host}\r\nOrigin: {origin}\r\nUpgrade: websocket\r\n\
+             Connection: Upgrade\r\nSec-WebSocket-Version: 13\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\
+             Cookie: indra_token=socket-test-token\r\n\r\n"
+        )
+    };
+    let own = format!("http://{at}");
+    // DNS rebinding: another name for this address is answered nothing — tree, value, socket.
+    for path in ["/", "/?HOST_INFO", "/indra/glow/intensity?VALUE", "/?token=socket-test-token"] {
+        let request = format!("GET {path} HTTP/1.1\r\nHost: evil.example:{}\r\nAccept: text/html\r\n\r\n", at.port());
+        assert_eq!(http_head(at, &request).0, 421, "{path}");
+    }
+    assert_eq!(http_head(at, &upgrade(&format!("evil.example:{}", at.port()), &own)).0, 421);
+    // Its own names are answered.
+    for host in [at.to_string(), format!("localhost:{}", at.port())] {
+        assert_eq!(http_head(at, &format!("GET /?HOST_INFO HTTP/1.1\r\nHost: {host}\r\n\r\n")).0, 200, "{host}");
+    }
+    // A page of another site (another port of this very host too) opens no socket, cookie or not.
+    for origin in ["http://evil.example", &format!("http://127.0.0.1:{}", at.port() + 1), "null"] {
+        assert_eq!(http_head(at, &upgrade(&at.to_string(), origin)).0, 403, "{origin}");
+    }
+    assert_eq!(http_head(at, &upgrade(&at.to_string(), &own)).0, 101, "the surface's own page");
+    // An allowed third-party client reads the tree across origins and, with the token, writes.
+    let (_, head) =
+        http_head(at, &format!("GET /?HOST_INFO HTTP/1.1\r\nHost: {at}\r\nOrigin: http://127.0.0.1:5173\r\n\r\n"));
+    assert!(head.contains("Access-Control-Allow-Origin: http://127.0.0.1:5173"), "{head}");
+    let (_, head) =
+        http_head(at, &format!("GET /?HOST_INFO HTTP/1.1\r\nHost: {at}\r\nOrigin: http://evil.example\r\n\r\n"));
+    assert!(!head.contains("Access-Control-Allow-Origin"), "{head}");
+    let connect = |query: &str| {
+        let mut request =
+            tungstenite::client::IntoClientRequest::into_client_request(format!("ws://{at}/{query}")).unwrap();
+        request.headers_mut().insert("Origin", "http://127.0.0.1:5173".parse().unwrap());
+        tungstenite::connect(request).map(|(socket, _)| socket)
+    };
+    let write = packet("/indra/glow/intensity", vec![OscType::Float(0.5)]);
+    let mut reader = connect("").expect("an allowed origin opens a socket");
+    reader.send(Message::binary(write.clone())).unwrap();
+    assert!(closed(&mut reader), "an allowed origin without the token wrote");
+    let mut writer = connect("?token=socket-test-token").unwrap();
+    writer.send(Message::binary(write)).unwrap();
+    assert_eq!(receive(&mut rx, 1).len(), 1, "with the token it controls the show");
 }

@@ -54,6 +54,11 @@ impl AccessToken {
         [request.query_param("token"), request.cookie(COOKIE)].into_iter().flatten().any(|t| self.matches(t))
     }
 
+    /// Whether `request` names this token in its URL (`?token=…`), its cookie aside.
+    pub fn admits_in_url(&self, request: &Request<'_>) -> bool {
+        request.query_param("token").is_some_and(|t| self.matches(t))
+    }
+
     /// Compares in time independent of where the strings differ, so response times do not
     /// give the token away a character at a time.
     fn matches(&self, offered: &str) -> bool {

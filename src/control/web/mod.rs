@@ -16,6 +16,7 @@ use std::net::{IpAddr, SocketAddr};
 pub use access::AccessToken;
 
 use super::http::{Reply, Request};
+use super::site::Origin;
 
 /// Where `--web` listens when given no address: loopback, so nothing on the network reaches it.
 pub const DEFAULT_ADDR: &str = "127.0.0.1:8080";
@@ -56,9 +57,16 @@ impl WebOptions {
         }
     }
 
-    /// Whether a WebSocket session opened by `request` may control the show.
-    pub fn controls(&self, request: &Request<'_>) -> bool {
-        !self.read_only && self.token.admits(request)
+    /// Whether a WebSocket session opened by `request` from a page of `origin` may control the
+    /// show: with the token, which a third-party page must name in its URL (the performer's
+    /// cookie speaks for this surface's own pages only).
+    pub fn controls(&self, request: &Request<'_>, origin: Origin) -> bool {
+        let token = match origin {
+            Origin::Absent | Origin::Own => self.token.admits(request),
+            Origin::Allowed => self.token.admits_in_url(request),
+            Origin::Foreign => false,
+        };
+        !self.read_only && token
     }
 
     /// The page, for a request with the token; `401` and a line on how to get in without it.
@@ -162,9 +170,14 @@ mod tests {
     #[test]
     fn control_needs_the_token_and_a_surface_that_is_not_read_only() {
         let with_cookie = Request::new("/", "Cookie: indra_token=test-token-0123");
-        assert!(options(false).controls(&with_cookie));
-        assert!(!options(true).controls(&with_cookie));
-        assert!(!options(false).controls(&Request::new("/", "")));
+        assert!(options(false).controls(&with_cookie, Origin::Own));
+        assert!(options(false).controls(&with_cookie, Origin::Absent));
+        assert!(!options(true).controls(&with_cookie, Origin::Own));
+        assert!(!options(false).controls(&Request::new("/", ""), Origin::Own));
+        // A third-party page carries the performer's cookie too: only a token it names counts.
+        assert!(!options(false).controls(&with_cookie, Origin::Allowed));
+        assert!(options(false).controls(&Request::new("/?token=test-token-0123", ""), Origin::Allowed));
+        assert!(!options(false).controls(&Request::new("/?token=test-token-0123", ""), Origin::Foreign));
     }
 
     #[test]
