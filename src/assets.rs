@@ -70,6 +70,9 @@ pub struct Assets {
     root: Option<PathBuf>,
     /// Shader file name → the text to use instead of the disk or the embedded copy.
     pinned: Arc<BTreeMap<String, Asset>>,
+    /// File a parameter names (an ISF shader), as located on disk → the bytes to read instead:
+    /// the version a running show was built from, whatever is on disk now.
+    pinned_files: Arc<BTreeMap<PathBuf, Arc<[u8]>>>,
     /// Where the files that parameters name may be.
     files: FileRules,
     /// Whether a step waits for the files it asks for.
@@ -81,13 +84,13 @@ impl Assets {
     /// Files that parameters name may lie under `root` only (see [`Assets::allowing`]).
     pub fn new(root: Option<PathBuf>) -> Self {
         let files = FileRules::new(root.clone());
-        Self { root, pinned: Arc::default(), files, load_wait: LoadWait::default() }
+        Self { root, pinned: Arc::default(), pinned_files: Arc::default(), files, load_wait: LoadWait::default() }
     }
 
     /// The built-in shaders and scenes only, with these assets' file rules and load mode (what a
     /// show falls back to when a file on disk is broken at start-up).
     pub fn builtin_only(&self) -> Self {
-        Self { root: None, pinned: Arc::default(), ..self.clone() }
+        Self { root: None, pinned: Arc::default(), pinned_files: Arc::default(), ..self.clone() }
     }
 
     /// These assets with files under `folder` open to file parameters too (`/`: any file).
@@ -118,7 +121,33 @@ impl Assets {
     /// The bytes of the file a parameter's `name` means, at most `limit` of them, or `bundled`'s
     /// where no such file exists (see [`FileRules::read`]).
     pub fn read_file(&self, name: &str, limit: u64, bundled: Option<&'static [u8]>) -> Result<NamedBytes, FileError> {
+        if !self.pinned_files.is_empty()
+            && let Ok(path) = self.locate_file(name)
+            && let Some(bytes) = self.pinned_files.get(&path)
+        {
+            let bytes = std::borrow::Cow::Owned(bytes.to_vec());
+            return Ok(NamedBytes { origin: path.display().to_string(), path: Some(path), bytes });
+        }
         self.files.read(self.root.as_deref(), name, limit, bundled)
+    }
+
+    /// These assets with the file at `path` (as [`Assets::locate_file`] gives it) read as
+    /// `bytes`, whatever is on disk: the version of a file-declared node (an ISF shader) that a
+    /// running show was built from.
+    pub fn with_file(&self, path: PathBuf, bytes: Arc<[u8]>) -> Self {
+        self.with_files([(path, bytes)])
+    }
+
+    /// [`Assets::with_file`] for several files at once.
+    pub fn with_files(&self, files: impl IntoIterator<Item = (PathBuf, Arc<[u8]>)>) -> Self {
+        let mut pinned = (*self.pinned_files).clone();
+        pinned.extend(files);
+        Self { pinned_files: Arc::new(pinned), ..self.clone() }
+    }
+
+    /// The bytes pinned for `path`, if any (see [`Assets::with_file`]).
+    pub fn pinned_file(&self, path: &Path) -> Option<Arc<[u8]>> {
+        self.pinned_files.get(path).cloned()
     }
 
     /// Where a parameter's `name` may be saved as a `.ext` file, if the rules allow it.

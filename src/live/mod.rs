@@ -9,5 +9,5 @@ mod reload;
 mod watcher;
 
 pub use recovery::{GpuGuard, GpuState, GpuTrouble, recover, roll_back_stall};
-pub use reload::{LiveReload, ReloadReport};
+pub use reload::{LiveReload, ReloadReport, RolledBack};
 pub use watcher::{Watcher, read_stable};

@@ -6,6 +6,7 @@
 use std::time::{Duration, Instant};
 
 use super::LiveReload;
+use super::reload::RolledBack;
 use crate::assets::Assets;
 use crate::gpu::{Gpu, Watchdog};
 use crate::scene::Player;
@@ -111,10 +112,19 @@ pub fn roll_back_stall(
     size: (u32, u32),
 ) -> String {
     let Some(live) = live else { return format!("{trouble}; waiting for it") };
-    let Some((shader, rolled_back)) = live.roll_back_newest(&trouble.to_string()) else {
+    let Some((taken, rolled_back)) = live.roll_back_newest(&trouble.to_string()) else {
         return format!("{trouble}; waiting for it");
     };
-    let rebuilt = player.instance_mut().rebuild_nodes_using(&shader, gpu, live.running_assets(), size);
+    let rebuilt = match taken {
+        RolledBack::Shader(shader) => {
+            let instance = player.instance_mut();
+            instance
+                .rebuild_nodes_using(&shader, gpu, live.running_assets(), size)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        }
+        RolledBack::Declared(path) => live.rebuild_declared(&path, player, gpu, size),
+    };
     match rebuilt {
         Ok(_) => format!("{rolled_back}; the show resumes when the GPU has finished the stuck frame"),
         Err(e) => format!("{rolled_back}, but its nodes did not rebuild: {e}"),

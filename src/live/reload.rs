@@ -2,6 +2,7 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use super::watcher::{Watcher, read_stable};
@@ -35,7 +36,8 @@ pub struct LiveReload {
     running: Assets,
     /// File → its current error, while broken.
     broken: BTreeMap<PathBuf, String>,
-    /// The newest shader reload applied, to roll back if the GPU stalls or is lost soon after.
+    /// The newest shader reload applied (WGSL or ISF), to roll back if the GPU stalls or is lost
+    /// soon after.
     newest: Option<AppliedShader>,
     /// File → the text that stalled the GPU: saved again unchanged, it is not tried again.
     stalled: BTreeMap<PathBuf, String>,
@@ -44,10 +46,31 @@ pub struct LiveReload {
 /// A shader reload that was applied, with the version it replaced.
 struct AppliedShader {
     path: PathBuf,
-    previous: Asset,
+    previous: Previous,
     source: String,
     at: Instant,
 }
+
+/// What a reload replaced.
+enum Previous {
+    /// A WGSL shader: nodes are built from it by name.
+    Shader(Asset),
+    /// A file nodes declare their parameters from (an ISF shader), by its canonical path.
+    Declared(Arc<[u8]>),
+}
+
+/// What [`LiveReload::roll_back_newest`] took back, for the caller to rebuild.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum RolledBack {
+    /// The WGSL shader of this name: rebuild the nodes that use it.
+    Shader(String),
+    /// The ISF file at this path: reload the scene with it (see [`LiveReload::rebuild_declared`]).
+    Declared(PathBuf),
+}
+
+/// The most bytes of ISF files pinned at start (what a stall rolls back to); files past it are
+/// read from disk as before and cannot be rolled back.
+const MAX_PINNED_DECLARED: u64 = 64 << 20;
 
 impl LiveReload {
     /// Watches `assets`' `shaders/`, `scenes/` and `shows/` folders and, under a source
@@ -55,7 +78,7 @@ impl LiveReload {
     pub fn new(assets: &Assets) -> Result<Self, String> {
         let dirs = assets.watched_dirs();
         let watcher = if dirs.is_empty() { None } else { Some(Watcher::watch(&dirs)?) };
-        let running = assets.with_shaders_pinned();
+        let running = pin_declared_files(assets.with_shaders_pinned(), &dirs);
         Ok(Self { watcher, running, broken: BTreeMap::new(), newest: None, stalled: BTreeMap::new() })
     }
 
@@ -82,14 +105,41 @@ impl LiveReload {
     /// before it is what nodes are built from again, and the file counts as broken with `why`
     /// until it is saved with different text. Returns the shader's name and the message for the
     /// performer; the caller rebuilds the nodes that use it.
-    pub fn roll_back_newest(&mut self, why: &str) -> Option<(String, String)> {
+    pub fn roll_back_newest(&mut self, why: &str) -> Option<(RolledBack, String)> {
         let newest = self.newest.take()?;
-        let shader = newest.previous.name.clone();
-        self.running = self.running.with_shader(newest.previous);
+        let taken = match newest.previous {
+            Previous::Shader(previous) => {
+                let shader = previous.name.clone();
+                self.running = self.running.with_shader(previous);
+                RolledBack::Shader(shader)
+            }
+            Previous::Declared(bytes) => {
+                let path = newest.path.canonicalize().unwrap_or_else(|_| newest.path.clone());
+                self.running = self.running.with_file(path.clone(), bytes);
+                RolledBack::Declared(path)
+            }
+        };
         let message = format!("{}: {why}; rolled back to the version before it", newest.path.display());
         self.broken.insert(newest.path.clone(), message.clone());
         self.stalled.insert(newest.path, newest.source);
-        Some((shader, message))
+        Some((taken, message))
+    }
+
+    /// Reloads the running scene with the ISF file at `path` as the running assets hold it now
+    /// (after [`LiveReload::roll_back_newest`]): the nodes that read it are rebuilt.
+    pub fn rebuild_declared(
+        &self,
+        path: &Path,
+        player: &mut Player,
+        gpu: &Gpu,
+        size: (u32, u32),
+    ) -> Result<(), String> {
+        let mut report = ReloadReport::default();
+        self.rebuild_reading(path, player.instance_mut(), gpu, size, &mut report, &self.running).map(|_| ())?;
+        if let Some(remap) = &report.remap {
+            player.remap(remap);
+        }
+        Ok(())
     }
 
     /// Files currently broken, with their errors.
@@ -166,6 +216,7 @@ impl LiveReload {
         let previous = self.running.load(AssetKind::Shader, &name).ok();
         self.running = next;
         if let Some(previous) = previous.filter(|_| used) {
+            let previous = Previous::Shader(previous);
             self.newest = Some(AppliedShader { path: path.to_path_buf(), previous, source, at: Instant::now() });
         }
         Ok(used)
@@ -174,14 +225,45 @@ impl LiveReload {
     /// For a file nodes declare their parameters from (an ISF shader, `.fs` or its `.vs`):
     /// Ok(true) if nodes read it and the scene was loaded again with them rebuilt — its inputs
     /// may have changed, so the scene's parameters are declared anew; an error keeps the last
-    /// good version running.
+    /// good version running. An applied edit is the newest reload: a stall right after it
+    /// takes it back, and the text that stalled is not tried again until it changes.
     fn reload_declared(
+        &mut self,
+        path: &Path,
+        instance: &mut SceneInstance,
+        gpu: &Gpu,
+        size: (u32, u32),
+        report: &mut ReloadReport,
+    ) -> Result<bool, String> {
+        let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        if self.stalled.get(path) == Some(&source) {
+            return Err(self.broken.get(path).cloned().unwrap_or_default());
+        }
+        let real = path.canonicalize().map_err(|e| format!("{}: {e}", path.display()))?;
+        let previous = self.running.pinned_file(&real);
+        let next = self.running.with_file(real, Arc::from(source.as_bytes()));
+        if !self.rebuild_reading(path, instance, gpu, size, report, &next)? {
+            return Ok(false);
+        }
+        self.stalled.remove(path);
+        self.running = next;
+        if let Some(previous) = previous {
+            let previous = Previous::Declared(previous);
+            self.newest = Some(AppliedShader { path: path.to_path_buf(), previous, source, at: Instant::now() });
+        }
+        Ok(true)
+    }
+
+    /// Loads the running scene again from `assets` and rebuilds the nodes that read the ISF
+    /// file `path` (or its companion); Ok(false) when none does.
+    fn rebuild_reading(
         &self,
         path: &Path,
         instance: &mut SceneInstance,
         gpu: &Gpu,
         size: (u32, u32),
         report: &mut ReloadReport,
+        assets: &Assets,
     ) -> Result<bool, String> {
         let shader = path.with_extension("fs").canonicalize().ok();
         let reads_it = |n: &crate::scene::SceneNode| {
@@ -198,9 +280,9 @@ impl LiveReload {
         let origin = instance.scene().origin.clone();
         // A built-in scene reloads by its name; one from disk (or a bare .fs) by its path.
         let name = origin.strip_prefix("<embedded>/scenes/").unwrap_or(&origin);
-        let scene = load_scene(&self.running, name).map_err(|e| e.to_string())?;
+        let scene = load_scene(assets, name).map_err(|e| e.to_string())?;
         let remap =
-            instance.replace_scene_rebuilding(scene, gpu, &self.running, size, &reads_it).map_err(|e| e.to_string())?;
+            instance.replace_scene_rebuilding(scene, gpu, assets, size, &reads_it).map_err(|e| e.to_string())?;
         report.scene_changed = true;
         report.remap = Some(remap);
         Ok(true)
@@ -243,4 +325,24 @@ impl LiveReload {
         report.remap = Some(remap);
         Ok(true)
     }
+}
+
+/// `assets` with every ISF file (`.fs`, `.vs`) in `dirs` pinned to its text now, up to
+/// [`MAX_PINNED_DECLARED`] bytes: what a stalled edit of one rolls back to.
+fn pin_declared_files(assets: Assets, dirs: &[PathBuf]) -> Assets {
+    let mut left = MAX_PINNED_DECLARED;
+    let mut files = Vec::new();
+    for dir in dirs {
+        let Ok(entries) = std::fs::read_dir(dir) else { continue };
+        for path in entries.flatten().map(|e| e.path()) {
+            if !path.extension().is_some_and(|e| e == "fs" || e == "vs") {
+                continue;
+            }
+            let Ok(real) = path.canonicalize() else { continue };
+            let Ok(bytes) = crate::files::read_limited(&real, left) else { continue };
+            left -= bytes.len() as u64;
+            files.push((real, Arc::from(bytes)));
+        }
+    }
+    assets.with_files(files)
 }

@@ -194,3 +194,66 @@ fn a_simulation_restarts_on_the_new_device_and_keeps_running() {
     assert!(r.render_next().unwrap().rgba != after.rgba, "the simulation runs on the new device");
     assert_eq!(r.check_gpu(), GpuState::Ready);
 }
+
+/// An ISF generator with a `spin` input; `body` is its `main`.
+fn isf_generator(body: &str) -> String {
+    format!(
+        "/*{{ \"INPUTS\": [ {{ \"NAME\": \"spin\", \"TYPE\": \"float\", \"DEFAULT\": 50.0, \"MIN\": 0.0, \"MAX\": 100.0 }} ] }}*/\n\
+         void main() {{\n{body}\n}}\n"
+    )
+}
+
+/// The same spinning loop as [`spinning_store`], in ISF's GLSL.
+fn spinning_isf() -> String {
+    let body = "        s = s ^ (s << 13u);\n        s = s ^ (s >> 17u);\n        s = s ^ (s << 5u) ^ uint(k);\n";
+    isf_generator(&format!(
+        "    uint s = uint(gl_FragCoord.x) * 9781u + uint(gl_FragCoord.y) * 6271u;
+    for (int k = 0; k < int(spin) * 300; k++) {{
+{}    }}
+    gl_FragColor = vec4(float(s & 255u) / 255.0);",
+        body.repeat(100)
+    ))
+}
+
+#[test]
+fn a_stalling_isf_edit_is_rolled_back_and_a_new_device_never_reads_it_again() {
+    let root = sandbox("isf-stall");
+    let isf = root.join("shaders/isf/spin.fs");
+    std::fs::create_dir_all(isf.parent().unwrap()).unwrap();
+    let calm = isf_generator("    gl_FragColor = vec4(isf_FragNormCoord.x, 0.25, 0.5 + spin * 0.0, 1.0);");
+    std::fs::write(&isf, &calm).unwrap();
+    let scene_file = root.join("scenes/spin.ron");
+    std::fs::write(
+        &scene_file,
+        r#"(name: "spin", size: (64, 64), nodes: [(id: "isf", technique: "isf", params: { "file": "shaders/isf/spin.fs" })], output: "isf")"#,
+    )
+    .unwrap();
+    let assets = Assets::new(Some(root.clone()));
+    let scene = load_scene(&assets, "spin").unwrap();
+    let mut live = LiveReload::new(&assets).unwrap();
+    let mut r = OffscreenRenderer::new(common::gpu(), &assets, scene, Some(SIZE), None, None).unwrap();
+    r.set_gpu_limits(Duration::from_millis(300), Duration::from_millis(1200));
+    let good = r.render_next().unwrap().rgba;
+    std::fs::write(&isf, spinning_isf()).unwrap();
+    let report = wait_for_applied(&mut r, &mut live);
+    assert_eq!(report.applied.len(), 1, "the spinning shader compiles and goes live: {report:?}");
+    r.render_only().unwrap();
+    let t = trouble(&mut r);
+    assert!(matches!(t, GpuTrouble::Stalled(_)), "{t:?}");
+    let message = r.roll_back_stall(&t, Some(&mut live));
+    assert!(message.contains("rolled back") && message.contains("spin.fs"), "{message}");
+    // The stuck frame outlasts the device's limit: the show moves to a new device, built from
+    // the version before the edit, not from the file on disk (which still spins).
+    let stuck = match state_after(&mut r, GpuState::Waiting) {
+        GpuState::Trouble(t) => t,
+        other => panic!("the spinning frame outlasts 1.2 s, yet: {other:?}"),
+    };
+    let message = r.recover(&stuck, Some(&mut live), &assets).unwrap();
+    assert!(message.contains("new device"), "{message}");
+    assert!(r.render_next().unwrap().rgba == good, "the ISF shader before the edit");
+    // Saved again unchanged, it is not tried again.
+    std::fs::write(&isf, spinning_isf()).unwrap();
+    std::thread::sleep(Duration::from_millis(400));
+    assert!(r.poll_reload(&mut live).applied.is_empty(), "the stalling version is not applied again");
+    std::fs::remove_dir_all(root).unwrap();
+}
