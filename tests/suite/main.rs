@@ -20,6 +20,7 @@ mod pipewire;
 mod recovery;
 mod seek;
 mod show;
+mod soak;
 mod triangulate;
 mod video;
 mod window;

@@ -103,6 +103,11 @@ impl Show {
         (Self { child, log }, port)
     }
 
+    /// The show's process id.
+    pub(crate) fn pid(&self) -> u32 {
+        self.child.id()
+    }
+
     /// Waits (at most 90 s: debug build on lavapipe) until the log holds `text`; returns the log.
     pub(crate) fn wait_for(&mut self, text: &str) -> String {
         let deadline = Instant::now() + Duration::from_secs(90);
