@@ -204,6 +204,7 @@ impl Spares {
             let spawned = std::thread::Builder::new().name("indra-clip-prepare".into()).spawn(move || {
                 let _ = send.send(build.run());
                 in_flight.fetch_sub(1, Ordering::Relaxed);
+                release_free_memory();
             });
             if spawned.is_err() {
                 // No thread to be had: the clip runs on from its state; told when it ends.
@@ -215,6 +216,19 @@ impl Spares {
             }
             *slot = Slot::Building { receive, restart };
         }
+    }
+}
+
+/// Gives the allocator's free pages back to the system. A clip build allocates and frees
+/// hundreds of megabytes in large blocks (pipelines, buffers, the driver's shader code) on
+/// threads that come and go; glibc keeps what they freed in its arenas, so a show that switches
+/// clips for hours grew by steps of tens of megabytes without holding any more (heaptrack: the
+/// live heap flat at 413–433 MB while RSS rose). Costs a few milliseconds, on this worker thread.
+fn release_free_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only walks and trims glibc's own arenas; it takes no pointer.
+    unsafe {
+        libc::malloc_trim(0);
     }
 }
 
