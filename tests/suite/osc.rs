@@ -928,3 +928,45 @@ fn only_the_servers_own_names_and_pages_of_its_own_or_allowed_origins_are_answer
     writer.send(Message::binary(write)).unwrap();
     assert_eq!(receive(&mut rx, 1).len(), 1, "with the token it controls the show");
 }
+
+#[test]
+fn a_third_party_oscquery_client_reads_the_tree_through_the_site_checks() {
+    // npm's `oscquery` (jangxx/node-oscquery), installed by tools/test under target/.
+    let Some(client) = std::env::var_os("INDRA_OSCQUERY_CLIENT") else {
+        assert!(std::env::var_os("CI").is_none(), "CI runs the OSCQuery client test: INDRA_OSCQUERY_CLIENT is unset");
+        return eprintln!("skipped: no OSCQuery client (tools/setup-oscquery-client installs it)");
+    };
+    let star_glow = scene("star_glow");
+    let values: Vec<indra::params::ParamSet> = star_glow.nodes.iter().map(|n| n.params.clone()).collect();
+    let view =
+        SceneView { scene: &star_glow, params: &values, tempo: indra::params::TempoClock::new(120.0), show: None };
+    let rx = OscReceiver::without_socket();
+    let sites = indra::control::site::SiteRules { hosts: vec![], cors: vec!["http://127.0.0.1:5173".into()] };
+    let server = surface_with(false, &rx, &sites);
+    server.publish(view);
+    let script = format!(
+        "const {{ OSCQueryDiscovery }} = require('oscquery');
+         new OSCQueryDiscovery().queryNewService('{host}', {port}).then(s => {{
+           console.log(JSON.stringify({{ port: s.hostInfo.oscPort, paths: s.flat().map(m => m.full_path) }}));
+           process.exit(0);
+         }}, e => {{ console.error(String(e)); process.exit(1); }});",
+        host = "localhost",
+        port = server.local_addr().port()
+    );
+    let out = std::process::Command::new("node")
+        .arg("-e")
+        .arg(&script)
+        .env("NODE_PATH", std::path::Path::new(&client).join("node_modules"))
+        .output()
+        .expect("node runs (the machine image has it)");
+    assert!(out.status.success(), "the client failed: {}", String::from_utf8_lossy(&out.stderr));
+    let said: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let paths: Vec<&str> = said["paths"].as_array().unwrap().iter().filter_map(|p| p.as_str()).collect();
+    for node in &star_glow.nodes {
+        for decl in node.params.decls() {
+            let path = format!("/indra/{}/{}", node.id, decl.name);
+            assert!(paths.contains(&path.as_str()), "the client misses {path}: {paths:?}");
+        }
+    }
+    assert_eq!(said["port"], 0, "HOST_INFO's OSC port as served");
+}
