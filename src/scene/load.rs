@@ -45,6 +45,9 @@ pub struct Scene {
     pub midi: Vec<(MidiMapping, Target)>,
     /// For a show: its layers, clips, columns and cues over these nodes (`None`: a scene).
     pub show: Option<std::sync::Arc<super::show::Show>>,
+    /// Texture bytes nodes keep beyond their outputs at the scene's size (an ISF node's pass
+    /// targets, as its file declares them), counted in [`Scene::texture_bytes`].
+    pub own_texture_bytes: u64,
 }
 
 /// An audio mapping, resolved (see the scene file's `controls.audio`).
@@ -178,7 +181,7 @@ impl Scene {
     pub fn texture_bytes(&self, size: (u32, u32)) -> u64 {
         let pixels = u64::from(size.0) * u64::from(size.1);
         let multisampled = if self.msaa > 1 { 12 * u64::from(self.msaa) } else { 0 };
-        self.nodes.len() as u64 * pixels * (16 + multisampled)
+        (self.nodes.len() as u64 * pixels * (16 + multisampled)).saturating_add(self.own_texture_bytes)
     }
 
     /// Whether the scene fits [`MAX_TEXTURE_BYTES`] at `size`; the error says what to lower.
@@ -587,7 +590,9 @@ impl Validator<'_> {
             osc_aliases,
             midi,
             show: None,
+            own_texture_bytes: 0,
         };
+        scene.own_texture_bytes = own_texture_bytes(self.assets, &scene.nodes, scene.size);
         for o in &file.outputs {
             if let Err(e) = scene.attach_output(o) {
                 let anchor = format!("\"{}\"", o.source.as_deref().unwrap_or_default());
@@ -885,6 +890,17 @@ fn describe(raw: &RawValue) -> String {
         RawValue::List(v) => format!("a list of {} numbers", v.len()),
         RawValue::Text(t) => format!("the text \"{t}\""),
     }
+}
+
+/// The texture bytes `nodes` keep beyond their outputs at `size` (see [`Scene::own_texture_bytes`]).
+pub(crate) fn own_texture_bytes(assets: &Assets, nodes: &[SceneNode], size: (u32, u32)) -> u64 {
+    let declared = |n: &SceneNode| {
+        let declarer = n.technique.declare?;
+        let index = n.params.index(declarer.file_param)?;
+        let ParamValue::Text(file) = n.params.value_at(index) else { return None };
+        Some((declarer.texture_bytes)(assets, file.as_str(), size))
+    };
+    nodes.iter().filter_map(declared).fold(0, u64::saturating_add)
 }
 
 #[cfg(test)]

@@ -108,6 +108,10 @@ pub struct Declarer {
     pub declare: fn(&Assets, &str) -> Result<Declared, String>,
     /// The scene text that plays such a file on its own (inputs wired to default sources).
     pub scene_for: fn(&Assets, &str) -> Result<String, ShaderError>,
+    /// The texture bytes a node of the file renders into at a render size, with the file's
+    /// defaults (an ISF shader's pass targets, persistent ones twice): counted in the scene's
+    /// texture budget.
+    pub texture_bytes: fn(&Assets, &str, (u32, u32)) -> u64,
 }
 
 /// The technique that plays files like `path` (by extension; see [`Declarer`]).

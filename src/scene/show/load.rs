@@ -286,7 +286,9 @@ impl Builder<'_> {
             osc_aliases: vec![("/indra/master".into(), Target { node: master, param: 0, component: None })],
             midi: Vec::new(),
             show: None,
+            own_texture_bytes: 0,
         };
+        scene.own_texture_bytes = crate::scene::load::own_texture_bytes(self.assets, &scene.nodes, scene.size);
         self.controls(&file, &mut scene);
         for output in &file.outputs {
             if let Err(e) = scene.attach_output(output) {

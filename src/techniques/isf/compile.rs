@@ -59,13 +59,7 @@ pub fn compile(sources: &Sources<'_>) -> Result<Compiled, ShaderError> {
 /// [`MAX_NODE_TARGET_BYTES`](super::targets::MAX_NODE_TARGET_BYTES) together (the node checks
 /// again at its render size, against the device).
 fn check_sizes(header: &Header) -> Result<(), String> {
-    let defaults: Vec<(String, f64)> =
-        header.inputs.iter().filter_map(|i| Some((i.name.clone(), i.number(i.decl()?.default)?))).collect();
-    let var = |name: &str| match name {
-        "WIDTH" => Some(1920.0),
-        "HEIGHT" => Some(1080.0),
-        _ => defaults.iter().find(|(n, _)| n == name).map(|d| d.1),
-    };
+    let var = super::targets::default_var(header, (1920, 1080));
     super::targets::pass_sizes(&header.passes, (1920, 1080), CHECK_MAX_SIDE, &var).map(|_| ())
 }
 

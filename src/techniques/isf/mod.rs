@@ -43,7 +43,13 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create: node::create,
     check: None,
     stage: None,
-    declare: Some(Declarer { file_param: "file", extension: "fs", declare, scene_for }),
+    declare: Some(Declarer {
+        file_param: "file",
+        extension: "fs",
+        declare,
+        scene_for,
+        texture_bytes: targets::declared_bytes,
+    }),
 };
 
 crate::technique_params! {

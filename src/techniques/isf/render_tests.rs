@@ -429,3 +429,41 @@ void main() { gl_FragColor = IMG_NORM_PIXEL(two, vec2(0.5, isf_FragNormCoord.y >
     let e = OffscreenRenderer::new(gpu(), &assets, scene, Some((16, 16)), None, None).err().unwrap().to_string();
     assert!(e.contains("IMPORTED 'two'") && e.contains("gone.png"), "{e}");
 }
+
+#[test]
+fn a_nodes_targets_are_bounded_together_and_counted_in_the_scene_budget() {
+    let (dir, assets) = shader_dir("targets");
+    let target = |name: &str, (w, h): (u32, u32)| {
+        format!(
+            "{{ \"TARGET\": \"{name}\", \"PERSISTENT\": true, \"FLOAT\": true, \"WIDTH\": \"{w}\", \"HEIGHT\": \"{h}\" }}"
+        )
+    };
+    let file = |name: &str, passes: &[String]| {
+        let path = dir.join(name);
+        let body = format!(
+            "/*{{ \"PASSES\": [ {}, {{ }} ] }}*/\nvoid main() {{ gl_FragColor = vec4(1.0); }}\n",
+            passes.join(", ")
+        );
+        std::fs::write(&path, body).unwrap();
+        path
+    };
+    // Four persistent 8192² float targets (the 835-byte file that took a process to 4.2 GB):
+    // each under the old per-pass bound, refused together by check.
+    let four: Vec<String> = ["a", "b", "c", "d"].iter().map(|n| target(n, (8192, 8192))).collect();
+    let hostile = file("four.fs", &four);
+    let e = super::IsfFiles::read(&assets, hostile.to_str().unwrap()).unwrap().compile().unwrap_err().to_string();
+    assert!(e.contains("MiB together") && e.contains("four.fs:"), "{e}");
+    // One persistent 8192×4096 float target per node (256 MiB, ping-ponged: 512 MiB) passes
+    // alone; seventeen such nodes pass each check but not the scene's 8 GiB budget.
+    let one = file("one.fs", &[target("a", (8192, 4096))]);
+    let node = |i: usize| format!(r#"(id: "n{i}", technique: "isf", params: {{ "file": "{}" }})"#, one.display());
+    let ron = |n: usize| {
+        let nodes: Vec<String> = (0..n).map(node).collect();
+        format!(r#"(name: "many", size: (64, 64), nodes: [{}], output: "n0")"#, nodes.join(", "))
+    };
+    let few = parse_scene_with(&assets, "few.ron", &ron(2)).unwrap_or_else(|e| panic!("{e}"));
+    // Per node: the target twice and the output pass (8-bit, at the scene's 64×64).
+    assert_eq!(few.own_texture_bytes, 2 * (8192 * 4096 * 8 * 2 + 64 * 64 * 4));
+    let e = parse_scene_with(&assets, "many.ron", &ron(17)).err().expect("over the budget").to_string();
+    assert!(e.contains("GiB of textures"), "{e}");
+}

@@ -4,7 +4,7 @@
 //! process to 4 GB and a crash. A persistent target counts twice (it is ping-ponged).
 
 use super::expr;
-use super::header::Pass;
+use super::header::{Header, Pass};
 use super::pipeline::{BYTE_FORMAT, FLOAT_FORMAT};
 
 /// The most texture memory one ISF node's targets may take together, persistent ones counted
@@ -49,6 +49,25 @@ pub fn pass_sizes(
         ));
     }
     Ok(sizes)
+}
+
+/// What `$name` means in `header`'s size expressions at render size `output`, with the inputs'
+/// defaults (what `check` and the scene budget evaluate).
+pub fn default_var(header: &Header, output: (u32, u32)) -> impl Fn(&str) -> Option<f64> + '_ {
+    move |name: &str| match name {
+        "WIDTH" => Some(f64::from(output.0)),
+        "HEIGHT" => Some(f64::from(output.1)),
+        _ => header.inputs.iter().find(|i| i.name == name).and_then(|i| i.number(i.decl()?.default)),
+    }
+}
+
+/// The bytes the targets of ISF file `file` take at render size `output` with its defaults (0
+/// where it cannot be read or sized: that is an error of its own, told by the scene loader).
+pub fn declared_bytes(assets: &crate::assets::Assets, file: &str, output: (u32, u32)) -> u64 {
+    let Ok(files) = super::IsfFiles::read(assets, file) else { return 0 };
+    let Ok(header) = Header::parse(&files.fs.1) else { return 0 };
+    let var = default_var(&header, output);
+    pass_sizes(&header.passes, output, u32::MAX, &var).map_or(0, |sizes| target_bytes(&header.passes, &sizes))
 }
 
 /// The bytes the targets of `passes` at `sizes` take: each named target once (at the size of the
