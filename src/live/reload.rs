@@ -200,10 +200,7 @@ impl LiveReload {
         size: (u32, u32),
     ) -> Result<bool, String> {
         let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default().to_string();
-        let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        if self.stalled.get(path) == Some(&source) {
-            return Err(self.broken.get(path).cloned().unwrap_or_default());
-        }
+        let source = self.read_untried(path)?;
         self.stalled.remove(path);
         let origin = path.display().to_string();
         let running = &self.running;
@@ -222,6 +219,15 @@ impl LiveReload {
         Ok(used)
     }
 
+    /// The text of `path` now, unless it is the text that stalled the GPU (then its error).
+    fn read_untried(&self, path: &Path) -> Result<String, String> {
+        let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        if self.stalled.get(path) == Some(&source) {
+            return Err(self.broken.get(path).cloned().unwrap_or_default());
+        }
+        Ok(source)
+    }
+
     /// For a file nodes declare their parameters from (an ISF shader, `.fs` or its `.vs`):
     /// Ok(true) if nodes read it and the scene was loaded again with them rebuilt — its inputs
     /// may have changed, so the scene's parameters are declared anew; an error keeps the last
@@ -235,10 +241,7 @@ impl LiveReload {
         size: (u32, u32),
         report: &mut ReloadReport,
     ) -> Result<bool, String> {
-        let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        if self.stalled.get(path) == Some(&source) {
-            return Err(self.broken.get(path).cloned().unwrap_or_default());
-        }
+        let source = self.read_untried(path)?;
         let real = path.canonicalize().map_err(|e| format!("{}: {e}", path.display()))?;
         let previous = self.running.pinned_file(&real);
         let next = self.running.with_file(real, Arc::from(source.as_bytes()));
