@@ -707,7 +707,7 @@ fn websockets_stalled_mid_frame_are_closed_and_free_their_places() {
             let mut s = std::net::TcpStream::connect(addr).unwrap();
             write!(
                 s,
-                "GET / HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Version: 13\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n"
+                "GET / HTTP/1.1\r\nHost: localhost\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Version: 13\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n\r\n"
             )
             .unwrap();
             let mut answer = [0u8; 12];
