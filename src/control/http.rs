@@ -180,7 +180,7 @@ impl HttpServer {
             let stop = stop.clone();
             std::thread::Builder::new()
                 .name(format!("indra-{name}"))
-                .spawn(move || accept_loop(&listener, &stop, &routes, &SiteGuard::new(local, &routes.sites)))
+                .spawn(move || accept_loop(&listener, &stop, &routes, &Arc::new(SiteGuard::new(local, &routes.sites))))
                 .map_err(|e| e.to_string())?
         };
         Ok(Self { local, stop, thread: Some(thread) })
@@ -201,7 +201,7 @@ impl Drop for HttpServer {
     }
 }
 
-fn accept_loop(listener: &TcpListener, stop: &AtomicBool, routes: &Routes, guard: &SiteGuard) {
+fn accept_loop(listener: &TcpListener, stop: &AtomicBool, routes: &Routes, guard: &Arc<SiteGuard>) {
     let active = Arc::new(AtomicUsize::new(0));
     let peers: Arc<Mutex<HashMap<IpAddr, usize>>> = Arc::default();
     let sockets = Arc::new(AtomicUsize::new(0));
@@ -268,11 +268,12 @@ fn serve(mut stream: TcpStream, routes: &Routes, guard: &SiteGuard, sockets: &At
         let _ = write_reply(&mut stream, &Reply::status(421));
         return;
     }
+    let origin = guard.origin(&request);
     let mut reply = match (&routes.socket, websocket_key(method, &request)) {
-        (Some(_), Some(_)) if guard.origin(&request) == Origin::Foreign => Reply::status(403),
+        (Some(_), Some(_)) if origin == Origin::Foreign => Reply::status(403),
         (Some(handler), Some(key)) => {
             if sockets.fetch_add(1, Ordering::Relaxed) < routes.max_sockets {
-                upgrade(stream, &request, guard.origin(&request), key, handler);
+                upgrade(stream, &request, origin, key, handler);
                 sockets.fetch_sub(1, Ordering::Relaxed);
                 return;
             }
@@ -281,7 +282,7 @@ fn serve(mut stream: TcpStream, routes: &Routes, guard: &SiteGuard, sockets: &At
         }
         _ => answer(method, &request, &routes.get),
     };
-    reply.headers.extend(guard.cors_headers(&request));
+    reply.headers.extend(SiteGuard::cors_headers(&request, origin));
     let _ = write_reply(&mut stream, &reply);
 }
 

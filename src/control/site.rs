@@ -92,9 +92,10 @@ impl SiteGuard {
         if own { Origin::Own } else { Origin::Foreign }
     }
 
-    /// The CORS headers for a reply to `request`: an allowed third-party origin may read it.
-    pub fn cors_headers(&self, request: &Request<'_>) -> Vec<(&'static str, String)> {
-        match (self.origin(request), request.header("origin")) {
+    /// The CORS headers for a reply to `request` from a page of `origin` (as [`SiteGuard::origin`]
+    /// classed it): an allowed third-party origin may read it.
+    pub fn cors_headers(request: &Request<'_>, origin: Origin) -> Vec<(&'static str, String)> {
+        match (origin, request.header("origin")) {
             (Origin::Allowed, Some(origin)) => {
                 vec![("Access-Control-Allow-Origin", origin.to_string()), ("Vary", "Origin".to_string())]
             }
@@ -161,8 +162,14 @@ mod tests {
         for foreign in ["http://127.0.0.1:8081", "http://evil.example", "http://127.0.0.1", "null", "file://"] {
             assert_eq!(origin(foreign), Origin::Foreign, "{foreign}");
         }
-        let headers = g.cors_headers(&with("Origin: http://127.0.0.1:5173"));
-        assert_eq!(headers[0], ("Access-Control-Allow-Origin", "http://127.0.0.1:5173".to_string()));
-        assert!(g.cors_headers(&with("Origin: http://evil.example")).is_empty());
+        let cors = |o: &str| {
+            let request = format!("Origin: {o}");
+            SiteGuard::cors_headers(&with(&request), g.origin(&with(&request)))
+        };
+        assert_eq!(
+            cors("http://127.0.0.1:5173")[0],
+            ("Access-Control-Allow-Origin", "http://127.0.0.1:5173".to_string())
+        );
+        assert!(cors("http://evil.example").is_empty());
     }
 }

@@ -572,6 +572,7 @@ impl Validator<'_> {
         if !self.errors.is_empty() {
             return Err(self.failure());
         }
+        let own_texture_bytes = own_texture_bytes(self.assets, &ordered, file.size);
         let mut scene = Scene {
             origin: self.origin.into(),
             name: file.name,
@@ -590,9 +591,8 @@ impl Validator<'_> {
             osc_aliases,
             midi,
             show: None,
-            own_texture_bytes: 0,
+            own_texture_bytes,
         };
-        scene.own_texture_bytes = own_texture_bytes(self.assets, &scene.nodes, scene.size);
         for o in &file.outputs {
             if let Err(e) = scene.attach_output(o) {
                 let anchor = format!("\"{}\"", o.source.as_deref().unwrap_or_default());

@@ -268,6 +268,7 @@ impl Builder<'_> {
             show.cues = file.cues.iter().enumerate().filter_map(|(i, c)| self.cue(&show, i, c)).collect();
         }
         show.kinds = std::mem::take(&mut self.kinds);
+        let own_texture_bytes = crate::scene::load::own_texture_bytes(self.assets, &nodes, file.size);
         let mut scene = Scene {
             origin: self.origin.to_string(),
             name: file.name.clone(),
@@ -286,9 +287,8 @@ impl Builder<'_> {
             osc_aliases: vec![("/indra/master".into(), Target { node: master, param: 0, component: None })],
             midi: Vec::new(),
             show: None,
-            own_texture_bytes: 0,
+            own_texture_bytes,
         };
-        scene.own_texture_bytes = crate::scene::load::own_texture_bytes(self.assets, &scene.nodes, scene.size);
         self.controls(&file, &mut scene);
         for output in &file.outputs {
             if let Err(e) = scene.attach_output(output) {

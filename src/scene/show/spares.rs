@@ -133,11 +133,6 @@ impl Spares {
         }
     }
 
-    /// Builds in flight now (for tests and the soak's report).
-    pub fn in_flight(&self) -> usize {
-        self.in_flight.load(Ordering::Relaxed)
-    }
-
     /// Copies finished on worker threads since the last call; queued copies take the places
     /// that freed.
     pub fn finished(&mut self) -> Vec<Finished> {

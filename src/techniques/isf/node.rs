@@ -345,16 +345,19 @@ impl Technique for IsfNode {
         let compiled = std::sync::Arc::clone(&self.compiled);
         let header_passes = &compiled.header.passes;
         // Sizes first: bad sizes (an input driven out of range) keep the last good ones, told once.
-        match self.pass_sizes(params, output) {
-            Ok(sizes) => self.sizes = sizes,
+        let sizes = match self.pass_sizes(params, output) {
+            Ok(sizes) => {
+                self.sizes.clone_from(&sizes);
+                sizes
+            }
             Err(problem) => {
                 if self.size_problem.as_ref() != Some(&problem) {
                     self.messages.push(format!("{}: {problem}; the passes keep their sizes", self.id));
                     self.size_problem = Some(problem);
                 }
+                self.sizes.clone()
             }
-        }
-        let sizes = self.sizes.clone();
+        };
         // Persistent targets, (re)made to their size; both halves imported.
         let mut feedback_handles: BTreeMap<String, [TextureHandle; 2]> = BTreeMap::new();
         for (pass, size) in header_passes.iter().zip(&sizes) {
