@@ -4,6 +4,7 @@
 //! the error (file:line:col) is reported once, until the next save fixes it. A lost or stuck GPU
 //! moves the show to a new device built from the last good shaders.
 
+mod prepare;
 mod recovery;
 mod reload;
 mod watcher;

@@ -1,16 +1,20 @@
 //! Applying changed files to the running scene, keeping the last good version on any error.
+//! In a live show a changed file is read, parsed, validated and built on a worker thread (see
+//! [`Job`]), one file at a time in the order they changed; the render thread only starts the
+//! job and installs what it built, so a large or hostile file never holds a frame.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, VecDeque};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
-use super::watcher::{Watcher, read_stable};
+use super::prepare::{Job, Prepared, rebuild_reading};
+use super::watcher::Watcher;
 use crate::assets::{Asset, AssetKind, Assets};
-use crate::gpu::{Gpu, validate_as_used};
+use crate::gpu::Gpu;
 use crate::params::Remap;
-use crate::scene::show::parse_show;
-use crate::scene::{Player, SceneInstance, load_scene, parse_scene_with};
+use crate::scene::{Outdated, Player};
 
 /// What one poll did.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -41,7 +45,23 @@ pub struct LiveReload {
     newest: Option<AppliedShader>,
     /// File → the text that stalled the GPU: saved again unchanged, it is not tried again.
     stalled: BTreeMap<PathBuf, String>,
+    /// Changed files waiting for their reload, oldest first, each once.
+    queue: VecDeque<PathBuf>,
+    /// The reload being built on a worker thread.
+    building: Option<Building>,
+    /// Counts the changes of `running`: a reload built from older assets is made again.
+    generation: u64,
 }
+
+/// A reload under way on a worker thread.
+struct Building {
+    path: PathBuf,
+    generation: u64,
+    receiver: Receiver<Result<Prepared, String>>,
+}
+
+/// The most changed files waiting at once (each file once); past it a change is dropped, told.
+pub const MAX_QUEUED_RELOADS: usize = 256;
 
 /// A shader reload that was applied, with the version it replaced.
 struct AppliedShader {
@@ -79,7 +99,16 @@ impl LiveReload {
         let dirs = assets.watched_dirs();
         let watcher = if dirs.is_empty() { None } else { Some(Watcher::watch(&dirs)?) };
         let running = pin_declared_files(assets.with_shaders_pinned(), &dirs);
-        Ok(Self { watcher, running, broken: BTreeMap::new(), newest: None, stalled: BTreeMap::new() })
+        Ok(Self {
+            watcher,
+            running,
+            broken: BTreeMap::new(),
+            newest: None,
+            stalled: BTreeMap::new(),
+            queue: VecDeque::new(),
+            building: None,
+            generation: 0,
+        })
     }
 
     /// Marks a file as broken from the start (the show began with the built-in copy).
@@ -87,6 +116,7 @@ impl LiveReload {
         let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default();
         if let Ok(built_in) = Assets::new(None).load(AssetKind::Shader, name) {
             self.running = self.running.with_shader(built_in);
+            self.generation += 1;
         }
         self.broken.insert(path, error);
     }
@@ -119,6 +149,7 @@ impl LiveReload {
                 RolledBack::Declared(path)
             }
         };
+        self.generation += 1;
         let message = format!("{}: {why}; rolled back to the version before it", newest.path.display());
         self.broken.insert(newest.path.clone(), message.clone());
         self.stalled.insert(newest.path, newest.source);
@@ -126,7 +157,7 @@ impl LiveReload {
     }
 
     /// Reloads the running scene with the ISF file at `path` as the running assets hold it now
-    /// (after [`LiveReload::roll_back_newest`]): the nodes that read it are rebuilt.
+    /// (after [`LiveReload::roll_back_newest`]): the nodes that read it are rebuilt, at once.
     pub fn rebuild_declared(
         &self,
         path: &Path,
@@ -134,12 +165,16 @@ impl LiveReload {
         gpu: &Gpu,
         size: (u32, u32),
     ) -> Result<(), String> {
-        let mut report = ReloadReport::default();
-        self.rebuild_reading(path, player.instance_mut(), gpu, size, &mut report, &self.running).map(|_| ())?;
-        if let Some(remap) = &report.remap {
-            player.remap(remap);
-        }
+        let snapshot = player.instance().snapshot();
+        let Some(replacement) = rebuild_reading(path, &snapshot, gpu, size, &self.running)? else { return Ok(()) };
+        let remap = player.instance_mut().install(replacement).expect("built from the running scene");
+        player.remap(&remap);
         Ok(())
+    }
+
+    /// The file whose reload is being built on a worker thread, if one is.
+    pub fn building(&self) -> Option<&Path> {
+        self.building.as_ref().map(|b| b.path.as_path())
     }
 
     /// Files currently broken, with their errors.
@@ -147,186 +182,167 @@ impl LiveReload {
         self.broken.iter()
     }
 
-    /// Applies whatever changed on disk since the last poll to `player`'s scene.
+    /// Takes up what changed on disk since the last poll: installs a reload built meanwhile, and
+    /// starts building the next changed file's on a worker thread. Never waits.
     pub fn poll(&mut self, player: &mut Player, gpu: &Gpu, size: (u32, u32)) -> ReloadReport {
-        let changed = self.watcher.as_ref().map(Watcher::changed).unwrap_or_default();
-        self.apply(&changed, player, gpu, size)
-    }
-
-    /// Applies the given changed files. When the scene is replaced, the player's scheduled
-    /// events follow the [`ReloadReport::remap`]; the caller applies it to whatever else holds
-    /// parameter positions (queued UI events, MIDI learn).
-    pub fn apply(&mut self, files: &[PathBuf], player: &mut Player, gpu: &Gpu, size: (u32, u32)) -> ReloadReport {
-        let mut report = ReloadReport::default();
-        let instance = player.instance_mut();
-        for path in files {
-            let shown = path.display().to_string();
-            let result = match path.extension().and_then(|e| e.to_str()) {
-                Some("wgsl") => self.reload_shader(path, instance, gpu, size),
-                Some("ron") => self.reload_scene(path, instance, gpu, size, &mut report),
-                Some("fs" | "vs") => self.reload_declared(path, instance, gpu, size, &mut report),
-                _ => continue,
-            };
-            match result {
-                Ok(true) => {
-                    report.applied.push(shown.clone());
-                    if self.broken.remove(path).is_some() {
-                        report.fixed.push(shown);
-                    }
-                }
-                Ok(false) => {}
-                Err(e) => {
-                    // Reported once: the same error again (another save, same mistake) stays quiet.
-                    // The caller shows and logs it.
-                    if self.broken.get(path) != Some(&e) {
-                        report.errors.push(e.clone());
-                    }
-                    self.broken.insert(path.clone(), e);
-                }
-            }
+        for path in self.watcher.as_ref().map(Watcher::changed).unwrap_or_default() {
+            self.enqueue(path);
         }
-        if let Some(remap) = &report.remap {
-            player.remap(remap);
+        let mut report = ReloadReport::default();
+        if let Some((building, result)) = self.finished() {
+            self.finish(building.path, building.generation, result, player, &mut report);
+        }
+        if self.building.is_none()
+            && let Some(path) = self.queue.pop_front()
+        {
+            self.start(path, player, gpu, size);
         }
         report
     }
 
-    /// Ok(true) if nodes were rebuilt, Ok(false) if no node uses the shader.
-    fn reload_shader(
+    /// Applies the given changed files at once, in order, on this thread (renders and tests).
+    /// When the scene is replaced, the player's scheduled events follow the
+    /// [`ReloadReport::remap`]; the caller applies it to whatever else holds parameter positions
+    /// (queued UI events, MIDI learn).
+    pub fn apply(&mut self, files: &[PathBuf], player: &mut Player, gpu: &Gpu, size: (u32, u32)) -> ReloadReport {
+        let mut report = ReloadReport::default();
+        for path in files {
+            let result = self.job(path.clone(), player, gpu, size).run();
+            self.finish(path.clone(), self.generation, result, player, &mut report);
+        }
+        report
+    }
+
+    /// Queues `path` for reloading, unless it waits already.
+    fn enqueue(&mut self, path: PathBuf) {
+        if self.queue.contains(&path) {
+            return;
+        }
+        if self.queue.len() >= MAX_QUEUED_RELOADS {
+            log::warn!("{}: {MAX_QUEUED_RELOADS} files wait for reloading; this change is dropped", path.display());
+            return;
+        }
+        self.queue.push_back(path);
+    }
+
+    /// What reloading `path` needs, taken from the running show now.
+    fn job(&self, path: PathBuf, player: &Player, gpu: &Gpu, size: (u32, u32)) -> Job {
+        let stalled =
+            self.stalled.get(&path).map(|text| (text.clone(), self.broken.get(&path).cloned().unwrap_or_default()));
+        Job {
+            path,
+            running: self.running.clone(),
+            snapshot: player.instance().snapshot(),
+            gpu: gpu.clone(),
+            size,
+            stalled,
+        }
+    }
+
+    /// Starts building `path`'s reload on a worker thread.
+    fn start(&mut self, path: PathBuf, player: &Player, gpu: &Gpu, size: (u32, u32)) {
+        let job = self.job(path.clone(), player, gpu, size);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        let spawned = std::thread::Builder::new().name("indra-reload".into()).spawn(move || {
+            let _ = sender.send(job.run());
+        });
+        let receiver = match spawned {
+            Ok(_) => receiver,
+            Err(e) => {
+                let (sender, failed) = std::sync::mpsc::channel();
+                let _ = sender.send(Err(format!("{}: no thread to reload it ({e})", path.display())));
+                failed
+            }
+        };
+        self.building = Some(Building { path, generation: self.generation, receiver });
+    }
+
+    /// The reload under way, with its result, once it is built.
+    fn finished(&mut self) -> Option<(Building, Result<Prepared, String>)> {
+        let result = match self.building.as_ref()?.receiver.try_recv() {
+            Ok(result) => result,
+            Err(TryRecvError::Empty) => return None,
+            Err(TryRecvError::Disconnected) => Err("the reload failed".to_string()),
+        };
+        let building = self.building.take().expect("checked above");
+        Some((building, result))
+    }
+
+    /// Installs a built reload and reports it; one built for assets or a scene that changed
+    /// since goes back to the front of the queue, to be built again.
+    fn finish(
+        &mut self,
+        path: PathBuf,
+        generation: u64,
+        result: Result<Prepared, String>,
+        player: &mut Player,
+        report: &mut ReloadReport,
+    ) {
+        let installed = match result {
+            _ if generation != self.generation => Err(Outdated),
+            Ok(prepared) => self.install(&path, prepared, player, report).map(Ok),
+            Err(e) => Ok(Err(e)),
+        };
+        let shown = path.display().to_string();
+        match installed {
+            Err(Outdated) => self.queue.push_front(path),
+            Ok(Ok(true)) => {
+                report.applied.push(shown.clone());
+                if self.broken.remove(&path).is_some() {
+                    report.fixed.push(shown);
+                }
+            }
+            Ok(Ok(false)) => {}
+            Ok(Err(e)) => {
+                // Reported once: the same error again (another save, same mistake) stays quiet.
+                // The caller shows and logs it.
+                if self.broken.get(&path) != Some(&e) {
+                    report.errors.push(e.clone());
+                }
+                self.broken.insert(path, e);
+            }
+        }
+    }
+
+    /// Swaps what `prepared` built into the running show: Ok(true) if nodes changed, Ok(false)
+    /// if the running show does not use the file.
+    fn install(
         &mut self,
         path: &Path,
-        instance: &mut SceneInstance,
-        gpu: &Gpu,
-        size: (u32, u32),
-    ) -> Result<bool, String> {
-        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default().to_string();
-        let source = self.read_untried(path)?;
+        prepared: Prepared,
+        player: &mut Player,
+        report: &mut ReloadReport,
+    ) -> Result<bool, Outdated> {
+        let mut replace = |replacement| -> Result<(), Outdated> {
+            let remap = player.instance_mut().install(replacement)?;
+            player.remap(&remap);
+            report.scene_changed = true;
+            report.remap = Some(remap);
+            Ok(())
+        };
+        let (previous, source, used) = match prepared {
+            Prepared::Unused | Prepared::Declared { replacement: None, .. } => return Ok(false),
+            Prepared::Scene(replacement) => return replace(replacement).map(|()| true),
+            Prepared::Shader { next, name, source, rebuild } => {
+                let used = !rebuild.is_empty();
+                player.instance_mut().install_nodes(rebuild)?;
+                let previous = self.running.load(AssetKind::Shader, &name).ok().map(Previous::Shader);
+                self.running = next;
+                (previous, source, used)
+            }
+            Prepared::Declared { next, real, source, replacement: Some(replacement) } => {
+                replace(replacement)?;
+                let previous = self.running.pinned_file(&real).map(Previous::Declared);
+                self.running = next;
+                (previous, source, true)
+            }
+        };
+        self.generation += 1;
         self.stalled.remove(path);
-        let origin = path.display().to_string();
-        let running = &self.running;
-        let shaders = running.names(AssetKind::Shader);
-        validate_as_used(&name, (&origin, &source), &shaders, |n| {
-            running.load(AssetKind::Shader, n).map(|a| (a.origin, a.source))
-        })?;
-        let next = self.running.with_shader(Asset { name: name.clone(), origin, source: source.clone() });
-        let used = instance.rebuild_nodes_using(&name, gpu, &next, size).map_err(|e| e.to_string())?;
-        let previous = self.running.load(AssetKind::Shader, &name).ok();
-        self.running = next;
         if let Some(previous) = previous.filter(|_| used) {
-            let previous = Previous::Shader(previous);
             self.newest = Some(AppliedShader { path: path.to_path_buf(), previous, source, at: Instant::now() });
         }
         Ok(used)
-    }
-
-    /// The text of `path` now, unless it is the text that stalled the GPU (then its error).
-    fn read_untried(&self, path: &Path) -> Result<String, String> {
-        let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        if self.stalled.get(path) == Some(&source) {
-            return Err(self.broken.get(path).cloned().unwrap_or_default());
-        }
-        Ok(source)
-    }
-
-    /// For a file nodes declare their parameters from (an ISF shader, `.fs` or its `.vs`):
-    /// Ok(true) if nodes read it and the scene was loaded again with them rebuilt — its inputs
-    /// may have changed, so the scene's parameters are declared anew; an error keeps the last
-    /// good version running. An applied edit is the newest reload: a stall right after it
-    /// takes it back, and the text that stalled is not tried again until it changes.
-    fn reload_declared(
-        &mut self,
-        path: &Path,
-        instance: &mut SceneInstance,
-        gpu: &Gpu,
-        size: (u32, u32),
-        report: &mut ReloadReport,
-    ) -> Result<bool, String> {
-        let source = self.read_untried(path)?;
-        let real = path.canonicalize().map_err(|e| format!("{}: {e}", path.display()))?;
-        let previous = self.running.pinned_file(&real);
-        let next = self.running.with_file(real, Arc::from(source.as_bytes()));
-        if !self.rebuild_reading(path, instance, gpu, size, report, &next)? {
-            return Ok(false);
-        }
-        self.stalled.remove(path);
-        self.running = next;
-        if let Some(previous) = previous {
-            let previous = Previous::Declared(previous);
-            self.newest = Some(AppliedShader { path: path.to_path_buf(), previous, source, at: Instant::now() });
-        }
-        Ok(true)
-    }
-
-    /// Loads the running scene again from `assets` and rebuilds the nodes that read the ISF
-    /// file `path` (or its companion); Ok(false) when none does.
-    fn rebuild_reading(
-        &self,
-        path: &Path,
-        instance: &mut SceneInstance,
-        gpu: &Gpu,
-        size: (u32, u32),
-        report: &mut ReloadReport,
-        assets: &Assets,
-    ) -> Result<bool, String> {
-        let shader = path.with_extension("fs").canonicalize().ok();
-        let reads_it = |n: &crate::scene::SceneNode| {
-            n.technique.declare.is_some_and(|d| {
-                let file = n.params.index(d.file_param).map(|i| n.params.value_at(i));
-                let Some(crate::params::ParamValue::Text(file)) = file else { return false };
-                let located = self.running.locate_file(file.as_str()).ok().and_then(|p| p.canonicalize().ok());
-                located.is_some() && located == shader
-            })
-        };
-        if !instance.scene().nodes.iter().any(reads_it) {
-            return Ok(false);
-        }
-        let origin = instance.scene().origin.clone();
-        // A built-in scene reloads by its name; one from disk (or a bare .fs) by its path.
-        let name = origin.strip_prefix("<embedded>/scenes/").unwrap_or(&origin);
-        let scene = load_scene(assets, name).map_err(|e| e.to_string())?;
-        let remap =
-            instance.replace_scene_rebuilding(scene, gpu, assets, size, &reads_it).map_err(|e| e.to_string())?;
-        report.scene_changed = true;
-        report.remap = Some(remap);
-        Ok(true)
-    }
-
-    /// Ok(true) if the running scene was replaced by its edited file.
-    fn reload_scene(
-        &self,
-        path: &Path,
-        instance: &mut SceneInstance,
-        gpu: &Gpu,
-        size: (u32, u32),
-        report: &mut ReloadReport,
-    ) -> Result<bool, String> {
-        let same_file = |origin: &str| {
-            let running = Path::new(origin);
-            running.canonicalize().ok().zip(path.canonicalize().ok()).is_some_and(|(a, b)| a == b)
-        };
-        let scene = match &instance.scene().show {
-            // A show reloads when its file or one of its clips' scenes changes; a clip that
-            // breaks keeps the whole show as it was (its last good version plays on).
-            Some(show) => {
-                if !show.sources.iter().any(|s| same_file(s)) {
-                    return Ok(false);
-                }
-                let origin = instance.scene().origin.clone();
-                let source = read_stable(Path::new(&origin)).map_err(|e| format!("{origin}: {e}"))?;
-                parse_show(&self.running, &origin, &source, false).map_err(|e| e.to_string())?
-            }
-            None => {
-                if !same_file(&instance.scene().origin) {
-                    return Ok(false);
-                }
-                let source = read_stable(path).map_err(|e| format!("{}: {e}", path.display()))?;
-                parse_scene_with(&self.running, &path.display().to_string(), &source).map_err(|e| e.to_string())?
-            }
-        };
-        let remap = instance.replace_scene(scene, gpu, &self.running, size).map_err(|e| e.to_string())?;
-        report.scene_changed = true;
-        report.remap = Some(remap);
-        Ok(true)
     }
 }
 

@@ -9,7 +9,7 @@ mod schema;
 pub mod show;
 
 pub use error::{SceneError, SceneErrors};
-pub use instance::{SceneInstance, SceneView};
+pub use instance::{NodeRebuild, Outdated, Replacement, SceneInstance, SceneSnapshot, SceneView};
 pub use load::{
     AudioMapping, BoundTrack, MAX_NAME_CHARS, Scene, SceneNode, SceneOutput, check_audio, load_scene, names_a_show,
     parse_scene, parse_scene_with, parse_value_override, resolve_target,

@@ -82,7 +82,6 @@ pub struct Mixer {
     passes: Vec<ImagePass>,
     /// Per kind: for an ISF kind, one node per layer.
     isf: Vec<Vec<IsfTransition>>,
-    files: Vec<String>,
 }
 
 impl Mixer {
@@ -114,14 +113,14 @@ impl Mixer {
             Some(k) => show.layers.iter().map(|_| ImagePass::new(device, k)).collect(),
             None => Vec::new(),
         };
-        let mut files: Vec<String> = show.kinds.iter().filter(|k| !is_isf(k)).map(|k| transition_file(k)).collect();
-        files.push(TRANSITION_BASE.into());
-        Ok(Self { kernels, passes, isf, files })
+        Ok(Self { kernels, passes, isf })
     }
 
-    /// Whether the mixer was built from shader file `name` (to rebuild it after an edit).
-    pub fn uses(&self, name: &str) -> bool {
-        self.files.iter().any(|f| f == name)
+    /// The shader files a mixer for `show` is built from (an edit of one rebuilds it).
+    pub fn files_for(show: &Show) -> Vec<String> {
+        let mut files: Vec<String> = show.kinds.iter().filter(|k| !is_isf(k)).map(|k| transition_file(k)).collect();
+        files.push(TRANSITION_BASE.into());
+        files
     }
 
     /// This frame's use of the mixer: each layer's pass lent out once.

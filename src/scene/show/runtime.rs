@@ -97,16 +97,10 @@ impl ShowRuntime {
         }
     }
 
-    /// Whether the transitions were built from shader `name`.
-    pub fn uses_shader(&self, name: &str) -> bool {
-        self.mixer.uses(name)
-    }
-
-    /// Rebuilds the transitions with `assets` (a shader edit); on error the old ones stay.
-    pub fn rebuild_mixer(&mut self, assets: &Assets) -> Result<(), ShaderError> {
-        self.mixer = Mixer::new(&self.gpu, assets, &self.plan)?;
+    /// Takes transitions rebuilt with `assets` (a shader edit) in place of the old ones.
+    pub fn install_mixer(&mut self, mixer: Mixer, assets: &Assets) {
+        self.mixer = mixer;
         self.assets = assets.clone();
-        Ok(())
     }
 
     /// Queues a command for the next step.

@@ -296,6 +296,15 @@ fn a_broken_isf_file_is_a_located_error_and_the_fix_reloads_with_its_new_inputs(
         )
         .replace("vec4(level, 0.0, 0.0, 1.0)", "vec4(level, green, 0.0, 1.0)");
     std::fs::write(&file, fixed).unwrap();
+    // The fix is parsed, compiled and built off the render thread: the poll that takes the
+    // change up returns before it is installed, and frames go on with the running version.
+    let start = std::time::Instant::now();
+    while live.building().is_none() {
+        let report = r.poll_reload(&mut live);
+        assert!(report.applied.is_empty() && start.elapsed().as_secs() < 5, "{report:?}");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert!(r.render_next().unwrap().rgba == before.rgba, "the running version draws while the fix builds");
     let report = wait_for_reload(&mut r, &mut live);
     assert!(report.scene_changed && report.fixed.len() == 1, "{report:?}");
     assert!(near(rgb(&r.render_next().unwrap(), 8, 8), [128, 255, 0]), "the new input is live");

@@ -7,6 +7,8 @@
 //! A live write (UI, OSC, MIDI) to a parameter a track drives stops that track for that parameter
 //! until `resume_tracks`, so a performer's fader is never yanked back by automation.
 
+mod rebuild;
+
 use std::collections::BTreeSet;
 
 use super::load::Scene;
@@ -19,6 +21,7 @@ use crate::params::{
 };
 use crate::techniques::{NodeSetup, Technique};
 use crate::time::FrameTime;
+pub use rebuild::{NodeRebuild, Outdated, Replacement, SceneSnapshot};
 
 /// What the control layer reads of a running show: the scene, every node's parameters and the
 /// tempo clock — not its GPU nodes, so protocol code (and its tests) needs no device.
@@ -58,6 +61,9 @@ pub struct SceneInstance {
     messages: Vec<String>,
     /// A show's clips, transitions and cues (`None` for a scene).
     show: Option<ShowRuntime>,
+    /// Counts the changes of scene and nodes (reloads, a new device): what a rebuild made ahead
+    /// checks before it is installed.
+    revision: u64,
 }
 
 impl SceneInstance {
@@ -83,6 +89,7 @@ impl SceneInstance {
             pending_morph: None,
             refused: BTreeSet::new(),
             messages,
+            revision: 0,
         })
     }
 
@@ -279,9 +286,9 @@ impl SceneInstance {
         self.nodes.iter().any(|n| n.simulates_on_gpu())
     }
 
-    /// Recreates every node whose technique loads shader file `name` (after an edit). Either all
-    /// of them build and are swapped in, or none is and the error is returned. Returns whether
-    /// any node uses the shader. (Stateless techniques lose nothing; stateful ones restart.)
+    /// Recreates every node whose technique loads shader file `name` (after an edit), at once
+    /// (see [`NodeRebuild`] for building them ahead). Either all of them build and are swapped
+    /// in, or none is and the error is returned. Returns whether anything uses the shader.
     pub fn rebuild_nodes_using(
         &mut self,
         name: &str,
@@ -289,20 +296,10 @@ impl SceneInstance {
         assets: &Assets,
         output_size: (u32, u32),
     ) -> Result<bool, ShaderError> {
-        let using: Vec<usize> =
-            (0..self.nodes.len()).filter(|&i| self.scene.nodes[i].technique.shaders.contains(&name)).collect();
-        let rebuilt = using
-            .iter()
-            .map(|&i| create_node(&self.scene, i, &self.params[i], gpu, assets, output_size))
-            .collect::<Result<Vec<_>, _>>()?;
-        let mixer_uses = self.show.as_ref().is_some_and(|s| s.uses_shader(name));
-        if let Some(show) = self.show.as_mut().filter(|_| mixer_uses) {
-            show.rebuild_mixer(assets)?;
-        }
-        for (i, node) in using.iter().zip(rebuilt) {
-            self.nodes[*i] = node;
-        }
-        Ok(!using.is_empty() || mixer_uses)
+        let rebuild = NodeRebuild::prepare(&self.snapshot(), name, gpu, assets, output_size)?;
+        let used = !rebuild.is_empty();
+        self.install_nodes(rebuild).expect("built from this revision");
+        Ok(used)
     }
 
     /// Recreates every node on `gpu` (a new device after the old one was lost or hung).
@@ -317,6 +314,7 @@ impl SceneInstance {
             show.keep_state(old);
             self.show = Some(show);
         }
+        self.revision += 1;
         Ok(())
     }
 
@@ -336,7 +334,7 @@ impl SceneInstance {
     }
 
     /// [`Self::replace_scene`], creating anew the nodes `rebuild` picks even where they are
-    /// unchanged (their file changed: an ISF shader).
+    /// unchanged (their file changed: an ISF shader). See [`Replacement`] for building ahead.
     pub fn replace_scene_rebuilding(
         &mut self,
         scene: Scene,
@@ -345,63 +343,8 @@ impl SceneInstance {
         output_size: (u32, u32),
         rebuild: &dyn Fn(&super::SceneNode) -> bool,
     ) -> Result<Remap, ShaderError> {
-        // A changed sample count rebuilds every node (pipelines are made for one count); so does
-        // a changed list of parameters (a file that declares them changed).
-        let same_msaa = self.scene.msaa == scene.msaa;
-        let same_decls = |a: &ParamSet, b: &ParamSet| {
-            a.decls().len() == b.decls().len() && a.decls().iter().zip(b.decls()).all(|(x, y)| x.name == y.name)
-        };
-        let kept = |n: &super::SceneNode| {
-            self.scene.nodes.iter().position(|o| {
-                same_msaa
-                    && o.id == n.id
-                    && o.technique.name == n.technique.name
-                    && same_decls(&o.params, &n.params)
-                    && !rebuild(n)
-            })
-        };
-        let mut fresh: Vec<Option<Box<dyn Technique>>> = Vec::with_capacity(scene.nodes.len());
-        for (i, n) in scene.nodes.iter().enumerate() {
-            fresh.push(match kept(n) {
-                Some(_) => None,
-                None => Some(create_node(&scene, i, &n.params, gpu, assets, output_size)?),
-            });
-        }
-        let mut show = ShowRuntime::new(gpu, assets, &scene, output_size)?;
-        let mut old_nodes: Vec<Option<Box<dyn Technique>>> = self.nodes.drain(..).map(Some).collect();
-        let mut params = Vec::with_capacity(scene.nodes.len());
-        for (n, new) in scene.nodes.iter().zip(fresh.iter_mut()) {
-            let mut set = n.params.clone();
-            if let Some(old) = kept(n) {
-                let (old_decls, old_set) = (&self.scene.nodes[old].params, &self.params[old]);
-                for (p, decl) in set.decls().to_vec().iter().enumerate() {
-                    let Some(op) = old_decls.index(&decl.name) else { continue };
-                    let unchanged = old_decls.decls()[op].default == decl.default;
-                    if unchanged && old_set.decls()[op].ty() == decl.ty() {
-                        set.set_at(p, old_set.target_at(op));
-                    }
-                }
-                set.snap();
-                *new = old_nodes[old].take();
-            }
-            params.push(set);
-        }
-        let remap = Remap::between(
-            self.scene.nodes.iter().map(|n| n.id.as_str()).zip(&self.params),
-            scene.nodes.iter().map(|n| n.id.as_str()).zip(&params),
-        );
-        self.nodes = fresh.into_iter().map(|n| n.expect("every node kept or created")).collect();
-        self.params = params;
-        self.scene = scene;
-        if let (Some(show), Some(old)) = (&mut show, &self.show) {
-            let messages = show.carry_over(old, &self.scene, &self.params, &mut self.nodes);
-            self.messages.extend(messages);
-        }
-        self.show = show;
-        self.overridden.clear();
-        self.morph = None;
-        self.pending_morph = None;
-        Ok(remap)
+        let replacement = Replacement::prepare(&self.snapshot(), scene, gpu, assets, output_size, rebuild)?;
+        Ok(self.install(replacement).expect("built from this revision"))
     }
 
     /// Node `node`'s status line for the panel (see [`Technique::status`]).
