@@ -709,39 +709,6 @@ pub fn list(assets: &Assets) -> Result<(), String> {
     Ok(())
 }
 
-/// A measured frame at which `bench --cue-every` triggered a cue.
-struct Switch {
-    /// Its position among the measured frames.
-    index: usize,
-    /// The show's frame.
-    frame: u64,
-    /// Milliseconds spent stepping and recording it (the rest of its wall time is the GPU's).
-    cpu: f64,
-}
-
-/// Each switch frame against the median of the frames that follow it until the next switch
-/// (the same clips on screen, so a costly clip does not count as a costly switch), and the
-/// worst switch against the median of all frames.
-fn report_switches(switches: &[Switch], walls: &[f64], median: f64, every: u64) {
-    let mut worst = (0.0f64, 0.0f64);
-    for s in switches {
-        let ms = walls[s.index];
-        let mut after: Vec<f64> = walls.iter().skip(s.index + 1).take(every as usize - 1).copied().collect();
-        after.sort_by(f64::total_cmp);
-        let steady = after.get(after.len() / 2).copied().unwrap_or(ms);
-        let ratio = ms / steady.max(1e-9);
-        say!("switch     frame {}: {ms:.3} ms ({:.3} ms on the CPU), then {steady:.3} ms: {ratio:.2}×", s.frame, s.cpu);
-        worst = (worst.0.max(ms), worst.1.max(ratio));
-    }
-    say!(
-        "{:<28} {:>9.3} ms  ({:.2}× the median frame)",
-        "worst frame at a switch",
-        worst.0,
-        worst.0 / median.max(1e-9)
-    );
-    say!("{:<28} {:>9.2}×  ({} switches)", "worst switch / frames after", worst.1, switches.len());
-}
-
 /// A show's layers, clips (with their trigger addresses) and cues.
 fn list_show(show: &indra::scene::show::Show) {
     for (l, layer) in show.layers.iter().enumerate() {
@@ -792,10 +759,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         renderer.render_only().map_err(|e| e.to_string())?;
     }
     renderer.restart_timings();
-    let mut walls = Vec::with_capacity(args.frames.min(1 << 16) as usize);
-    // Stepping, recording and submitting a frame: the CPU's share of its wall time.
-    let mut cpu = Vec::with_capacity(walls.capacity());
-    let mut switches = Vec::new();
+    let mut record = crate::bench_record::FrameRecord::new(cue_steps.unwrap_or(1));
     let mut last = Instant::now();
     let mut stats = None;
     let mut in_flight = None;
@@ -806,8 +770,8 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
             renderer.schedule(frame, vec![indra::params::ControlEvent::Show(indra::params::ShowCommand::CueGo)]);
         }
         let (time, s) = renderer.render_only().map_err(|e| e.to_string())?;
+        // Stepping, recording and submitting a frame: the CPU's share of its wall time.
         let recorded = Instant::now();
-        cpu.push((recorded - last).as_secs_f64() * 1e3);
         // Waiting for this frame makes wall time its full latency; waiting for the one before
         // (pipelined) makes it the interval between frames with one in flight, as live.
         let newest = renderer.last_submission();
@@ -817,22 +781,13 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
             let _ = renderer.gpu().device.poll(wait);
         }
         let now = Instant::now();
-        let ms = (now - last).as_secs_f64() * 1e3;
-        walls.push(ms);
-        if go {
-            switches.push(Switch {
-                index: walls.len() - 1,
-                frame: time.frame,
-                cpu: (recorded - last).as_secs_f64() * 1e3,
-            });
-        }
+        let ms = |from: Instant, to: Instant| (to - from).as_secs_f64() * 1e3;
+        record.push(ms(last, now), ms(last, recorded), go.then_some(time.frame));
         last = now;
         stats = Some(s);
     }
     renderer.finish_timings();
-    let in_order = walls.clone();
-    walls.sort_by(f64::total_cmp);
-    let wall_median = walls.get(walls.len() / 2).copied().unwrap_or(0.0);
+    let wall_median = record.wall_median();
     say!("scene      {name}");
     say!("adapter    {adapter}");
     say!(
@@ -871,12 +826,11 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     } else {
         say!("(this adapter has no TIMESTAMP_QUERY_INSIDE_ENCODERS: wall-clock only)");
     }
-    cpu.sort_by(f64::total_cmp);
-    say!("{:<28} {:>9.3} ms", "step + record (CPU median)", cpu.get(cpu.len() / 2).copied().unwrap_or(0.0));
+    say!("{:<28} {:>9.3} ms", "step + record (CPU median)", record.cpu_median());
     let wall_label = if args.pipelined { "frame interval (median)" } else { "frame wall time (median)" };
     say!("{:<28} {:>9.3} ms  ({:.1} fps)", wall_label, wall_median, 1e3 / wall_median.max(1e-9));
-    if !switches.is_empty() {
-        report_switches(&switches, &in_order, wall_median, cue_steps.unwrap_or(1));
+    for line in record.switch_report() {
+        say!("{line}");
     }
     for line in renderer.instance_mut().bench_reports() {
         say!("node       {line}");

@@ -1,5 +1,6 @@
 //! The `indra` command line: parsing only; each command's work is in `commands`.
 
+mod bench_record;
 mod commands;
 mod triangulate_cmd;
 
