@@ -105,15 +105,15 @@ pub struct RunArgs {
     /// Record every control event with its frame to this file (replay with `render --replay`).
     #[arg(long)]
     pub record_controls: Option<PathBuf>,
-    /// Folder of presets.
-    #[arg(long, default_value = "presets")]
-    pub presets: PathBuf,
-    /// File of MIDI-learned mappings.
-    #[arg(long, default_value = "midi-learn.ron")]
-    pub midi_learn: PathBuf,
-    /// File of audio mappings learned from the panel.
-    #[arg(long, default_value = "audio-learn.ron")]
-    pub audio_learn: PathBuf,
+    /// Folder of presets [default: presets, in %APPDATA%\indra on Windows].
+    #[arg(long)]
+    pub presets: Option<PathBuf>,
+    /// File of MIDI-learned mappings [default: midi-learn.ron, in %APPDATA%\indra on Windows].
+    #[arg(long)]
+    pub midi_learn: Option<PathBuf>,
+    /// File of audio mappings learned from the panel [default: audio-learn.ron, likewise].
+    #[arg(long)]
+    pub audio_learn: Option<PathBuf>,
     /// Do not watch shaders/ and scenes/ for edits.
     #[arg(long)]
     pub no_watch: bool,
@@ -168,9 +168,9 @@ impl Default for RunArgs {
             list_audio: false,
             output_windows: Vec::new(),
             record_controls: None,
-            presets: "presets".into(),
-            midi_learn: "midi-learn.ron".into(),
-            audio_learn: "audio-learn.ron".into(),
+            presets: None,
+            midi_learn: None,
+            audio_learn: None,
             no_watch: false,
             record_video: None,
             stream: None,
@@ -417,9 +417,9 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         audio_in: (!args.no_audio).then(|| args.audio_in.clone()),
         midi_filter: args.midi.clone(),
         record: args.record_controls.clone(),
-        presets_dir: args.presets.clone(),
-        learn_file: args.midi_learn.clone(),
-        audio_learn_file: args.audio_learn.clone(),
+        presets_dir: args.presets.clone().unwrap_or_else(|| indra::files::user_data("presets")),
+        learn_file: args.midi_learn.clone().unwrap_or_else(|| indra::files::user_data("midi-learn.ron")),
+        audio_learn_file: args.audio_learn.clone().unwrap_or_else(|| indra::files::user_data("audio-learn.ron")),
         link: args.link,
         sites: indra::control::site::SiteRules { hosts: args.web_hosts.clone(), cors: args.oscquery_cors.clone() },
     };

@@ -66,7 +66,9 @@ impl Drop for Advertisement {
 
 /// This machine's host name as a DNS label (letters, digits and hyphens), or `indra`.
 fn host_name() -> String {
+    // Windows names the machine in COMPUTERNAME; Linux shells export HOSTNAME, services may not.
     let raw = std::env::var("HOSTNAME")
+        .or_else(|_| std::env::var("COMPUTERNAME"))
         .ok()
         .or_else(|| std::fs::read_to_string("/proc/sys/kernel/hostname").ok())
         .or_else(|| std::fs::read_to_string("/etc/hostname").ok())

@@ -13,8 +13,10 @@
 //! - Reading and decoding run on a worker thread ([`Loader`]); the render thread only polls.
 
 mod loader;
+mod windows_names;
 
 pub use loader::{LoadWait, Loader};
+pub use windows_names::windows_problem;
 
 use std::borrow::Cow;
 use std::io::Read;
@@ -63,6 +65,7 @@ impl FileRules {
         if name.is_empty() || name.contains('\0') {
             return Err(FileError::NotFound("no file named".into()));
         }
+        refuse_windows_problem(name)?;
         let candidates = [root.map(|r| r.join(name)), Some(PathBuf::from(name))];
         let found = candidates.into_iter().flatten().find(|p| p.symlink_metadata().is_ok());
         let Some(found) = found else {
@@ -77,6 +80,7 @@ impl FileRules {
     /// Where to save `name` (a new or existing file with extension `ext`): beside `root` when
     /// relative, and inside an allowed folder.
     pub fn locate_for_saving(&self, root: Option<&Path>, name: &str, ext: &str) -> Result<PathBuf, FileError> {
+        refuse_windows_problem(name)?;
         let given = Path::new(name);
         if given.extension().and_then(|e| e.to_str()) != Some(ext) {
             return Err(FileError::Refused(format!("'{name}' is not a .{ext} file; only .{ext} files are saved")));
@@ -138,6 +142,25 @@ impl FileRules {
             "'{name}' is outside the folders the show may use ({}); start indra with --allow-path <folder> to open it",
             if folders.is_empty() { "none".to_string() } else { folders.join(", ") }
         )))
+    }
+}
+
+/// On Windows, refuses a name it reads as something other than a local file (a share, a
+/// device, a stream: see [`windows_problem`]) before anything looks it up.
+fn refuse_windows_problem(name: &str) -> Result<(), FileError> {
+    match windows_problem(name) {
+        Some(why) if cfg!(windows) => Err(FileError::Refused(format!("'{name}': {why}"))),
+        _ => Ok(()),
+    }
+}
+
+/// Where the performer's own files live by default (presets, learned mappings): `name` in the
+/// current folder, or on Windows in `%APPDATA%\indra` — a show started from the Start menu
+/// runs in its install folder, which is not the user's to write.
+pub fn user_data(name: &str) -> PathBuf {
+    match std::env::var_os("APPDATA").filter(|d| cfg!(windows) && !d.is_empty()) {
+        Some(app_data) => PathBuf::from(app_data).join("indra").join(name),
+        None => PathBuf::from(name),
     }
 }
 
@@ -246,6 +269,32 @@ mod tests {
             assert!(rules.locate_for_saving(Some(&root), "link.ron", "ron").is_err(), "a link out");
         }
         assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep");
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    /// Windows only (run under Wine in CI): a share, a device or a stream is refused before any
+    /// look-up, and the allowed folders hold whatever case a name is given in.
+    #[cfg(windows)]
+    #[test]
+    fn windows_shares_devices_and_streams_are_refused_and_case_does_not_matter() {
+        let dir = scratch("windows");
+        let root = dir.join("inside");
+        std::fs::write(root.join("a.ron"), "x").unwrap();
+        let rules = FileRules::new([root.clone()]);
+        for name in
+            ["\\\\127.0.0.1\\c$\\a.ron", "//127.0.0.1/c$/a.ron", "\\\\.\\pipe\\indra", "NUL.ron", "a.ron:x", "a.ron."]
+        {
+            let refused = rules.locate(Some(&root), name);
+            assert!(
+                matches!(&refused, Err(FileError::Refused(m)) if m.contains("never") || m.contains("drops")),
+                "{name}: {refused:?}"
+            );
+            assert!(rules.locate_for_saving(Some(&root), name, "ron").is_err(), "{name}");
+        }
+        let upper = FileRules::new([PathBuf::from(root.to_str().unwrap().to_uppercase())]);
+        assert!(upper.locate(Some(&root), "A.RON").is_ok(), "a name in another case is the same file");
+        let drive = root.to_str().unwrap()[..2].to_string();
+        assert!(matches!(rules.locate(Some(&root), &format!("{drive}\\Windows\\win.ini")), Err(FileError::Refused(_))));
         std::fs::remove_dir_all(dir).unwrap();
     }
 

@@ -68,6 +68,9 @@ impl PipeWireOut {
     /// frames of `size` at `fps`; with `pace` (a render, faster than real time) each frame waits
     /// until it is due. A missing daemon or GStreamer is one sentence.
     pub fn start(name: &str, size: (u32, u32), fps: f64, pace: bool) -> Result<Self, String> {
+        if !cfg!(target_os = "linux") {
+            return Err("PipeWire out is Linux-only; on this system send the show with --ndi-out or --stream".into());
+        }
         let name = name.trim();
         let plain = |c: char| c.is_ascii_alphanumeric() || "-_.".contains(c);
         if name.is_empty() || name.len() > 64 || !name.chars().all(plain) {

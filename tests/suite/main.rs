@@ -16,6 +16,7 @@ mod media;
 mod msaa;
 mod ndi;
 mod osc;
+#[cfg(target_os = "linux")]
 mod pipewire;
 mod recovery;
 mod seek;

@@ -280,6 +280,7 @@ fn projector_outputs_open_their_windows_and_follow_corner_addresses() {
     }
 }
 
+#[cfg(unix)]
 #[test]
 fn the_network_can_neither_name_files_outside_nor_freeze_the_show_with_them() {
     let display = VirtualDisplay::start();

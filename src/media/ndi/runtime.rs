@@ -15,11 +15,19 @@ use std::sync::OnceLock;
 pub const RUNTIME_DIR_ENV: &str = "NDI_RUNTIME_DIR_V6";
 
 /// Library names tried in each folder, newest ABI first.
+#[cfg(not(windows))]
 const LIBRARY_NAMES: &[&str] = &["libndi.so.6", "libndi.so"];
+/// The runtime's name on Windows (64-bit), as NDI Tools and the NDI 6 Runtime install it.
+#[cfg(windows)]
+const LIBRARY_NAMES: &[&str] = &["Processing.NDI.Lib.x64.dll"];
 
 /// Folders the NDI SDK and NDI Tools install the runtime to on Linux.
+#[cfg(not(windows))]
 const STANDARD_DIRS: &[&str] =
     &["/usr/local/lib", "/usr/lib", "/usr/lib/x86_64-linux-gnu", "/usr/lib/aarch64-linux-gnu"];
+/// Folders the NDI 6 Runtime and NDI Tools install the runtime to on Windows.
+#[cfg(windows)]
+const STANDARD_DIRS: &[&str] = &["C:/Program Files/NDI/NDI 6 Runtime/v6", "C:/Program Files/NDI/NDI 6 Tools/Runtime"];
 
 /// A source as the finder reports it and a receiver connects to it (`NDIlib_source_t`).
 #[repr(C)]
@@ -217,7 +225,8 @@ fn candidates() -> Vec<String> {
 fn load() -> Result<NdiRuntime, String> {
     let not_found = || {
         format!(
-            "no NDI runtime was found: install NDI Tools or the NDI SDK (https://ndi.video), or name the folder holding libndi.so.6 in {RUNTIME_DIR_ENV}"
+            "no NDI runtime was found: install NDI Tools or the NDI SDK (https://ndi.video), or name the folder holding {} in {RUNTIME_DIR_ENV}",
+            LIBRARY_NAMES[0]
         )
     };
     let (path, library) = candidates()
