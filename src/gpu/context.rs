@@ -10,8 +10,10 @@ pub enum BackendChoice {
     Auto,
     /// Vulkan (lavapipe on a machine without a GPU).
     Vulkan,
-    /// OpenGL / GLES through EGL.
+    /// OpenGL / GLES through EGL (WGL on Windows).
     Gl,
+    /// Direct3D 12 (Windows only).
+    Dx12,
 }
 
 /// How to pick the adapter.
@@ -27,9 +29,7 @@ pub struct GpuOptions {
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
     /// No adapter at all.
-    #[error(
-        "no GPU adapter found for backend {backend:?}. On Linux without a GPU install Mesa's software Vulkan: `sudo apt-get install mesa-vulkan-drivers libvulkan1`"
-    )]
+    #[error("no GPU adapter found for backend {backend:?}. {}", no_adapter_hint(*.backend))]
     NoAdapter {
         /// The backend asked for.
         backend: BackendChoice,
@@ -50,6 +50,17 @@ pub enum GpuError {
         /// wgpu's reason.
         reason: String,
     },
+}
+
+/// What to do when no adapter is found, on this system.
+fn no_adapter_hint(backend: BackendChoice) -> &'static str {
+    if backend == BackendChoice::Dx12 && !cfg!(windows) {
+        "Direct3D 12 exists on Windows only; leave --backend at auto"
+    } else if cfg!(windows) {
+        "Update the graphics driver (Vulkan, Direct3D 12 or OpenGL 3.3 is needed), or try another --backend"
+    } else {
+        "On Linux without a GPU install Mesa's software Vulkan: `sudo apt-get install mesa-vulkan-drivers libvulkan1`"
+    }
 }
 
 /// A device and queue plus what we learned about the adapter.
@@ -169,6 +180,7 @@ pub fn instance_descriptor(backend: BackendChoice) -> wgpu::InstanceDescriptor {
         BackendChoice::Auto => {}
         BackendChoice::Vulkan => desc.backends = wgpu::Backends::VULKAN,
         BackendChoice::Gl => desc.backends = wgpu::Backends::GL,
+        BackendChoice::Dx12 => desc.backends = wgpu::Backends::DX12,
     }
     desc
 }
@@ -192,7 +204,9 @@ async fn pick_adapter(
             .find(|a| a.get_info().name.to_lowercase().contains(&lower))
             .ok_or(GpuError::NoMatchingAdapter { wanted: wanted.clone(), found });
     }
-    // Prefer a real GPU over a software one; among equals keep wgpu's order (Vulkan first).
+    // Prefer a real GPU over a software one; among equals keep wgpu's order: Vulkan first (the
+    // backend every test and golden runs on, lavapipe and NVIDIA), then Direct3D 12 on Windows
+    // (which Wine cannot test here), then GL.
     let rank = |a: &wgpu::Adapter| match a.get_info().device_type {
         wgpu::DeviceType::DiscreteGpu => 0,
         wgpu::DeviceType::IntegratedGpu => 1,

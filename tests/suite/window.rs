@@ -373,6 +373,7 @@ fn the_show_sends_its_output_as_ndi_and_each_frame_is_its_render() {
 /// `run --pipewire-out`: the window's output is a PipeWire video source a GStreamer consumer reads
 /// while the show runs, and so is one node's image through a headless output (no window of its
 /// own); SIGTERM withdraws both cleanly.
+#[cfg(target_os = "linux")]
 #[test]
 fn the_show_offers_its_output_and_a_node_as_pipewire_sources_until_sigterm() {
     let Some(session) = crate::pipewire::PipeWireSession::start("window") else { return };
