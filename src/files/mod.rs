@@ -273,7 +273,8 @@ mod tests {
     }
 
     /// Windows only (run under Wine in CI): a share, a device or a stream is refused before any
-    /// look-up, and the allowed folders hold whatever case a name is given in.
+    /// look-up, the allowed folders hold whatever case a name is given in, and the user's own
+    /// files go to %APPDATA%.
     #[cfg(windows)]
     #[test]
     fn windows_shares_devices_and_streams_are_refused_and_case_does_not_matter() {
@@ -293,6 +294,9 @@ mod tests {
         }
         let upper = FileRules::new([PathBuf::from(root.to_str().unwrap().to_uppercase())]);
         assert!(upper.locate(Some(&root), "A.RON").is_ok(), "a name in another case is the same file");
+        // Presets and learned mappings default to the user's roaming folder, not the install's.
+        let app_data = PathBuf::from(std::env::var_os("APPDATA").expect("Windows sets APPDATA"));
+        assert_eq!(user_data("presets"), app_data.join("indra").join("presets"));
         let drive = root.to_str().unwrap()[..2].to_string();
         assert!(matches!(rules.locate(Some(&root), &format!("{drive}\\Windows\\win.ini")), Err(FileError::Refused(_))));
         std::fs::remove_dir_all(dir).unwrap();
