@@ -28,7 +28,8 @@ struct Switch {
 pub struct FrameRecord {
     walls: RollingMedian,
     cpu: RollingMedian,
-    /// Frames from one switch to the next.
+    /// Frames from one switch to the next (at most [`WINDOW`]: the frames after a switch are
+    /// kept only that far).
     every: usize,
     open: Option<Switch>,
     lines: Vec<String>,
@@ -43,7 +44,7 @@ impl FrameRecord {
         Self {
             walls: RollingMedian::new(WINDOW),
             cpu: RollingMedian::new(WINDOW),
-            every: usize::try_from(every).unwrap_or(usize::MAX).max(1),
+            every: usize::try_from(every).unwrap_or(WINDOW).clamp(1, WINDOW),
             open: None,
             lines: Vec::new(),
             switches: 0,
@@ -58,11 +59,11 @@ impl FrameRecord {
         self.cpu.push(cpu);
         if let Some(frame) = switch {
             self.close();
-            let after = Vec::with_capacity(self.every.min(WINDOW) - 1);
+            let after = Vec::with_capacity(self.every - 1);
             self.open = Some(Switch { frame, ms: wall, cpu, after });
         } else if let Some(open) = &mut self.open {
             open.after.push(wall);
-            if open.after.len() + 1 >= self.every.min(WINDOW) {
+            if open.after.len() + 1 >= self.every {
                 self.close();
             }
         }

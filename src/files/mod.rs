@@ -16,7 +16,7 @@ mod loader;
 mod windows_names;
 
 pub use loader::{LoadWait, Loader};
-pub use windows_names::windows_problem;
+use windows_names::windows_problem;
 
 use std::borrow::Cow;
 use std::io::Read;
@@ -148,10 +148,10 @@ impl FileRules {
 /// On Windows, refuses a name it reads as something other than a local file (a share, a
 /// device, a stream: see [`windows_problem`]) before anything looks it up.
 fn refuse_windows_problem(name: &str) -> Result<(), FileError> {
-    match windows_problem(name) {
-        Some(why) if cfg!(windows) => Err(FileError::Refused(format!("'{name}': {why}"))),
-        _ => Ok(()),
+    if !cfg!(windows) {
+        return Ok(());
     }
+    windows_problem(name).map_or(Ok(()), |why| Err(FileError::Refused(format!("'{name}': {why}"))))
 }
 
 /// Where the performer's own files live by default (presets, learned mappings): `name` in the

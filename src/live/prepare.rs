@@ -53,7 +53,7 @@ impl Job {
 
     /// The text of the file now, unless it is the text that stalled the GPU (then its message).
     fn read_untried(&self) -> Result<String, String> {
-        let source = read_stable(&self.path).map_err(|e| format!("{}: {e}", self.path.display()))?;
+        let source = read(&self.path)?;
         match &self.stalled {
             Some((text, message)) if *text == source => Err(message.clone()),
             _ => Ok(source),
@@ -89,14 +89,14 @@ impl Job {
                     return Ok(Prepared::Unused);
                 }
                 let origin = &running.origin;
-                let source = read_stable(Path::new(origin)).map_err(|e| format!("{origin}: {e}"))?;
+                let source = read(Path::new(origin))?;
                 parse_show(&self.running, origin, &source, false).map_err(|e| e.to_string())?
             }
             None => {
                 if !same_file(&running.origin) {
                     return Ok(Prepared::Unused);
                 }
-                let source = read_stable(&self.path).map_err(|e| format!("{}: {e}", self.path.display()))?;
+                let source = read(&self.path)?;
                 let origin = self.path.display().to_string();
                 parse_scene_with(&self.running, &origin, &source).map_err(|e| e.to_string())?
             }
@@ -115,6 +115,11 @@ impl Job {
         let replacement = rebuild_reading(&self.path, &self.snapshot, &self.gpu, self.size, &next)?;
         Ok(Prepared::Declared { next, real, source, replacement })
     }
+}
+
+/// The text of `path` once an editor has finished writing it, or a message naming the file.
+fn read(path: &Path) -> Result<String, String> {
+    read_stable(path).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// The running scene loaded again from `assets`, with the nodes that read the ISF file `path`

@@ -13,7 +13,6 @@ use crate::scene::show::{Mixer, ShowRuntime};
 use crate::techniques::Technique;
 
 /// What a rebuild is made from: the running scene and its parameters as they were taken.
-#[derive(Clone)]
 pub struct SceneSnapshot {
     /// The running scene.
     pub scene: Scene,
