@@ -11,8 +11,8 @@ use std::time::{Duration, Instant};
 
 use serde_json::{Value, json};
 
+use crate::live_show::{Show, VirtualDisplay, scratch_dir};
 use crate::osc::http_get;
-use crate::window::{Show, VirtualDisplay, scratch_dir};
 
 /// A headless Chromium with its own profile, killed when dropped.
 struct Chromium {

@@ -439,7 +439,7 @@ fn golden_transition_midpoint_and_two_layer_blend() {
 
 #[test]
 fn an_osc_trigger_changes_the_playing_clip_and_the_oscquery_tree() {
-    use crate::window::{Show, VirtualDisplay, scratch_dir, send};
+    use crate::live_show::{Show, VirtualDisplay, scratch_dir, send};
     let display = VirtualDisplay::start();
     let dir = scratch_dir("show-osc");
     let file = dir.join("two.ron");
@@ -546,7 +546,7 @@ fn a_show_reloads_when_a_clip_changes_and_keeps_playing_through_a_broken_edit() 
 fn show_commands_survive_a_recording_and_midi_notes_trigger_clips() {
     let scene = show_from(&TWO_COLOURS.replace(r#"id: "blue","#, r#"id: "blue", note: 40, channel: 2,"#));
     // A note-on on the clip's channel triggers it; another channel or note does not.
-    let dir = crate::window::scratch_dir("show-record");
+    let dir = crate::live_show::scratch_dir("show-record");
     let triggered = |bytes: &[u8]| crate::control::hub(&dir, &scene).midi_bytes(bytes, &scene, 0.0);
     assert_eq!(triggered(&[0x91, 40, 100]), [ControlEvent::Show(ShowCommand::Trigger { layer: 0, clip: Some(1) })]);
     assert!(triggered(&[0x90, 40, 100]).is_empty() && triggered(&[0x91, 41, 100]).is_empty());
