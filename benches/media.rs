@@ -9,8 +9,9 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use indra::media::clip::{Clip, Picture};
+use indra::media::clip::Clip;
 use indra::media::hap;
+use indra::media::picture::Picture;
 
 const FRAMES: usize = 12;
 

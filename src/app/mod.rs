@@ -5,6 +5,7 @@
 
 mod outputs;
 mod panel;
+mod param_widget;
 mod show_panel;
 mod surface;
 mod web_panel;

@@ -100,7 +100,7 @@ fn layer_faders(ui: &mut egui::Ui, instance: &SceneInstance) -> Vec<ControlEvent
                 ui.label(name);
                 for (p, decl) in params.decls().iter().enumerate() {
                     let mut value = params.target_at(p);
-                    if super::panel::param_widget(ui, decl, &mut value) {
+                    if super::param_widget::param_widget(ui, decl, &mut value) {
                         let write = ParamWrite { node, param: p, component: None, value, source: Source::Ui };
                         events.push(ControlEvent::Write(write));
                     }

@@ -264,11 +264,11 @@ fn serve(mut stream: TcpStream, routes: &Routes, guard: &SiteGuard, sockets: &At
         }
     };
     let (method, request) = parse(&head);
-    if !guard.host_ok(&request) {
+    if !guard.host_ok(request.header("host")) {
         let _ = write_reply(&mut stream, &Reply::status(421));
         return;
     }
-    let origin = guard.origin(&request);
+    let origin = guard.origin(request.header("origin"));
     let mut reply = match (&routes.socket, websocket_key(method, &request)) {
         (Some(_), Some(_)) if origin == Origin::Foreign => Reply::status(403),
         (Some(handler), Some(key)) => {
@@ -282,7 +282,7 @@ fn serve(mut stream: TcpStream, routes: &Routes, guard: &SiteGuard, sockets: &At
         }
         _ => answer(method, &request, &routes.get),
     };
-    reply.headers.extend(SiteGuard::cors_headers(&request, origin));
+    reply.headers.extend(SiteGuard::cors_headers(request.header("origin"), origin));
     let _ = write_reply(&mut stream, &reply);
 }
 

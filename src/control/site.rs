@@ -14,8 +14,6 @@
 use std::collections::BTreeSet;
 use std::net::SocketAddr;
 
-use super::http::Request;
-
 /// What the performer opened beyond the server's own names.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct SiteRules {
@@ -70,16 +68,16 @@ impl SiteGuard {
         Self { port: local.port(), hosts, cors }
     }
 
-    /// Whether `request` names this server in its `Host` (or names nothing).
-    pub fn host_ok(&self, request: &Request<'_>) -> bool {
-        let Some(host) = request.header("host") else { return true };
+    /// Whether a request's `Host` header names this server (or the request has none).
+    pub fn host_ok(&self, host: Option<&str>) -> bool {
+        let Some(host) = host else { return true };
         let (name, port) = split_port(host);
         port.is_none_or(|p| p == self.port) && self.hosts.contains(&name.to_ascii_lowercase())
     }
 
-    /// Where `request`'s page comes from.
-    pub fn origin(&self, request: &Request<'_>) -> Origin {
-        let Some(origin) = request.header("origin") else { return Origin::Absent };
+    /// Where a request's page comes from, by its `Origin` header.
+    pub fn origin(&self, origin: Option<&str>) -> Origin {
+        let Some(origin) = origin else { return Origin::Absent };
         let origin = origin.trim_end_matches('/').to_ascii_lowercase();
         if self.cors.contains(&origin) {
             return Origin::Allowed;
@@ -92,10 +90,10 @@ impl SiteGuard {
         if own { Origin::Own } else { Origin::Foreign }
     }
 
-    /// The CORS headers for a reply to `request` from a page of `origin` (as [`SiteGuard::origin`]
-    /// classed it): an allowed third-party origin may read it.
-    pub fn cors_headers(request: &Request<'_>, origin: Origin) -> Vec<(&'static str, String)> {
-        match (origin, request.header("origin")) {
+    /// The CORS headers for a reply to a request whose `Origin` header is `header`, from a page
+    /// of `origin` (as [`SiteGuard::origin`] classed it): an allowed third-party origin may read it.
+    pub fn cors_headers(header: Option<&str>, origin: Origin) -> Vec<(&'static str, String)> {
+        match (origin, header) {
             (Origin::Allowed, Some(origin)) => {
                 vec![("Access-Control-Allow-Origin", origin.to_string()), ("Vary", "Origin".to_string())]
             }
@@ -125,6 +123,7 @@ fn bare_host(host: &str) -> &str {
 
 #[cfg(test)]
 mod tests {
+    use super::super::http::Request;
     use super::*;
 
     fn guard(local: &str, rules: SiteRules) -> SiteGuard {
@@ -140,22 +139,22 @@ mod tests {
         let g = guard("127.0.0.1:8080", SiteRules { hosts: vec!["stage.example".into()], cors: Vec::new() });
         for ok in ["127.0.0.1:8080", "localhost:8080", "LOCALHOST", "[::1]:8080", "stage.example:8080", ""] {
             let headers = if ok.is_empty() { String::new() } else { format!("Host: {ok}") };
-            assert!(g.host_ok(&with(&headers)), "{ok}");
+            assert!(g.host_ok(with(&headers).header("host")), "{ok}");
         }
         for bad in ["evil.example:8080", "evil.example", "127.0.0.1:9999", "127.0.0.1.evil.example:8080"] {
-            assert!(!g.host_ok(&with(&format!("Host: {bad}"))), "{bad}");
+            assert!(!g.host_ok(with(&format!("Host: {bad}")).header("host")), "{bad}");
         }
         let name = gethostname::gethostname().to_string_lossy().to_string();
-        assert!(g.host_ok(&with(&format!("Host: {name}:8080"))), "the machine's own name");
-        assert!(g.host_ok(&with(&format!("Host: {name}.local:8080"))), "its mDNS name");
+        assert!(g.host_ok(with(&format!("Host: {name}:8080")).header("host")), "the machine's own name");
+        assert!(g.host_ok(with(&format!("Host: {name}.local:8080")).header("host")), "its mDNS name");
     }
 
     #[test]
     fn a_page_of_this_server_is_own_others_are_foreign_unless_allowed() {
         let rules = SiteRules { hosts: Vec::new(), cors: vec!["http://127.0.0.1:5173/".into()] };
         let g = guard("127.0.0.1:8080", rules);
-        let origin = |o: &str| g.origin(&with(&format!("Origin: {o}")));
-        assert_eq!(g.origin(&with("")), Origin::Absent);
+        let origin = |o: &str| g.origin(with(&format!("Origin: {o}")).header("origin"));
+        assert_eq!(g.origin(with("").header("origin")), Origin::Absent);
         assert_eq!(origin("http://127.0.0.1:8080"), Origin::Own);
         assert_eq!(origin("http://localhost:8080"), Origin::Own);
         assert_eq!(origin("http://127.0.0.1:5173"), Origin::Allowed);
@@ -164,7 +163,7 @@ mod tests {
         }
         let cors = |o: &str| {
             let request = format!("Origin: {o}");
-            SiteGuard::cors_headers(&with(&request), g.origin(&with(&request)))
+            SiteGuard::cors_headers(with(&request).header("origin"), g.origin(with(&request).header("origin")))
         };
         assert_eq!(
             cors("http://127.0.0.1:5173")[0],

@@ -11,6 +11,7 @@ pub mod ffmpeg;
 pub mod hap;
 pub mod mov;
 pub mod ndi;
+pub mod picture;
 pub mod playhead;
 pub mod prefetch;
 pub mod sequence;

@@ -8,7 +8,8 @@ use std::collections::BTreeMap;
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::Duration;
 
-use super::clip::{Clip, ClipInfo, Picture};
+use super::clip::{Clip, ClipInfo};
+use super::picture::Picture;
 
 /// The decoded frames kept at most, by bytes (a 4K RGBA frame is 33 MB; a 4K Hap frame 4 MB).
 pub const CACHE_BYTES: usize = 256 << 20;

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::clip::Picture;
+use super::picture::Picture;
 use super::still::{Still, decode};
 
 /// The largest file one frame may be.

@@ -6,7 +6,7 @@ use std::io::Cursor;
 
 use image::ImageDecoder;
 
-use super::clip::Picture;
+use super::picture::Picture;
 
 /// A decoded still.
 #[derive(Clone, Debug)]

@@ -9,8 +9,8 @@ use super::NodeSetup;
 use super::image_pass::{self, ImageKernel, ImagePass};
 use crate::gpu::ShaderError;
 use crate::graph::{FrameGraph, PersistentTexture, TextureHandle};
-use crate::media::clip::Picture;
 use crate::media::hap::{self, BlockFormat, Channels, HapTexture};
+use crate::media::picture::Picture;
 
 crate::param_enum! {
     /// How a picture of another shape fills the node's image.

@@ -10,6 +10,7 @@ mod browser;
 mod common;
 mod control;
 mod errors;
+mod file_imports;
 mod flood;
 mod graph_gpu;
 mod live;

@@ -2,8 +2,9 @@
 //! against ffmpeg's own decode: same frames, same pixels (within BC tolerance), any order.
 
 use crate::common::clips::{COUNTER_SIZE, counter_source, ffmpeg_frames, make_clip, read_counter};
-use indra::media::clip::{Clip, Picture};
+use indra::media::clip::Clip;
 use indra::media::hap::{self, Channels};
+use indra::media::picture::Picture;
 
 const LIMIT: u64 = indra::media::DECODED_LIMIT;
 

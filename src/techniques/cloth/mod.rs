@@ -139,7 +139,7 @@ impl Cloth {
 /// A cloth of `p`'s resolution and pinning, at rest.
 fn at_rest(device: &wgpu::Device, queue: &wgpu::Queue, renderer: &Renderer, p: &Settings) -> State {
     let (res, pin) = (p.resolution.clamp(4, 1024) as u32, p.pin.index());
-    let mut state = State::new(device, renderer, res, pin);
+    let mut state = State::new(device, res, pin, renderer.surface_indices(device, res));
     state.reset(queue, &rest_pose(res, p.rest_length, p.mass, pin));
     state
 }

@@ -6,7 +6,6 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 
 use super::ClothUniforms;
-use super::render::Renderer;
 use crate::gpu::BindGroupCache;
 use crate::graph::{BufferHandle, FrameGraph};
 
@@ -125,8 +124,9 @@ impl State {
         self.surface_count / 3 + if sphere { 32 * 16 * 2 } else { 0 }
     }
 
-    /// Buffers for `res` × `res` particles.
-    pub fn new(device: &wgpu::Device, renderer: &Renderer, res: u32, pin: u32) -> Self {
+    /// Buffers for `res` × `res` particles, drawn as the triangles of `surface` (the renderer's
+    /// index buffer and its count).
+    pub fn new(device: &wgpu::Device, res: u32, pin: u32, surface: (wgpu::Buffer, u32)) -> Self {
         let bytes = u64::from(res * res) * 16;
         let particles = std::array::from_fn(|i| storage(device, &format!("cloth_particles_{i}"), bytes));
         let status = storage(device, "cloth_status", 4);
@@ -136,7 +136,7 @@ impl State {
             usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             mapped_at_creation: false,
         });
-        let (surface_indices, surface_count) = renderer.surface_indices(device, res);
+        let (surface_indices, surface_count) = surface;
         Self {
             res,
             pin,

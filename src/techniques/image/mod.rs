@@ -24,7 +24,7 @@ use crate::time::FrameTime;
 use super::image_pass;
 use super::picture_pass::{Fit, PicturePass};
 use super::{NodeSetup, Technique, TechniqueInfo};
-use crate::media::clip::Picture;
+use crate::media::picture::Picture;
 use crate::media::still::Still;
 
 /// The registry entry.

@@ -6,8 +6,9 @@ use std::collections::BTreeMap;
 
 use super::compile::Compiled;
 use super::header::InputKind;
-use super::pipeline::{BYTE_FORMAT, FLOAT_FORMAT, FormatKey, OUTPUT_FORMAT, Pipeline, Pipelines, build_pipelines};
+use super::pipeline::{FormatKey, OUTPUT_FORMAT, Pipeline, Pipelines, build_pipelines};
 use super::sound::{AUDIO_WIDTH, AudioTexture};
+use super::targets::{BYTE_FORMAT, FLOAT_FORMAT};
 use super::translate::{FIRST_TEXTURE_BINDING, SAMPLER_BINDING, TextureSource, UNIFORM_BINDING, storage_binding};
 use super::{IsfFiles, Settings};
 use crate::gpu::{BindGroupCache, DEFAULT_MAX_AGE, ShaderError};
@@ -194,7 +195,7 @@ impl IsfNode {
             let max_side = setup.gpu.device.limits().max_texture_dimension_2d;
             let still = crate::media::still::decode(&bytes.bytes, &bytes.origin, max_side, 256 << 20)
                 .map_err(|e| failed(format!("IMPORTED '{name}': {e}")))?;
-            let crate::media::clip::Picture::Rgba(pixels) = still.picture else {
+            let crate::media::picture::Picture::Rgba(pixels) = still.picture else {
                 return Err(failed(format!("IMPORTED '{name}': only 8-bit images (PNG, JPEG) are imported")));
             };
             let texture = PersistentTexture::new(&self.device, &format!("isf/{name}"), still.size, BYTE_FORMAT);

@@ -5,15 +5,12 @@
 use std::collections::BTreeMap;
 
 use super::compile::Compiled;
+use super::targets::{BYTE_FORMAT, FLOAT_FORMAT};
 use super::translate::{FIRST_TEXTURE_BINDING, SAMPLER_BINDING, UNIFORM_BINDING, storage_binding};
 use crate::gpu::ShaderError;
 
 /// The node's image: linear HDR like every node's.
 pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-/// A target without `FLOAT`: 8 bits a channel, as GL hosts make them.
-pub const BYTE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
-/// A `FLOAT` target (half floats: filterable everywhere, enough for feedback).
-pub const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// The pipelines of one compiled shader.
 pub struct Pipelines {

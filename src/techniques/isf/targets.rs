@@ -5,7 +5,11 @@
 
 use super::expr;
 use super::header::{Header, Pass};
-use super::pipeline::{BYTE_FORMAT, FLOAT_FORMAT};
+
+/// A target without `FLOAT`: 8 bits a channel, as GL hosts make them.
+pub const BYTE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// A `FLOAT` target (half floats: filterable everywhere, enough for feedback).
+pub const FLOAT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// The most texture memory one ISF node's targets may take together, persistent ones counted
 /// twice: an eighth of a scene's whole budget.
