@@ -1,9 +1,7 @@
 //! The `indra` command line: parsing, and the process's allocator settings; each command's work
-//! is in `commands`.
+//! is in `cli`.
 
-mod bench_record;
-mod commands;
-mod triangulate_cmd;
+mod cli;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -63,9 +61,9 @@ struct GpuArgs {
 #[derive(Subcommand)]
 enum Command {
     /// Open a scene in a window with live controls (default: the kleinian scene).
-    Run(commands::RunArgs),
+    Run(cli::RunArgs),
     /// Render frames off-screen to a PNG sequence.
-    Render(commands::RenderArgs),
+    Render(cli::RenderArgs),
     /// Validate every scene and shader (or the given files); non-zero exit on any error.
     Check {
         /// Scene (.ron) or shader (.wgsl) files; all known ones when empty.
@@ -74,9 +72,9 @@ enum Command {
     /// List scenes and their parameters.
     List,
     /// Render off-screen and print per-pass GPU medians and frame time.
-    Bench(commands::BenchArgs),
+    Bench(cli::BenchArgs),
     /// Triangulate rings from a JSON or SVG file; print triangle count, area deviation and time.
-    Triangulate(triangulate_cmd::TriangulateArgs),
+    Triangulate(cli::TriangulateArgs),
 }
 
 fn main() -> ExitCode {
@@ -92,15 +90,15 @@ fn main() -> ExitCode {
     }
     let gpu = indra::gpu::GpuOptions { backend: cli.gpu.backend, adapter: cli.gpu.adapter };
     let result = match cli.command {
-        _ if cli.list_cameras => commands::list_cameras(),
-        _ if cli.list_ndi => commands::list_ndi(),
-        None => commands::run(&assets, &gpu, &commands::RunArgs::default()),
-        Some(Command::Run(args)) => commands::run(&assets, &gpu, &args),
-        Some(Command::Render(args)) => commands::render(&assets, &gpu, &args),
-        Some(Command::Check { files }) => commands::check(&assets, &files),
-        Some(Command::List) => commands::list(&assets),
-        Some(Command::Bench(args)) => commands::bench(&assets, &gpu, &args),
-        Some(Command::Triangulate(args)) => triangulate_cmd::triangulate(&args),
+        _ if cli.list_cameras => cli::list_cameras(),
+        _ if cli.list_ndi => cli::list_ndi(),
+        None => cli::run(&assets, &gpu, &cli::RunArgs::default()),
+        Some(Command::Run(args)) => cli::run(&assets, &gpu, &args),
+        Some(Command::Render(args)) => cli::render(&assets, &gpu, &args),
+        Some(Command::Check { files }) => cli::check(&assets, &files),
+        Some(Command::List) => cli::list(&assets),
+        Some(Command::Bench(args)) => cli::bench(&assets, &gpu, &args),
+        Some(Command::Triangulate(args)) => cli::triangulate(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

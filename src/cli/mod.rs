@@ -1,0 +1,95 @@
+//! What each CLI command does, on top of the library: one module per command, and here the
+//! argument types and checks they share. Every failure is one sentence for the user; nothing
+//! here panics on bad input.
+
+use indra::assets::Assets;
+use indra::scene::{Scene, load_scene};
+
+/// Prints a line to stdout, ignoring a closed pipe (`indra list | head` must not panic).
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
+mod bench;
+mod bench_record;
+mod check;
+mod list;
+mod render;
+mod run;
+mod triangulate;
+
+pub use bench::{BenchArgs, bench};
+pub use check::check;
+pub use list::{list, list_cameras, list_ndi};
+pub use render::{RenderArgs, render};
+pub use run::{RunArgs, run};
+pub use triangulate::{TriangulateArgs, triangulate};
+
+/// The scene `indra` opens with no arguments.
+pub const DEFAULT_SCENE: &str = "kleinian";
+
+fn parse_msaa(text: &str) -> Result<u32, String> {
+    match text.trim().parse::<u32>() {
+        Ok(n @ (1 | 2 | 4 | 8)) => Ok(n),
+        _ => Err(format!("'{text}' is not a sample count: use 1, 2, 4 or 8")),
+    }
+}
+
+fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(|| format!("'{text}' is not WxH (e.g. 1920x1080)"))?;
+    let parse = |s: &str| s.trim().parse::<u32>().ok().filter(|v| (1..=16384).contains(v));
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(format!("'{text}' is not WxH with sides from 1 to 16384")),
+    }
+}
+
+/// Most steps a render or bench may seek through (≈ 190 days at 60 fps): beyond it a seek
+/// would run for hours, so it is refused with a sentence instead.
+const MAX_START: u64 = 1_000_000_000;
+
+/// Checks `--start`, `--frames` and `--dt`: one sentence for each bad value.
+fn check_timing(start: u64, frames: u64, dt: Option<f32>) -> Result<(), String> {
+    if start > MAX_START {
+        return Err(format!("--start {start} is past {MAX_START} steps; split the render or lower it"));
+    }
+    if frames > MAX_START {
+        return Err(format!("--frames {frames} is more than {MAX_START}; render in parts"));
+    }
+    if let Some(dt) = dt.filter(|dt| !(dt.is_finite() && *dt > 0.0 && *dt <= 1.0)) {
+        return Err(format!("--dt {dt} must be a number of seconds in (0, 1], e.g. 0.0166667"));
+    }
+    Ok(())
+}
+
+/// `assets` with the folder of scene file `name` (if it is a path to a file) open to the files
+/// its parameters name: a scene kept beside its warp files and images works from any folder.
+fn with_scene_folder(assets: &Assets, name: &str) -> Assets {
+    let path = std::path::Path::new(name);
+    match path.parent() {
+        Some(folder) if path.is_file() => {
+            assets.allowing(if folder.as_os_str().is_empty() { std::path::Path::new(".") } else { folder })
+        }
+        _ => assets.clone(),
+    }
+}
+
+/// Loads a scene and applies `--set` assignments.
+fn scene_with_sets(assets: &Assets, name: &str, sets: &[String], msaa: Option<u32>) -> Result<Scene, String> {
+    with_sets(load_scene(assets, name).map_err(|e| e.to_string())?, sets, msaa)
+}
+
+/// Applies `--set` assignments and `--msaa` to a loaded scene.
+fn with_sets(mut scene: Scene, sets: &[String], msaa: Option<u32>) -> Result<Scene, String> {
+    for assignment in sets {
+        scene.set_from_str(assignment)?;
+    }
+    if let Some(samples) = msaa {
+        scene.msaa = samples;
+        scene.check_texture_budget(scene.size)?;
+    }
+    Ok(scene)
+}

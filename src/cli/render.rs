@@ -1,0 +1,210 @@
+//! `indra render`: frames to PNGs or a video file, off-screen and exact.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use indra::assets::Assets;
+use indra::gpu::{Gpu, GpuOptions};
+use indra::offscreen::{OffscreenRenderer, RenderedFrame, VideoSettings, VideoWriter, write_png};
+
+use super::{check_timing, parse_msaa, parse_size, scene_with_sets, with_scene_folder};
+
+/// `indra render`.
+#[derive(Args, Clone)]
+pub struct RenderArgs {
+    /// Scene name (from scenes/) or path to a .ron file.
+    pub scene: String,
+    /// Number of frames to render.
+    #[arg(long, default_value_t = 1)]
+    pub frames: u64,
+    /// First frame index (time = frame × dt).
+    #[arg(long, default_value_t = 0)]
+    pub start: u64,
+    /// Output size WxH (default: the scene's).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Fixed time step in seconds (default: the scene's).
+    #[arg(long)]
+    pub dt: Option<f32>,
+    /// Seed (default: the scene's).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Output folder; frames are written as <scene>_<frame>.png.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    /// Write the frames as one video file instead of PNGs (.mp4 and .mkv: H.264; .mov: ProRes
+    /// 422 HQ; .webm: VP9), through ffmpeg, at 1/dt frames per second.
+    #[arg(long, value_name = "FILE")]
+    pub video: Option<PathBuf>,
+    /// Send the frames to a network stream instead: srt://HOST:PORT, udp://HOST:PORT or
+    /// rtmp://HOST/APP/KEY — H.264 tuned for latency (no B-frames, a keyframe a second) in
+    /// MPEG-TS (FLV for RTMP), through ffmpeg.
+    #[arg(long, value_name = "URL", conflicts_with = "video")]
+    pub stream: Option<String>,
+    /// Also send the frames as an NDI source of this name, in real time (each frame waits until
+    /// it is due at 1/dt frames per second), stamped with their frame numbers as timecodes.
+    #[arg(long, value_name = "NAME")]
+    pub ndi_out: Option<String>,
+    /// Also offer the frames as a PipeWire video source of this name, in real time (each frame
+    /// waits until it is due at 1/dt frames per second).
+    #[arg(long, value_name = "NAME")]
+    pub pipewire_out: Option<String>,
+    /// Video codec: h264, h265, prores, vp9, av1, ffv1, hap, hap_alpha, hap_q (in .mov; clips
+    /// indra and VJ tools play frame-exact), or an ffmpeg encoder name (default: the container's).
+    #[arg(long, requires = "video")]
+    pub codec: Option<String>,
+    /// Video quality: the CRF for h264/h265/vp9/av1 (lower is better; default 18, 20, 30, 30),
+    /// the ProRes profile (0 proxy … 3 HQ, 4 4444).
+    #[arg(long, requires = "video")]
+    pub quality: Option<u32>,
+    /// Set a parameter (repeatable): node.param=value — 0.5, true, an option name, a vector as
+    /// 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
+    #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
+    pub sets: Vec<String>,
+    /// Samples per pixel of rasterising nodes, 1, 2, 4 or 8 (default: the scene's, normally 4);
+    /// lowered to what the adapter supports.
+    #[arg(long, value_parser = parse_msaa)]
+    pub msaa: Option<u32>,
+    /// Replay a control stream recorded with `run --record-controls`, frame-exactly.
+    #[arg(long)]
+    pub replay: Option<PathBuf>,
+    /// Which output to render: 0 the scene's output (default), 1… its `outputs` as their
+    /// windows show them (warped).
+    #[arg(long, default_value_t = 0)]
+    pub output: usize,
+    /// A sound file the scene's audio mappings hear (frame n hears it up to (n + 1) × dt, so
+    /// renders are exact): WAV, or any format ffmpeg decodes (MP3, FLAC, Ogg, …); with --video it
+    /// is also the video's sound track.
+    #[arg(long, value_name = "FILE")]
+    pub audio: Option<PathBuf>,
+}
+
+/// Renders a PNG sequence.
+pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<(), String> {
+    check_timing(args.start, args.frames, args.dt)?;
+    let assets = &with_scene_folder(assets, &args.scene);
+    let scene = scene_with_sets(assets, &args.scene, &args.sets, args.msaa)?;
+    let mut script = match &args.replay {
+        Some(path) => indra::control::record::read_replay(path, &scene)?,
+        None => Default::default(),
+    };
+    let dt = f64::from(args.dt.unwrap_or(scene.dt));
+    if let Some(path) = &args.audio {
+        let file = indra::control::audio::AudioFile::open(path)?;
+        if scene.audio.is_empty() {
+            eprintln!("'{}' maps no audio (controls.audio): the file is only the sound track", scene.name);
+        }
+        let frames = args.start.saturating_add(args.frames);
+        for (frame, events) in indra::control::audio::file_script(&file, &scene, frames, dt) {
+            script.entry(frame).or_default().extend(events);
+        }
+    }
+    scene.check_texture_budget(args.size.unwrap_or(scene.size))?;
+    let stem = Path::new(&args.scene).file_stem().map_or("frame".into(), |s| s.to_string_lossy().into_owned());
+    let size = args.size.unwrap_or(scene.size);
+    let fps = 1.0 / dt;
+    // ffmpeg starts before the GPU and the seek, so a missing one or a bad codec fails at once.
+    let mut sink = match &args.video {
+        None if args.stream.is_some() => {
+            let settings = VideoSettings::stream(args.stream.as_deref().unwrap_or_default(), size, fps, true);
+            FrameSink::Video(VideoWriter::start(settings).map_err(|e| e.to_string())?)
+        }
+        Some(path) => {
+            let settings = VideoSettings {
+                path: path.clone(),
+                size,
+                fps,
+                codec: args.codec.clone(),
+                quality: args.quality,
+                audio: args.audio.clone().map(|file| (file, args.start as f64 * dt)),
+                stream: false,
+                pace: false,
+            };
+            if settings.encoded_size() != size {
+                let (w, h) = settings.encoded_size();
+                eprintln!("the video is {w}x{h}: odd sides are padded by one black pixel (4:2:0 chroma)");
+            }
+            FrameSink::Video(VideoWriter::start(settings).map_err(|e| e.to_string())?)
+        }
+        None => {
+            std::fs::create_dir_all(&args.out).map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
+            FrameSink::Png { folder: args.out.clone(), stem }
+        }
+    };
+    // Sends beside the frames written. A render is faster than real time: each send paces the
+    // frames to the scene's rate.
+    let mut sends: Vec<Box<dyn indra::offscreen::FrameOutlet>> = Vec::new();
+    if let Some(name) = &args.ndi_out {
+        sends.push(indra::offscreen::ndi_outlet(name, size, fps, true)?);
+    }
+    if let Some(name) = &args.pipewire_out {
+        sends.push(Box::new(indra::offscreen::PipeWireOut::start(name, size, fps, true)?));
+    }
+    let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
+    eprintln!("rendering '{}' on {}", scene.name, device.adapter_label());
+    let mut renderer =
+        OffscreenRenderer::new(device, assets, scene, args.size, args.dt, args.seed).map_err(|e| e.to_string())?;
+    renderer.show_output(args.output)?;
+    // Replayed events apply at their own frames, also those a seek passes over.
+    for (frame, events) in script {
+        renderer.schedule(frame, events);
+    }
+    if args.start > 0 {
+        eprintln!("seeking to frame {} (every step runs; nothing before it is drawn)", args.start);
+    }
+    renderer.seek(args.start).map_err(|e| e.to_string())?;
+    let bar = indicatif::ProgressBar::new(args.frames);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}")
+            .expect("valid template"),
+    );
+    for _ in 0..args.frames {
+        let frame = renderer.render_next().map_err(|e| e.to_string())?;
+        sink.write(&frame)?;
+        for send in &mut sends {
+            send.take(&frame.rgba, 1, frame.time.frame).map_err(|e| e.to_string())?;
+        }
+        // What a node tells the performer (a clip that cannot play, a bad image path) is said
+        // once, as the window's overlay says it; the render goes on.
+        for message in renderer.instance_mut().take_messages() {
+            bar.suspend(|| eprintln!("warning: {message}"));
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    for e in renderer.gpu().take_uncaptured_errors() {
+        eprintln!("GPU error during the render: {e}");
+    }
+    let place = match sink {
+        FrameSink::Video(video) => {
+            let path = video.settings().path.display().to_string();
+            video.finish().map_err(|e| e.to_string())?;
+            path
+        }
+        FrameSink::Png { folder, .. } => folder.display().to_string(),
+    };
+    for send in sends {
+        send.close().map_err(|e| e.to_string())?;
+    }
+    eprintln!("wrote {} frame(s) to {place}", args.frames);
+    Ok(())
+}
+
+/// Where `render` puts its frames.
+enum FrameSink {
+    /// `<folder>/<stem>_<frame>.png`.
+    Png { folder: PathBuf, stem: String },
+    /// One video file.
+    Video(VideoWriter),
+}
+
+impl FrameSink {
+    fn write(&mut self, frame: &RenderedFrame) -> Result<(), String> {
+        match self {
+            FrameSink::Png { folder, stem } => {
+                write_png(&folder.join(format!("{stem}_{:05}.png", frame.time.frame)), frame.size, &frame.rgba)
+            }
+            FrameSink::Video(video) => video.write(&frame.rgba).map_err(|e| e.to_string()),
+        }
+    }
+}

@@ -1,0 +1,273 @@
+//! `indra run`: the show in a window, with its live inputs.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use indra::assets::Assets;
+use indra::gpu::GpuOptions;
+
+use super::{DEFAULT_SCENE, parse_msaa, scene_with_sets, with_scene_folder, with_sets};
+
+/// `indra run`.
+#[derive(Args, Clone)]
+pub struct RunArgs {
+    /// Scene name (from scenes/) or path to a .ron file.
+    #[arg(default_value = DEFAULT_SCENE)]
+    pub scene: String,
+    /// Start in borderless fullscreen (F11 toggles, Esc leaves fullscreen).
+    #[arg(long)]
+    pub fullscreen: bool,
+    /// Monitor index for fullscreen (see the log for the list).
+    #[arg(long)]
+    pub monitor: Option<usize>,
+    /// Set a parameter at start (repeatable): node.param=value — 0.5, true, an option name,
+    /// a vector as 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
+    #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
+    pub sets: Vec<String>,
+    /// Samples per pixel of rasterising nodes, 1, 2, 4 or 8 (default: the scene's, normally 4);
+    /// lowered to what the adapter supports.
+    #[arg(long, value_parser = parse_msaa)]
+    pub msaa: Option<u32>,
+    /// OSC listen address; loopback by default, 0.0.0.0:9000 opens it to the network.
+    #[arg(long, default_value = DEFAULT_OSC)]
+    pub osc: String,
+    /// No OSC input.
+    #[arg(long)]
+    pub no_osc: bool,
+    /// Send every parameter change to this OSC destination (host:port), so faders follow.
+    #[arg(long)]
+    pub osc_out: Option<String>,
+    /// Serve the OSCQuery address tree over HTTP here (e.g. 127.0.0.1:9001).
+    #[arg(long)]
+    pub oscquery: Option<String>,
+    /// Serve the browser control surface, with the OSCQuery tree, here: 127.0.0.1:8080 when
+    /// given no address; 0.0.0.0:8080 opens it to the venue network. The printed URL (and QR
+    /// code) carries the access token the page needs.
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = indra::control::web::DEFAULT_ADDR, conflicts_with = "oscquery")]
+    pub web: Option<String>,
+    /// Browser pages show the values but cannot change them (a display of the show's state).
+    #[arg(long, requires = "web")]
+    pub web_read_only: bool,
+    /// The access token (12–128 characters of A-Z a-z 0-9 - _) instead of a new random one each
+    /// start: for a bookmarked URL or a printed QR code at an installation.
+    #[arg(long, value_name = "TOKEN", requires = "web")]
+    pub web_token: Option<String>,
+    /// One more name the OSCQuery server and the browser surface answer as (repeatable): a DNS
+    /// name of the venue's network that points here. Its own addresses, `localhost` and the
+    /// machine's name are always answered; any other `Host` is refused (DNS rebinding).
+    #[arg(long = "web-host", value_name = "NAME")]
+    pub web_hosts: Vec<String>,
+    /// Let a third-party OSCQuery web client served from ORIGIN (`http://host:port`, repeatable)
+    /// read the tree and open a WebSocket; it controls the show only with the access token.
+    /// Pages of any other origin are refused.
+    #[arg(long = "oscquery-cors", value_name = "ORIGIN", value_parser = parse_origin)]
+    pub oscquery_cors: Vec<String>,
+    /// WebSocket sessions open at once: browser pages and OSCQuery clients together (1–256).
+    #[arg(long, value_name = "N", default_value_t = 16, value_parser = parse_web_sessions)]
+    pub web_sessions: usize,
+    /// Only MIDI input ports whose name contains this (default: all ports).
+    #[arg(long)]
+    pub midi: Option<String>,
+    /// No MIDI input.
+    #[arg(long)]
+    pub no_midi: bool,
+    /// Audio input device: the first whose name contains this (default: the default device,
+    /// opened when the scene maps audio).
+    #[arg(long, value_name = "NAME")]
+    pub audio_in: Option<String>,
+    /// No audio input.
+    #[arg(long)]
+    pub no_audio: bool,
+    /// Join the Ableton Link session on the local network: follow its tempo and phase, propose
+    /// tempo changes made here (builds with `--features link`, GPL-2.0-or-later).
+    #[arg(long)]
+    pub link: bool,
+    /// Open one more output window (repeatable): source=NODE, warp=FILE.ron, monitor=N,
+    /// fullscreen — e.g. `--output-window warp=wall.ron,monitor=1,fullscreen`.
+    #[arg(long = "output-window", value_name = "SPEC")]
+    pub output_windows: Vec<String>,
+    /// List the audio input devices and exit.
+    #[arg(long)]
+    pub list_audio: bool,
+    /// Record every control event with its frame to this file (replay with `render --replay`).
+    #[arg(long)]
+    pub record_controls: Option<PathBuf>,
+    /// Folder of presets [default: presets, in %APPDATA%\indra on Windows].
+    #[arg(long)]
+    pub presets: Option<PathBuf>,
+    /// File of MIDI-learned mappings [default: midi-learn.ron, in %APPDATA%\indra on Windows].
+    #[arg(long)]
+    pub midi_learn: Option<PathBuf>,
+    /// File of audio mappings learned from the panel [default: audio-learn.ron, likewise].
+    #[arg(long)]
+    pub audio_learn: Option<PathBuf>,
+    /// Do not watch shaders/ and scenes/ for edits.
+    #[arg(long)]
+    pub no_watch: bool,
+    /// Record the output as shown to this video from the start (.mp4, .mov, .webm, .mkv);
+    /// later takes (panel button, OSC /indra/record/start) go beside it. Never overwrites.
+    #[arg(long, value_name = "FILE")]
+    pub record_video: Option<PathBuf>,
+    /// Send the output as shown to a network stream from the start: srt://HOST:PORT,
+    /// udp://HOST:PORT or rtmp://HOST/APP/KEY (H.264 tuned for latency, through ffmpeg). The show
+    /// never waits for the network: frames the encoder cannot take are dropped and counted.
+    #[arg(long, value_name = "URL")]
+    pub stream: Option<String>,
+    /// Send the output as shown as an NDI source of this name from the start (OBS, Resolume,
+    /// TouchDesigner find it). Needs the NDI runtime, loaded at run time (see the README); the
+    /// show never waits for the network: frames the sender cannot take are dropped and counted.
+    #[arg(long, value_name = "NAME")]
+    pub ndi_out: Option<String>,
+    /// Offer the output as shown as a PipeWire video source of this name from the start (what
+    /// OBS, browsers and `pipewiresrc` read on Linux), through GStreamer's `pipewiresink`. The
+    /// show never waits: frames the source cannot take are dropped and counted.
+    #[arg(long, value_name = "NAME")]
+    pub pipewire_out: Option<String>,
+}
+
+/// Where OSC listens unless told otherwise: loopback, so nothing on the network can reach it.
+pub const DEFAULT_OSC: &str = "127.0.0.1:9000";
+
+impl Default for RunArgs {
+    /// What `indra` with no arguments does (the same defaults as `indra run`).
+    fn default() -> Self {
+        Self {
+            scene: DEFAULT_SCENE.into(),
+            fullscreen: false,
+            monitor: None,
+            sets: Vec::new(),
+            msaa: None,
+            osc: DEFAULT_OSC.into(),
+            no_osc: false,
+            osc_out: None,
+            oscquery: None,
+            web: None,
+            web_read_only: false,
+            web_token: None,
+            web_sessions: 16,
+            web_hosts: Vec::new(),
+            oscquery_cors: Vec::new(),
+            midi: None,
+            no_midi: false,
+            audio_in: None,
+            no_audio: false,
+            link: false,
+            list_audio: false,
+            output_windows: Vec::new(),
+            record_controls: None,
+            presets: None,
+            midi_learn: None,
+            audio_learn: None,
+            no_watch: false,
+            record_video: None,
+            stream: None,
+            ndi_out: None,
+            pipewire_out: None,
+        }
+    }
+}
+
+/// Opens the scene in a window. A scene file that is broken on disk falls back to its built-in
+/// copy (with the error shown) so the show starts; the fix is picked up on save.
+pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), String> {
+    if args.list_audio {
+        return list_audio();
+    }
+    // A live show never waits for a file a parameter names: it loads in the background.
+    let assets = &with_scene_folder(assets, &args.scene).with_load_wait(indra::files::LoadWait::Background);
+    let mut notices = Vec::new();
+    // A show plays what it can: a clip whose scene is missing or broken is left out and told.
+    let loaded = if indra::scene::names_a_show(&args.scene) {
+        indra::scene::show::load_show(assets, &args.scene, true)
+            .map_err(|e| e.to_string())
+            .and_then(|scene| with_sets(scene, &args.sets, args.msaa))
+    } else {
+        scene_with_sets(assets, &args.scene, &args.sets, args.msaa)
+    };
+    let mut scene = match loaded {
+        Ok(scene) => scene,
+        Err(e) => match scene_with_sets(&assets.builtin_only(), &args.scene, &args.sets, args.msaa) {
+            Ok(builtin) => {
+                notices.push(format!("{e}\n(running the built-in copy until the file is fixed)"));
+                builtin
+            }
+            Err(_) => return Err(e),
+        },
+    };
+    for spec in &args.output_windows {
+        scene.add_output(spec)?;
+    }
+    let options = indra::app::WindowOptions {
+        fullscreen: args.fullscreen,
+        monitor: args.monitor,
+        watch: !args.no_watch,
+        record_video: args.record_video.clone(),
+        stream: args.stream.clone(),
+        ndi_out: args.ndi_out.clone(),
+        pipewire_out: args.pipewire_out.clone(),
+    };
+    let web = match &args.web {
+        Some(addr) => {
+            let token = match &args.web_token {
+                Some(chosen) => indra::control::web::AccessToken::chosen(chosen)?,
+                None => indra::control::web::AccessToken::random()?,
+            };
+            let (read_only, sessions) = (args.web_read_only, args.web_sessions);
+            Some(indra::control::web::WebOptions { addr: addr.clone(), read_only, token, sessions })
+        }
+        None => None,
+    };
+    let control = indra::control::ControlOptions {
+        osc: (!args.no_osc).then(|| args.osc.clone()),
+        osc_out: args.osc_out.clone(),
+        oscquery: args.oscquery.clone(),
+        web,
+        midi: !args.no_midi,
+        audio_in: (!args.no_audio).then(|| args.audio_in.clone()),
+        midi_filter: args.midi.clone(),
+        record: args.record_controls.clone(),
+        presets_dir: args.presets.clone().unwrap_or_else(|| indra::files::user_data("presets")),
+        learn_file: args.midi_learn.clone().unwrap_or_else(|| indra::files::user_data("midi-learn.ron")),
+        audio_learn_file: args.audio_learn.clone().unwrap_or_else(|| indra::files::user_data("audio-learn.ron")),
+        link: args.link,
+        sites: indra::control::site::SiteRules { hosts: args.web_hosts.clone(), cors: args.oscquery_cors.clone() },
+    };
+    indra::app::run(assets.clone(), gpu.clone(), scene, options, control, notices)
+}
+
+/// `--oscquery-cors`: an origin as a browser sends it, `http(s)://host[:port]` with no path.
+fn parse_origin(text: &str) -> Result<String, String> {
+    let site = text.strip_prefix("http://").or_else(|| text.strip_prefix("https://"));
+    match site.map(|s| s.trim_end_matches('/')) {
+        Some(site) if !site.is_empty() && !site.contains('/') => Ok(text.trim_end_matches('/').to_string()),
+        _ => Err(format!(
+            "{text}: an origin is http://HOST:PORT or https://HOST:PORT, as the page's address bar shows it"
+        )),
+    }
+}
+
+/// `--web-sessions`: a count within [`indra::control::web::SESSIONS`].
+fn parse_web_sessions(text: &str) -> Result<usize, String> {
+    let range = indra::control::web::SESSIONS;
+    text.parse::<usize>()
+        .ok()
+        .filter(|n| range.contains(n))
+        .ok_or_else(|| format!("{text}: WebSocket sessions are {} to {}", range.start(), range.end()))
+}
+
+/// Prints the audio input devices, one per line.
+fn list_audio() -> Result<(), String> {
+    #[cfg(feature = "audio")]
+    {
+        let devices = indra::control::audio::live::list_devices()?;
+        if devices.is_empty() {
+            say!("no audio input devices");
+        }
+        for d in devices {
+            say!("{d}");
+        }
+        Ok(())
+    }
+    #[cfg(not(feature = "audio"))]
+    Err("this build has no live audio input (built without the `audio` feature)".into())
+}
