@@ -11,7 +11,7 @@ mod rebuild;
 
 use std::collections::BTreeSet;
 
-use super::load::Scene;
+use super::model::Scene;
 use super::show::{Show, ShowRuntime, ShowState};
 use crate::assets::Assets;
 use crate::gpu::{Gpu, ShaderError};

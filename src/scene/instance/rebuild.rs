@@ -8,7 +8,7 @@ use crate::assets::Assets;
 use crate::gpu::{Gpu, ShaderError};
 use crate::params::{ParamSet, Remap};
 use crate::scene::SceneNode;
-use crate::scene::load::Scene;
+use crate::scene::model::Scene;
 use crate::scene::show::{Mixer, ShowRuntime};
 use crate::techniques::Technique;
 

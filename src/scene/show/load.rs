@@ -12,10 +12,9 @@ use super::{Clip, Cue, CueNotes, Layer, Length, MAX_CLIPS_PER_LAYER, MAX_CUES, M
 use crate::assets::{AssetKind, Assets};
 use crate::params::{ParamSet, ParamValue, Target, coerce};
 use crate::scene::error::{SceneError, SceneErrors, locate};
-use crate::scene::load::{
-    MAX_NODES, MAX_REPORTED_ERRORS, Scene, SceneNode, header_problems, load_scene, names_a_show, read_ron,
-    resolve_target,
-};
+use crate::scene::load::{load_scene, names_a_show, read_ron};
+use crate::scene::model::{MAX_NODES, MAX_REPORTED_ERRORS, Scene, SceneNode, resolve_target};
+use crate::scene::validate::header_problems;
 use crate::techniques::{blend, fader};
 
 /// Ids a clip may not take: the show's own addresses start with them.
@@ -268,7 +267,7 @@ impl Builder<'_> {
             show.cues = file.cues.iter().enumerate().filter_map(|(i, c)| self.cue(&show, i, c)).collect();
         }
         show.kinds = std::mem::take(&mut self.kinds);
-        let own_texture_bytes = crate::scene::load::own_texture_bytes(self.assets, &nodes, file.size);
+        let own_texture_bytes = crate::scene::model::own_texture_bytes(self.assets, &nodes, file.size);
         let mut scene = Scene {
             origin: self.origin.to_string(),
             name: file.name.clone(),
@@ -526,7 +525,7 @@ fn budget(scene: &Scene, show: &Show) -> Result<(), String> {
             scene.size.0,
             scene.size.1,
             scene.msaa,
-            gib(crate::scene::load::MAX_TEXTURE_BYTES),
+            gib(crate::scene::model::MAX_TEXTURE_BYTES),
             clips.join(", ")
         )
     })
