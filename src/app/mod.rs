@@ -3,9 +3,11 @@
 //! errors. F11 toggles fullscreen, Esc leaves it (never the show), F1 hides the panel, F2 gives
 //! taken-over parameters back to their tracks, 1–9 recall presets.
 
+mod input;
 mod outputs;
 mod panel;
 mod param_widget;
+mod running;
 mod show_panel;
 mod surface;
 mod web_panel;
