@@ -9,7 +9,8 @@ use std::time::{Duration, Instant, SystemTime};
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use indra::assets::Assets;
-use indra::control::osc::{OscReceiver, OscRouter};
+use indra::control::osc::OscReceiver;
+use indra::control::osc_route::OscRouter;
 use indra::gpu::{BackendChoice, Gpu, GpuOptions};
 use indra::live::LiveReload;
 use indra::offscreen::OffscreenRenderer;

@@ -9,7 +9,8 @@ use std::net::UdpSocket;
 use std::time::{Duration, Instant, SystemTime};
 
 use indra::assets::Assets;
-use indra::control::osc::{OscReceiver, OscRouter};
+use indra::control::osc::OscReceiver;
+use indra::control::osc_route::OscRouter;
 use indra::geometry::SplitMix64;
 use indra::scene::load_scene;
 use rosc::{OscBundle, OscMessage, OscPacket, OscTime, OscType};

@@ -17,6 +17,7 @@ pub mod listen;
 pub mod midi;
 pub mod osc;
 mod osc_guard;
+pub mod osc_route;
 pub mod oscquery;
 pub mod presets;
 pub mod record;
@@ -26,4 +27,4 @@ pub mod web;
 
 pub use address::{AddressMap, Route};
 pub use hub::{ControlHub, ControlOptions};
-pub use osc::RecordRequest;
+pub use osc_route::RecordRequest;

@@ -8,7 +8,8 @@ use std::net::UdpSocket;
 use std::time::{Duration, Instant, SystemTime};
 
 use indra::control::feedback::{OscFeedback, ParamChanges};
-use indra::control::osc::{OscReceiver, OscRouter, Routed, decode};
+use indra::control::osc::{OscReceiver, decode};
+use indra::control::osc_route::{OscRouter, Routed};
 use indra::control::oscquery::OscQueryServer;
 use indra::params::ParamValue;
 use indra::scene::{ControlEvent, Scene, SceneInstance, SceneView, load_scene};
@@ -511,7 +512,7 @@ fn a_flood_of_new_patterns_costs_a_bounded_amount_per_frame() {
     let packets: Vec<Vec<u8>> =
         (0..100).map(|i| packet(&format!("/indra/output{{1,x{i}}}/blend_curve"), vec![OscType::Float(2.5)])).collect();
     let (routed, rx) = send_and_route(&s, &packets);
-    let new_patterns = indra::control::osc::NEW_PATTERNS_PER_FRAME;
+    let new_patterns = indra::control::osc_route::NEW_PATTERNS_PER_FRAME;
     assert_eq!(routed.len(), new_patterns, "each routed pattern reaches output1 once");
     assert_eq!(rx.counters().snapshot()[3], (100 - new_patterns) as u64, "the rest are counted");
 }

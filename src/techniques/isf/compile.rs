@@ -5,7 +5,8 @@
 use naga::front::glsl::{Frontend, Options};
 
 use super::header::Header;
-use super::translate::{Program, Stage, translate};
+use super::program::{Program, Stage};
+use super::translate::translate;
 use crate::gpu::ShaderError;
 
 /// An ISF shader ready to build: its header, what the host binds, and both stages as naga modules.

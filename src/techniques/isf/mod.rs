@@ -20,8 +20,10 @@ pub mod expr;
 pub mod header;
 mod node;
 mod pipeline;
+pub mod program;
 #[cfg(test)]
 mod render_tests;
+mod rewrite;
 mod sound;
 pub mod targets;
 pub mod translate;

@@ -5,8 +5,8 @@
 use std::collections::BTreeMap;
 
 use super::compile::Compiled;
+use super::program::{FIRST_TEXTURE_BINDING, SAMPLER_BINDING, UNIFORM_BINDING, storage_binding};
 use super::targets::{BYTE_FORMAT, FLOAT_FORMAT};
-use super::translate::{FIRST_TEXTURE_BINDING, SAMPLER_BINDING, UNIFORM_BINDING, storage_binding};
 use crate::gpu::ShaderError;
 
 /// The node's image: linear HDR like every node's.

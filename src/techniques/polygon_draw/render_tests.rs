@@ -5,7 +5,8 @@
 
 use crate::common;
 
-use indra::control::osc::{OscReceiver, OscRouter, Routed};
+use indra::control::osc::OscReceiver;
+use indra::control::osc_route::{OscRouter, Routed};
 use indra::offscreen::{OffscreenRenderer, RenderedFrame};
 use indra::params::ParamValue;
 use indra::scene::{ControlEvent, Scene, load_scene};

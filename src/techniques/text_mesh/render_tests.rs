@@ -3,7 +3,8 @@
 
 use crate::common;
 
-use indra::control::osc::{OscReceiver, OscRouter, Routed};
+use indra::control::osc::OscReceiver;
+use indra::control::osc_route::{OscRouter, Routed};
 use indra::offscreen::OffscreenRenderer;
 use indra::scene::load_scene;
 use rosc::{OscMessage, OscType};
