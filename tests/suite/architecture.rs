@@ -1,5 +1,6 @@
 //! The architecture page (`docs/architecture.md`) against the code: its layer table lists every
-//! module of `src/` once, and every `crate::` import goes to a lower layer.
+//! module of `src/` once, every `crate::` import goes to a lower layer, and no file is over 600
+//! lines but those the page names.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -95,6 +96,35 @@ fn every_import_goes_to_a_lower_layer() {
         }
     }
     assert!(wrong.is_empty(), "imports against the layers of docs/architecture.md:\n{}", wrong.join("\n"));
+}
+
+/// The most lines a file of `src/` may have unless the page names it as an exception.
+const MAX_LINES: usize = 600;
+
+#[test]
+fn no_file_is_over_600_lines_but_the_exceptions_the_page_names() {
+    let page = std::fs::read_to_string(Path::new(ROOT).join("docs/architecture.md")).unwrap();
+    let section = page.split("## File sizes").nth(1).unwrap().split("\n## ").next().unwrap();
+    let named: Vec<&str> =
+        section.lines().filter_map(|l| l.strip_prefix("- `")).filter_map(|l| l.split('`').next()).collect();
+    let mut files = Vec::new();
+    rust_files(&Path::new(ROOT).join("src"), &mut files);
+    let mut long = Vec::new();
+    for file in files {
+        let relative = file.strip_prefix(ROOT).unwrap().to_string_lossy().replace('\\', "/");
+        let lines = std::fs::read_to_string(&file).unwrap().lines().count();
+        if lines > MAX_LINES && !named.contains(&relative.as_str()) {
+            long.push(format!("{relative}: {lines} lines"));
+        }
+    }
+    assert!(
+        long.is_empty(),
+        "files over {MAX_LINES} lines that docs/architecture.md does not name:\n{}",
+        long.join("\n")
+    );
+    for name in named {
+        assert!(Path::new(ROOT).join(name).is_file(), "docs/architecture.md names {name}, which is not a file");
+    }
 }
 
 #[test]
