@@ -29,6 +29,8 @@ pub mod time;
 // helpers of `tests/common`.
 #[cfg(test)]
 extern crate self as indra;
+#[cfg(all(test, not(feature = "golden")))]
+compile_error!("indra's own tests compare renders by FLIP: build them with the `golden` feature (on by default)");
 #[cfg(test)]
 #[path = "../tests/common/mod.rs"]
 mod common;

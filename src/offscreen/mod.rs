@@ -3,6 +3,7 @@
 
 pub mod capture;
 mod frame_pipe;
+#[cfg(feature = "golden")]
 mod golden;
 mod ndi_out;
 mod pipewire_out;
@@ -10,6 +11,7 @@ mod renderer;
 pub mod video;
 
 pub use capture::{CaptureCounts, CaptureReport, FinishingTake, FrameOutlet, LiveRecorder};
+#[cfg(feature = "golden")]
 pub use golden::{FlipScore, GoldenCheck, flip_score};
 pub use ndi_out::ndi_outlet;
 pub use pipewire_out::{GST_LAUNCH_ENV, PipeWireOut};

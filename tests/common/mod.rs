@@ -3,10 +3,17 @@
 #![allow(dead_code)]
 
 pub mod clips;
+// FLIP goldens need the `golden` feature (on by default); the CLI tests also run without it,
+// against the render-node build.
+#[cfg(feature = "golden")]
+mod golden;
+#[cfg(feature = "golden")]
+#[allow(unused_imports)] // each test binary uses some of them
+pub use golden::{golden, golden_beside, golden_in};
 
 use indra::assets::Assets;
 use indra::gpu::{BackendChoice, Gpu, GpuOptions};
-use indra::offscreen::{GoldenCheck, OffscreenRenderer, RenderedFrame};
+use indra::offscreen::{OffscreenRenderer, RenderedFrame};
 use indra::scene::{Scene, load_scene, parse_scene};
 
 /// A headless device. Vulkan (lavapipe on CI) so that goldens are made by one backend.
@@ -46,27 +53,6 @@ pub fn render_named(name: &str, size: (u32, u32), frame: u64) -> RenderedFrame {
 /// Renders a scene given as RON text.
 pub fn render_text(ron: &str, size: (u32, u32)) -> RenderedFrame {
     render_scene(parse_scene("inline.ron", ron).unwrap_or_else(|e| panic!("{e}")), size, 0)
-}
-
-/// The golden checker for `tests/golden/`, passing a picture whose FLIP error against the
-/// reference is at most `max_mean` on average and `max_p99` at the 99th percentile. Each test
-/// states its own bounds where it checks (0.01 and 0.3 tolerate rasterisation noise across
-/// drivers but not a changed picture).
-pub fn golden(max_mean: f32, max_p99: f32) -> GoldenCheck {
-    golden_in(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/golden"), max_mean, max_p99)
-}
-
-/// The golden checker for the `golden/` folder beside `file` (a test's `file!()`: a technique's
-/// references sit in its own folder), with the bounds of [`golden`].
-pub fn golden_beside(file: &str, max_mean: f32, max_p99: f32) -> GoldenCheck {
-    let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
-    let dir = folder.parent().expect("a test file is in a folder").join("golden");
-    golden_in(dir, max_mean, max_p99)
-}
-
-/// The golden checker for the references in `dir`, with the bounds of [`golden`].
-pub fn golden_in(dir: impl Into<std::path::PathBuf>, max_mean: f32, max_p99: f32) -> GoldenCheck {
-    GoldenCheck { max_mean, max_percentile: max_p99, percentile: 0.99, ..GoldenCheck::new(dir) }
 }
 
 /// Whether pixel (x, y) is bright (mean of RGB above half).
