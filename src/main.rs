@@ -13,7 +13,7 @@ use indra::gpu::BackendChoice;
 /// hold theirs gets an arena of its own, up to eight per core, and a show's clip builds, reloads
 /// and the driver's threads each fragment one: on a loaded two-core machine a show under
 /// trigger floods rose ~150 MiB an hour with the default and stayed flat with two (tests/soak;
-/// frame times within noise, docs/performance.md). Set before any thread starts.
+/// frame times within noise, docs/performance-notes.md). Set before any thread starts.
 fn fewer_malloc_arenas() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     // SAFETY: mallopt only changes glibc's allocator settings; no other thread runs yet.
