@@ -17,7 +17,7 @@ fn main() {
     let res: usize = arg(0, "1024").parse().expect("resolution");
     let (solver, substeps, seconds) = (arg(1, "XPBD"), arg(2, "16"), arg(3, "10").parse::<u32>().expect("seconds"));
     let rest = 5.12 / res as f32;
-    let mut params = ParamSet::new(indra::techniques::cloth::params());
+    let mut params = ParamSet::new(indra::techniques::cloth::Settings::decls());
     let settings = [
         ("resolution", res.to_string()),
         ("solver", solver.clone()),

@@ -81,7 +81,7 @@ fn each_blend_mode_matches_a_cpu_reference() {
     assert_eq!(modes, ["normal", "add", "screen", "multiply", "difference", "lighten"]);
     for (mode, name) in modes.iter().enumerate() {
         for opacity in [0.0, 0.37, 1.0] {
-            let mut params = ParamSet::new(blend::params());
+            let mut params = ParamSet::new(blend::Settings::decls());
             params.set_at(params.index("blend").unwrap(), ParamValue::Enum(mode as u32));
             params.set_at(params.index("opacity").unwrap(), ParamValue::Float(opacity));
             params.snap();

@@ -17,7 +17,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "blend",
     chapter: "show: layer compositing",
     summary: "one image over another: normal, add, screen, multiply, difference or lighten, at an opacity",
-    params,
+    params: Settings::decls,
     inputs: &["below", "over"],
     shaders: &["blend.wgsl"],
     create,
@@ -52,11 +52,6 @@ crate::technique_params! {
         /// how the layer's colour meets the image below
         blend: BlendMode = |n, doc| ParamDecl::choice(n, BlendMode::OPTIONS, 0, doc),
     }
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// The shader's uniform block.

@@ -25,7 +25,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "camera",
     chapter: "media: cameras",
     summary: "a camera's newest frame (V4L2 through ffmpeg; `test` for a moving test pattern)",
-    params,
+    params: Settings::decls,
     inputs: &[],
     shaders: &["picture.wgsl"],
     create,
@@ -48,11 +48,6 @@ crate::technique_params! {
         /// how a picture of another shape fills the image
         fit: Fit = |n, doc| ParamDecl::choice(n, Fit::OPTIONS, 0, doc),
     }
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// What reopens the camera when it changes.

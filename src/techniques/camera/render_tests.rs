@@ -9,7 +9,7 @@ use indra::techniques::{NodeSetup, camera};
 use indra::time::FrameTime;
 
 fn params(settings: &[(&str, &str)]) -> ParamSet {
-    let mut params = ParamSet::new(camera::params());
+    let mut params = ParamSet::new(camera::Settings::decls());
     for (name, value) in settings {
         let i = params.index(name).unwrap();
         params.set_at(i, parse_value_override(value, &params.decls()[i]).unwrap());

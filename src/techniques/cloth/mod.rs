@@ -13,7 +13,7 @@ mod render;
 pub mod runner;
 mod state;
 
-pub use params::{ClothUniforms, Pin, Settings, Solver, View, params, rest_pose, sphere_center, wind_force};
+pub use params::{ClothUniforms, Pin, Settings, Solver, View, rest_pose, sphere_center, wind_force};
 use render::{ClothView, Renderer};
 use state::State;
 
@@ -30,7 +30,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "cloth",
     chapter: "3: GPU-Based Cloth Simulation",
     summary: "mass-spring (Verlet) or XPBD cloth on the GPU with a colliding sphere",
-    params,
+    params: Settings::decls,
     inputs: &[],
     shaders: &["cloth.wgsl", "cloth_render.wgsl", "cloth_raster.wgsl", "splat_draw.wgsl", "msaa_samples.wgsl"],
     create,

@@ -106,11 +106,6 @@ crate::technique_params! {
     }
 }
 
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
-}
-
 /// The simulation shader's uniform block.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]

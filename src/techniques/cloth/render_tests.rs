@@ -12,7 +12,7 @@ use indra::techniques::cloth::{ClothUniforms, reference, rest_pose};
 
 /// A 16×16 cloth (rest 0.1, damping 2) with `settings` applied, stepping `dt` per frame.
 fn rig(settings: &[(&str, &str)], dt: f32) -> Runner {
-    let mut params = ParamSet::new(indra::techniques::cloth::params());
+    let mut params = ParamSet::new(indra::techniques::cloth::Settings::decls());
     for (name, value) in [("resolution", "16"), ("rest_length", "0.1"), ("damping", "2")].iter().chain(settings) {
         let i = params.index(name).unwrap_or_else(|| panic!("{name}"));
         params.set_at(i, parse_value_override(value, &params.decls()[i]).unwrap());

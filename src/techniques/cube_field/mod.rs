@@ -28,7 +28,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "cube_field",
     chapter: "4: StarGlow (demo scene)",
     summary: "instanced spinning cubes with HDR specular glints",
-    params,
+    params: Settings::decls,
     inputs: &[],
     shaders: &["cube_field.wgsl", "cube_field_raster.wgsl", "splat_draw.wgsl", "msaa_samples.wgsl"],
     create,
@@ -76,11 +76,6 @@ crate::technique_params! {
         /// hardware rasterizer
         rasterizer: Rasterizer = |n, doc| ParamDecl::choice(n, Rasterizer::OPTIONS, 0, doc),
     }
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// The shader's uniform block.

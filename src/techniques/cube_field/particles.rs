@@ -69,7 +69,7 @@ mod tests {
 
     #[test]
     fn the_field_is_full_from_the_start_and_stays_rate_times_life() {
-        let p = ParamSet::new(super::super::params());
+        let p = ParamSet::new(super::super::Settings::decls());
         for t in [0.0, 0.5, 7.25, 100.0] {
             let n = at(t, &p).len();
             assert!((999..=1001).contains(&n), "{n} cubes at {t} s");
@@ -78,7 +78,7 @@ mod tests {
 
     #[test]
     fn cubes_move_towards_the_camera_and_stay_in_the_emitter_footprint() {
-        let p = ParamSet::new(super::super::params());
+        let p = ParamSet::new(super::super::Settings::decls());
         let cubes = at(3.0, &p);
         for c in &cubes {
             let [x, y, z, _] = c.position_size;
@@ -91,7 +91,7 @@ mod tests {
 
     #[test]
     fn same_time_and_seed_give_the_same_field() {
-        let mut p = ParamSet::new(super::super::params());
+        let mut p = ParamSet::new(super::super::Settings::decls());
         assert_eq!(at(4.2, &p), at(4.2, &p));
         p.set_at(p.index("rate").unwrap(), ParamValue::Float(0.0));
         assert!(at(4.2, &p).is_empty());

@@ -16,7 +16,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "fader",
     chapter: "show: master fader",
     summary: "the image faded towards black by a level",
-    params,
+    params: Settings::decls,
     inputs: &["image"],
     shaders: &["fader.wgsl"],
     create,
@@ -31,11 +31,6 @@ crate::technique_params! {
         /// 1 shows the image, 0 is black
         level: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.0), Some((0.0, 1.0)), doc),
     }
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// The shader's uniform block.

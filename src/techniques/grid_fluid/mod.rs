@@ -33,7 +33,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "grid_fluid",
     chapter: "6: Tessellation & Displacement (displacement source)",
     summary: "a 2-D stable-fluids grid stirred by a cursor; its density is a height map",
-    params,
+    params: Settings::decls,
     inputs: &[],
     shaders: &["grid_fluid.wgsl"],
     create,
@@ -75,11 +75,6 @@ crate::technique_params! {
         /// clear the fluid (R in the window)
         reset: bool = |n, doc| ParamDecl::trigger(n, doc).with_role(InputRole::Key('r')),
     }
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// The kernels (one pipeline per entry point) and their two layouts.

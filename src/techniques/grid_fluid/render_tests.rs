@@ -11,7 +11,7 @@ use indra::techniques::runner::NodeRunner;
 const N: usize = 32;
 
 fn runner(settings: &[(&str, ParamValue)], dt: f32) -> NodeRunner<GridFluid> {
-    let mut params = ParamSet::new(grid_fluid::params());
+    let mut params = ParamSet::new(grid_fluid::Settings::decls());
     params.set_at(params.index("resolution").unwrap(), ParamValue::Int(N as i32));
     for (name, value) in settings {
         params.set_at(params.index(name).unwrap_or_else(|| panic!("{name}")), *value);

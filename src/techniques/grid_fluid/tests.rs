@@ -11,7 +11,7 @@ fn the_dispatch_block_matches_the_wgsl_struct() {
 
 #[test]
 fn a_step_solves_in_the_books_order_and_every_solve_ends_in_its_field() {
-    let params = ParamSet::new(params());
+    let params = ParamSet::new(Settings::decls());
     let plan = step_dispatches(64, &Settings::read(&params), 1.0 / 60.0, Some(([0.5, 0.5], [0.01, 0.0])));
     let kernels: Vec<Kernel> = plan.iter().map(|p| p.0).collect();
     assert_eq!(kernels[0], Kernel::AddSource);
@@ -24,7 +24,7 @@ fn a_step_solves_in_the_books_order_and_every_solve_ends_in_its_field() {
     let (last_kernel, last) = plan.last().unwrap();
     assert_eq!((*last_kernel, last.src, last.dst), (Kernel::Copy, Field::DensityTmp as u32, Field::Density as u32));
     // Without stirring there is no source, and an odd iteration count copies back.
-    let mut odd = ParamSet::new(super::params());
+    let mut odd = ParamSet::new(super::Settings::decls());
     odd.set_at(odd.index("pressure_iterations").unwrap(), crate::params::ParamValue::Int(3));
     let still = step_dispatches(64, &Settings::read(&odd), 1.0 / 60.0, None);
     assert!(still.iter().all(|p| p.0 != Kernel::AddSource));
@@ -35,7 +35,7 @@ fn a_step_solves_in_the_books_order_and_every_solve_ends_in_its_field() {
 
 #[test]
 fn a_flick_of_the_cursor_is_limited() {
-    let params = ParamSet::new(params());
+    let params = ParamSet::new(Settings::decls());
     let plan = step_dispatches(100, &Settings::read(&params), 1.0 / 60.0, Some(([0.5, 0.5], [0.9, 0.0])));
     let impulse = plan[0].1.impulse;
     assert!((impulse[0] - MAX_IMPULSE * 100.0).abs() < 1e-3 && impulse[1] == 0.0, "{impulse:?}");

@@ -32,7 +32,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "image",
     chapter: "media: stills (and ch. 6's height maps)",
     summary: "a PNG or JPEG: a picture fitted into the image, or its values as data (a height map)",
-    params,
+    params: Settings::decls,
     inputs: &[],
     shaders: &["picture.wgsl"],
     create,
@@ -68,11 +68,6 @@ crate::technique_params! {
         /// how a picture of another shape fills the image
         fit: Fit = |n, doc| ParamDecl::choice(n, Fit::OPTIONS, 0, doc),
     }
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// An image node.

@@ -39,7 +39,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "isf",
     chapter: "import: ISF shaders (generators, filters, transitions)",
     summary: "a shader in the Interactive Shader Format; its inputs become parameters and input slots",
-    params,
+    params: Settings::decls,
     inputs: &[],
     shaders: &["isf_present.wgsl"],
     create: node::create,
@@ -62,11 +62,6 @@ crate::technique_params! {
         /// DATE at the start: year, month, day, seconds since midnight (the clock advances it)
         date: [f32; 4] = |n, doc| ParamDecl::new(n, ParamValue::Vec4([2026.0, 1.0, 1.0, 0.0]), None, doc),
     }
-}
-
-/// Parameters (see [`Settings`]); the shader's inputs follow them.
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// The largest `.fs` or `.vs` file read.
@@ -123,7 +118,7 @@ impl IsfFiles {
 /// What an ISF file declares for its node: its inputs as parameters and image slots.
 fn declare(assets: &Assets, file: &str) -> Result<Declared, String> {
     let compiled = IsfFiles::read(assets, file)?.compile().map_err(|e| e.to_string())?;
-    let own = params();
+    let own = Settings::decls();
     if let Some(clash) = compiled.header.inputs.iter().find(|i| own.iter().any(|d| d.name == i.name)) {
         return Err(format!("{file}: input '{}' has the name of the node's own parameter; rename it", clash.name));
     }

@@ -19,7 +19,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "kleinian",
     chapter: "2: Limit sets of Kleinian groups",
     summary: "Jos Leys' escape-time limit set of the Maskit slice, with circle inversion",
-    params,
+    params: Settings::decls,
     inputs: &[],
     shaders: &["kleinian.wgsl"],
     create,
@@ -58,11 +58,6 @@ crate::technique_params! {
         /// inversion circle radius
         circle_radius: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(1.0), Some((0.01, 20.0)), doc),
     }
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// The shader's uniform block; layout checked against naga's reflection in the tests.

@@ -8,7 +8,7 @@ fn uniform_layout_matches_the_wgsl_struct() {
 
 #[test]
 fn uniforms_convert_colours_to_linear_and_flags() {
-    let mut p = ParamSet::new(params());
+    let mut p = ParamSet::new(Settings::decls());
     p.set_at(p.index("hit_color").unwrap(), ParamValue::Color([1.0, 0.5, 0.0, 1.0]));
     p.set_at(p.index("circle_inversion").unwrap(), ParamValue::Bool(true));
     let time = FrameTime { frame: 0, seconds: 0.0, dt: 0.1, seed: 9 };

@@ -23,7 +23,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "ndi",
     chapter: "media: NDI",
     summary: "the newest frame of an NDI source on the network (`indra --list-ndi` lists them)",
-    params,
+    params: Settings::decls,
     inputs: &[],
     shaders: &["picture.wgsl"],
     create,
@@ -40,11 +40,6 @@ crate::technique_params! {
         /// how a picture of another shape fills the image
         fit: Fit = |n, doc| ParamDecl::choice(n, Fit::OPTIONS, 0, doc),
     }
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// An NDI node.

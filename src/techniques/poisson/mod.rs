@@ -22,7 +22,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "poisson",
     chapter: "7: Fast Poisson disk sampling",
     summary: "Bridson Poisson disk samples in 2-D or 3-D, growing step by step",
-    params,
+    params: Settings::decls,
     inputs: &[],
     shaders: &["poisson.wgsl", "poisson_raster.wgsl", "splat_draw.wgsl", "msaa_samples.wgsl"],
     create,
@@ -71,11 +71,6 @@ crate::technique_params! {
         /// start sampling again from one seed point (R in the window)
         restart: bool = |n, doc| ParamDecl::trigger(n, doc).with_role(InputRole::Key('r')),
     }
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// The shader's uniform block.
@@ -492,7 +487,7 @@ mod tests {
 
     #[test]
     fn the_whole_box_stays_in_view_at_every_orbit_angle() {
-        let mut p = ParamSet::new(params());
+        let mut p = ParamSet::new(Settings::decls());
         p.set_at(p.index("dimensions").unwrap(), crate::params::ParamValue::Enum(1));
         p.set_at(p.index("extent").unwrap(), crate::params::ParamValue::Vec3([200.0, 200.0, 200.0]));
         let settings = Settings::read(&p);
@@ -521,7 +516,7 @@ mod tests {
 
     #[test]
     fn in_range_settings_too_large_for_memory_are_refused_by_check_and_fitted_live() {
-        let mut p = ParamSet::new(params());
+        let mut p = ParamSet::new(Settings::decls());
         assert!(check_settings(&p).is_ok(), "the defaults fit");
         p.set_at(p.index("dimensions").unwrap(), crate::params::ParamValue::Enum(1));
         p.set_at(p.index("extent").unwrap(), crate::params::ParamValue::Vec3([10000.0; 3]));

@@ -23,7 +23,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "polygon_draw",
     chapter: "5: Triangulation by ear clipping",
     summary: "draw polygons with the mouse or OSC; holes and islands by nesting, UV checker + wireframe",
-    params,
+    params: Settings::decls,
     inputs: &[],
     shaders: &["polygon_draw.wgsl"],
     create,
@@ -74,11 +74,6 @@ impl Settings {
     pub fn style(&self) -> DrawStyle {
         DrawStyle { wireframe: self.wireframe, checker: self.checker, view_size: self.view_size }
     }
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// The sample's TriangulationTest data (seed-reference §5): an outer ring, two holes, three

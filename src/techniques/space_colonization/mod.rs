@@ -44,9 +44,7 @@ mod render;
 pub use cloud::{Attraction, Cloud, NONE, Node};
 pub use growth::{SkinData, VertexSkin};
 pub use model::{Sampling, load as load_model};
-pub use params::{
-    GridLayout, GrowthUniforms, MAX_CELLS, PoseUniforms, Search, Settings, Source, View, ViewUniforms, params,
-};
+pub use params::{GridLayout, GrowthUniforms, MAX_CELLS, PoseUniforms, Search, Settings, Source, View, ViewUniforms};
 pub use render::{TUBE_CAP_ROWS, TUBE_SIDES, tube_indices};
 
 use std::sync::Arc;
@@ -67,7 +65,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "space_colonization",
     chapter: "1: GPU-Based Space Colonization",
     summary: "branches grow towards a cloud of attractions, grid-accelerated on the GPU, drawn as lines or tubes",
-    params,
+    params: Settings::decls,
     inputs: &[],
     shaders: &[
         "space_colonization.wgsl",

@@ -121,11 +121,6 @@ crate::technique_params! {
     }
 }
 
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
-}
-
 /// The growth shader's uniform block (`Growth` in `space_colonization.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]

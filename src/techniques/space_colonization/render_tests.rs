@@ -16,7 +16,7 @@ use indra::techniques::space_colonization::{self, Attraction, NONE, Node, SpaceC
 type Runner = NodeRunner<SpaceColonization>;
 
 fn rig(settings: &[(&str, ParamValue)]) -> Runner {
-    let mut params = ParamSet::new(space_colonization::params());
+    let mut params = ParamSet::new(space_colonization::Settings::decls());
     let defaults = [
         ("side", ParamValue::Int(10)),
         ("influence", ParamValue::Float(1.14)),

@@ -33,7 +33,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "star_glow",
     chapter: "4: StarGlow",
     summary: "Kawase streak glow on any HDR input: book layout, fused, or one scan per line",
-    params,
+    params: Settings::decls,
     inputs: &["source"],
     shaders: &["star_glow.wgsl"],
     create,
@@ -107,11 +107,6 @@ crate::technique_params! {
         /// streak length relative to the image (as the book at 1080p) instead of in texels
         resolution_independent: bool = |n, doc| ParamDecl::new(n, ParamValue::Bool(true), None, doc),
     }
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// The shader's uniform block; layout checked against naga's reflection in the tests.

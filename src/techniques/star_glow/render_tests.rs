@@ -27,11 +27,11 @@ fn glow_sized(gpu: &Gpu, size: (u32, u32), source: &[[f32; 4]], settings: &[(&st
         id: "glow",
         output_size: size,
         msaa: 1,
-        params: &ParamSet::new(star_glow::params()),
+        params: &ParamSet::new(star_glow::Settings::decls()),
         seed: 1,
     })
     .unwrap();
-    let mut params = ParamSet::new(star_glow::params());
+    let mut params = ParamSet::new(star_glow::Settings::decls());
     for (name, value) in settings {
         let i = params.index(name).unwrap();
         params.set_at(i, indra::scene::parse_value_override(value, &params.decls()[i]).unwrap());

@@ -18,7 +18,7 @@ fn streak_directions_follow_the_sample() {
 
 #[test]
 fn auto_layout_is_fused_and_book_is_selectable() {
-    let mut p = ParamSet::new(params());
+    let mut p = ParamSet::new(Settings::decls());
     assert_eq!(Layout::choose(&p), Layout::Fused);
     p.set_at(p.index("layout").unwrap(), ParamValue::Enum(1));
     assert_eq!(Layout::choose(&p), Layout::Book);

@@ -22,7 +22,7 @@ mod params;
 pub mod reference;
 
 pub use params::{
-    Channel, PLANE_SIZE, Rasterizer, Settings, TessUniforms, View, camera, edge_count, frustum_planes, model, params,
+    Channel, PLANE_SIZE, Rasterizer, Settings, TessUniforms, View, camera, edge_count, frustum_planes, model,
 };
 
 use std::cell::RefCell;
@@ -40,7 +40,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "tessellation",
     chapter: "6: Tessellation & Displacement",
     summary: "a plane tessellated on the GPU by screen-space edge length and displaced by an input texture",
-    params,
+    params: Settings::decls,
     inputs: &["height"],
     shaders: &["tessellation.wgsl", "tessellation_raster.wgsl", "msaa_samples.wgsl"],
     create,
@@ -510,7 +510,7 @@ mod tests {
 
     #[test]
     fn a_pointer_over_a_plane_point_picks_that_points_uv() {
-        let mut params = ParamSet::new(super::params());
+        let mut params = ParamSet::new(super::Settings::decls());
         params.set_at(params.index("camera_yaw").unwrap(), crate::params::ParamValue::Float(25.0));
         params.snap();
         let u = TessUniforms::from_params(&params, (640, 360));

@@ -80,11 +80,6 @@ crate::technique_params! {
     }
 }
 
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
-}
-
 /// `Tess` in `tessellation.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]

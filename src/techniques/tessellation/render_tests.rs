@@ -51,7 +51,7 @@ fn frame(
 }
 
 fn random_params(rng: &mut SplitMix64, grid: i32) -> ParamSet {
-    let mut p = ParamSet::new(tessellation::params());
+    let mut p = ParamSet::new(tessellation::Settings::decls());
     let mut set = |name: &str, value: ParamValue| p.set_at(p.index(name).unwrap(), value);
     set("grid", ParamValue::Int(grid));
     set("camera_yaw", ParamValue::Float(rng.unit() as f32 * 120.0 - 60.0));
@@ -72,7 +72,7 @@ fn node(gpu: &indra::gpu::Gpu) -> Tessellation {
         id: "surface",
         output_size: (320, 200),
         msaa: 4,
-        params: &ParamSet::new(tessellation::params()),
+        params: &ParamSet::new(tessellation::Settings::decls()),
         seed: 1,
     })
     .unwrap()

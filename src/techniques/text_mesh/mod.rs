@@ -21,7 +21,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "text_mesh",
     chapter: "5: Triangulation by ear clipping (glyph outlines)",
     summary: "a text parameter as triangulated glyph outlines, live",
-    params,
+    params: Settings::decls,
     inputs: &[],
     shaders: &["polygon_draw.wgsl"],
     create,
@@ -51,11 +51,6 @@ crate::technique_params! {
         /// half the view height in world units
         view_size: f32 = |n, doc| ParamDecl::new(n, ParamValue::Float(2.5), Some((0.5, 100.0)), doc),
     }
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// Forwards a glyph's outline into a [`RingBuilder`], scaled and offset into world units.

@@ -38,7 +38,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "video",
     chapter: "media: video clips",
     summary: "a video clip's current frame: HAP straight to the GPU, other codecs through ffmpeg, frame-exact",
-    params,
+    params: Settings::decls,
     inputs: &[],
     shaders: &["picture.wgsl"],
     create,
@@ -93,11 +93,6 @@ crate::technique_params! {
         /// how a clip of another shape fills the image
         fit: Fit = |n, doc| ParamDecl::choice(n, Fit::OPTIONS, 0, doc),
     }
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 impl Settings {

@@ -21,7 +21,7 @@ fn clip_assets() -> Assets {
 }
 
 fn params(settings: &[(&str, &str)]) -> ParamSet {
-    let mut params = ParamSet::new(video::params());
+    let mut params = ParamSet::new(video::Settings::decls());
     for (name, value) in settings {
         let i = params.index(name).unwrap();
         params.set_at(i, parse_value_override(value, &params.decls()[i]).unwrap());

@@ -26,7 +26,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "warp",
     chapter: "stage output: projection mapping",
     summary: "corner pin, mesh warp and soft edge blend of any texture, for projectors",
-    params,
+    params: Settings::decls,
     inputs: &["source"],
     shaders: &["warp.wgsl"],
     create,
@@ -115,11 +115,6 @@ fn corner(name: &str, at: [f32; 2], doc: &str) -> ParamDecl {
 /// A soft edge's width, as a share of the image.
 fn edge_width(name: &str, doc: &str) -> ParamDecl {
     ParamDecl::new(name, ParamValue::Float(0.0), Some((0.0, 0.5)), doc)
-}
-
-/// Parameters (see [`Settings`]).
-pub fn params() -> Vec<ParamDecl> {
-    Settings::decls()
 }
 
 /// The shader's uniform block.
@@ -463,7 +458,7 @@ mod tests {
 
     #[test]
     fn a_warp_file_round_trips_through_the_parameters() {
-        let mut params = ParamSet::new(super::params());
+        let mut params = ParamSet::new(super::Settings::decls());
         let warp = WarpFile {
             region: Region { min: [0.0, 0.1], max: [0.6, 1.0] },
             corners: Corners { top_left: [0.1, 0.95], bottom_right: [0.9, 0.02], ..Default::default() },

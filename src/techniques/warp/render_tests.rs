@@ -28,9 +28,9 @@ impl Node {
     }
 
     fn with_assets(gpu: &Gpu, assets: &Assets) -> Self {
-        let params = ParamSet::new(warp::params());
+        let params = ParamSet::new(warp::Settings::decls());
         let setup = NodeSetup { gpu, assets, id: "wall", output_size: SIZE, msaa: 1, params: &params, seed: 1 };
-        Self { node: (warp::INFO.create)(&setup).unwrap(), params: ParamSet::new(warp::params()) }
+        Self { node: (warp::INFO.create)(&setup).unwrap(), params: ParamSet::new(warp::Settings::decls()) }
     }
 
     fn set(&mut self, name: &str, value: ParamValue) {
