@@ -7,7 +7,7 @@ use indra::assets::Assets;
 use indra::gpu::{Gpu, GpuOptions};
 use indra::offscreen::OffscreenRenderer;
 
-use super::{MAX_START, check_timing, parse_msaa, parse_size, scene_with_sets, with_scene_folder};
+use super::{MAX_START, SceneEdits, check_timing, parse_size, scene_with_edits, with_scene_folder};
 
 /// `indra bench`.
 #[derive(Args, Clone)]
@@ -27,14 +27,8 @@ pub struct BenchArgs {
     /// measure a cloth that has settled rather than one at rest.
     #[arg(long, default_value_t = 0)]
     pub start: u64,
-    /// Set a parameter (repeatable): node.param=value — 0.5, true, an option name, a vector as
-    /// 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
-    #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
-    pub sets: Vec<String>,
-    /// Samples per pixel of rasterising nodes, 1, 2, 4 or 8 (default: the scene's, normally 4);
-    /// lowered to what the adapter supports.
-    #[arg(long, value_parser = parse_msaa)]
-    pub msaa: Option<u32>,
+    #[command(flatten)]
+    pub edits: SceneEdits,
     /// Hold tracks still (measure one parameter set, not an animation).
     #[arg(long)]
     pub no_animation: bool,
@@ -64,7 +58,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     }
     check_timing(args.start, args.frames, None)?;
     let assets = &with_scene_folder(assets, &args.scene);
-    let scene = scene_with_sets(assets, &args.scene, &args.sets, args.msaa)?;
+    let scene = scene_with_edits(assets, &args.scene, &args.edits)?;
     scene.check_texture_budget(args.size)?;
     let cue_steps = match args.cue_every {
         None => None,
@@ -129,7 +123,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         args.warmup,
         args.start
     );
-    for s in &args.sets {
+    for s in &args.edits.sets {
         say!("set        {s}");
     }
     if timestamps {

@@ -2,6 +2,7 @@
 //! argument types and checks they share. Every failure is one sentence for the user; nothing
 //! here panics on bad input.
 
+use clap::Args;
 use indra::assets::Assets;
 use indra::scene::{Scene, load_scene};
 
@@ -26,6 +27,7 @@ pub use check::check;
 pub use list::{list, list_cameras, list_ndi};
 pub use render::{RenderArgs, render};
 pub use run::{RunArgs, run};
+
 pub use triangulate::{TriangulateArgs, triangulate};
 
 /// The scene `indra` opens with no arguments.
@@ -77,19 +79,34 @@ fn with_scene_folder(assets: &Assets, name: &str) -> Assets {
     }
 }
 
-/// Loads a scene and applies `--set` assignments.
-fn scene_with_sets(assets: &Assets, name: &str, sets: &[String], msaa: Option<u32>) -> Result<Scene, String> {
-    with_sets(load_scene(assets, name).map_err(|e| e.to_string())?, sets, msaa)
+/// The edits every command that plays a scene takes from the command line: `--set` and `--msaa`.
+#[derive(Args, Clone)]
+pub struct SceneEdits {
+    /// Set a parameter (repeatable): node.param=value — 0.5, true, an option name, a vector as
+    /// 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
+    #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
+    pub sets: Vec<String>,
+    /// Samples per pixel of rasterising nodes, 1, 2, 4 or 8 (default: the scene's, normally 4);
+    /// lowered to what the adapter supports.
+    #[arg(long, value_parser = parse_msaa)]
+    pub msaa: Option<u32>,
 }
 
-/// Applies `--set` assignments and `--msaa` to a loaded scene.
-fn with_sets(mut scene: Scene, sets: &[String], msaa: Option<u32>) -> Result<Scene, String> {
-    for assignment in sets {
-        scene.set_from_str(assignment)?;
+impl SceneEdits {
+    /// Applies the `--set` assignments and `--msaa` to a loaded scene.
+    fn apply(&self, mut scene: Scene) -> Result<Scene, String> {
+        for assignment in &self.sets {
+            scene.set_from_str(assignment)?;
+        }
+        if let Some(samples) = self.msaa {
+            scene.msaa = samples;
+            scene.check_texture_budget(scene.size)?;
+        }
+        Ok(scene)
     }
-    if let Some(samples) = msaa {
-        scene.msaa = samples;
-        scene.check_texture_budget(scene.size)?;
-    }
-    Ok(scene)
+}
+
+/// Loads a scene and applies the command line's edits to it.
+fn scene_with_edits(assets: &Assets, name: &str, edits: &SceneEdits) -> Result<Scene, String> {
+    edits.apply(load_scene(assets, name).map_err(|e| e.to_string())?)
 }

@@ -7,7 +7,7 @@ use indra::assets::Assets;
 use indra::gpu::{Gpu, GpuOptions};
 use indra::offscreen::{OffscreenRenderer, RenderedFrame, VideoSettings, VideoWriter, write_png};
 
-use super::{check_timing, parse_msaa, parse_size, scene_with_sets, with_scene_folder};
+use super::{SceneEdits, check_timing, parse_size, scene_with_edits, with_scene_folder};
 
 /// `indra render`.
 #[derive(Args, Clone)]
@@ -57,14 +57,8 @@ pub struct RenderArgs {
     /// the ProRes profile (0 proxy … 3 HQ, 4 4444).
     #[arg(long, requires = "video")]
     pub quality: Option<u32>,
-    /// Set a parameter (repeatable): node.param=value — 0.5, true, an option name, a vector as
-    /// 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
-    #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
-    pub sets: Vec<String>,
-    /// Samples per pixel of rasterising nodes, 1, 2, 4 or 8 (default: the scene's, normally 4);
-    /// lowered to what the adapter supports.
-    #[arg(long, value_parser = parse_msaa)]
-    pub msaa: Option<u32>,
+    #[command(flatten)]
+    pub edits: SceneEdits,
     /// Replay a control stream recorded with `run --record-controls`, frame-exactly.
     #[arg(long)]
     pub replay: Option<PathBuf>,
@@ -83,7 +77,7 @@ pub struct RenderArgs {
 pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<(), String> {
     check_timing(args.start, args.frames, args.dt)?;
     let assets = &with_scene_folder(assets, &args.scene);
-    let scene = scene_with_sets(assets, &args.scene, &args.sets, args.msaa)?;
+    let scene = scene_with_edits(assets, &args.scene, &args.edits)?;
     let mut script = match &args.replay {
         Some(path) => indra::control::record::read_replay(path, &scene)?,
         None => Default::default(),

@@ -6,7 +6,7 @@ use clap::Args;
 use indra::assets::Assets;
 use indra::gpu::GpuOptions;
 
-use super::{DEFAULT_SCENE, parse_msaa, scene_with_sets, with_scene_folder, with_sets};
+use super::{DEFAULT_SCENE, SceneEdits, scene_with_edits, with_scene_folder};
 
 /// `indra run`.
 #[derive(Args, Clone)]
@@ -20,14 +20,8 @@ pub struct RunArgs {
     /// Monitor index for fullscreen (see the log for the list).
     #[arg(long)]
     pub monitor: Option<usize>,
-    /// Set a parameter at start (repeatable): node.param=value — 0.5, true, an option name,
-    /// a vector as 1,0.3,0.1 or (1.0,0.3,0.1), one component as node.param.x=0.5.
-    #[arg(long = "set", value_name = "NODE.PARAM=VALUE")]
-    pub sets: Vec<String>,
-    /// Samples per pixel of rasterising nodes, 1, 2, 4 or 8 (default: the scene's, normally 4);
-    /// lowered to what the adapter supports.
-    #[arg(long, value_parser = parse_msaa)]
-    pub msaa: Option<u32>,
+    #[command(flatten)]
+    pub edits: SceneEdits,
     /// OSC listen address; loopback by default, 0.0.0.0:9000 opens it to the network.
     #[arg(long, default_value = DEFAULT_OSC)]
     pub osc: String,
@@ -129,41 +123,12 @@ pub struct RunArgs {
 pub const DEFAULT_OSC: &str = "127.0.0.1:9000";
 
 impl Default for RunArgs {
-    /// What `indra` with no arguments does (the same defaults as `indra run`).
+    /// What `indra` with no arguments does: `indra run`'s own defaults, read from its arguments'
+    /// declarations so that the two cannot drift apart.
     fn default() -> Self {
-        Self {
-            scene: DEFAULT_SCENE.into(),
-            fullscreen: false,
-            monitor: None,
-            sets: Vec::new(),
-            msaa: None,
-            osc: DEFAULT_OSC.into(),
-            no_osc: false,
-            osc_out: None,
-            oscquery: None,
-            web: None,
-            web_read_only: false,
-            web_token: None,
-            web_sessions: 16,
-            web_hosts: Vec::new(),
-            oscquery_cors: Vec::new(),
-            midi: None,
-            no_midi: false,
-            audio_in: None,
-            no_audio: false,
-            link: false,
-            list_audio: false,
-            output_windows: Vec::new(),
-            record_controls: None,
-            presets: None,
-            midi_learn: None,
-            audio_learn: None,
-            no_watch: false,
-            record_video: None,
-            stream: None,
-            ndi_out: None,
-            pipewire_out: None,
-        }
+        use clap::FromArgMatches;
+        let command = Self::augment_args(clap::Command::new("run"));
+        Self::from_arg_matches(&command.get_matches_from(["run"])).expect("`indra run` parses with no arguments")
     }
 }
 
@@ -180,13 +145,13 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
     let loaded = if indra::scene::names_a_show(&args.scene) {
         indra::scene::show::load_show(assets, &args.scene, true)
             .map_err(|e| e.to_string())
-            .and_then(|scene| with_sets(scene, &args.sets, args.msaa))
+            .and_then(|scene| args.edits.apply(scene))
     } else {
-        scene_with_sets(assets, &args.scene, &args.sets, args.msaa)
+        scene_with_edits(assets, &args.scene, &args.edits)
     };
     let mut scene = match loaded {
         Ok(scene) => scene,
-        Err(e) => match scene_with_sets(&assets.builtin_only(), &args.scene, &args.sets, args.msaa) {
+        Err(e) => match scene_with_edits(&assets.builtin_only(), &args.scene, &args.edits) {
             Ok(builtin) => {
                 notices.push(format!("{e}\n(running the built-in copy until the file is fixed)"));
                 builtin
@@ -270,4 +235,19 @@ fn list_audio() -> Result<(), String> {
     }
     #[cfg(not(feature = "audio"))]
     Err("this build has no live audio input (built without the `audio` feature)".into())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn indra_with_no_arguments_runs_with_the_defaults_of_indra_run() {
+        let args = RunArgs::default();
+        assert_eq!(args.scene, DEFAULT_SCENE);
+        assert_eq!(args.osc, DEFAULT_OSC);
+        assert_eq!(args.web_sessions, 16);
+        assert!(args.edits.sets.is_empty() && args.edits.msaa.is_none());
+        assert!(!args.no_osc && !args.no_midi && !args.no_watch && args.presets.is_none());
+    }
 }
