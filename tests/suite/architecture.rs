@@ -5,7 +5,8 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+/// The repository.
+pub(crate) const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 /// The binary's files and folder (its commands), which may use any layer.
 const BINARY: [&str; 3] = ["lib.rs", "main.rs", "cli"];
@@ -36,7 +37,8 @@ fn modules() -> Vec<String> {
     found
 }
 
-fn rust_files(path: &Path, out: &mut Vec<PathBuf>) {
+/// Every `.rs` file under `path`, into `out`.
+pub(crate) fn rust_files(path: &Path, out: &mut Vec<PathBuf>) {
     if path.is_dir() {
         for entry in std::fs::read_dir(path).unwrap() {
             rust_files(&entry.unwrap().path(), out);

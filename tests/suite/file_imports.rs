@@ -5,14 +5,14 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+use crate::architecture::{ROOT, rust_files};
 
 /// The module path of each library file: `src/media/clip.rs` → `media::clip`,
 /// `src/scene/mod.rs` → `scene`. The binary's files (`main.rs`, `cli/`) are not the library's.
 fn library_files() -> BTreeMap<Vec<String>, PathBuf> {
     let src = Path::new(ROOT).join("src");
     let mut files = Vec::new();
-    collect(&src, &mut files);
+    rust_files(&src, &mut files);
     let binary = [src.join("main.rs"), src.join("lib.rs"), src.join("cli")];
     files
         .into_iter()
@@ -26,16 +26,6 @@ fn library_files() -> BTreeMap<Vec<String>, PathBuf> {
             (path, f)
         })
         .collect()
-}
-
-fn collect(path: &Path, out: &mut Vec<PathBuf>) {
-    if path.is_dir() {
-        for entry in std::fs::read_dir(path).unwrap() {
-            collect(&entry.unwrap().path(), out);
-        }
-    } else if path.extension().is_some_and(|e| e == "rs") {
-        out.push(path.to_path_buf());
-    }
 }
 
 /// The paths `source` names from `crate::`, `super::` and `self::`, made absolute for a file
