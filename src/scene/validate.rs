@@ -43,6 +43,22 @@ pub(crate) fn header_problems(
     problems
 }
 
+/// One node built as a scene file's `node` would be — technique, the parameters its file
+/// declares, start values, ranges — with its errors located in `source`; its input slots are
+/// the caller's to wire (a show's effects are nodes wired by the show).
+pub(super) fn build_node(
+    (origin, source): (&str, &str),
+    assets: &Assets,
+    node: &super::schema::NodeFile,
+    anchor: &str,
+) -> Result<SceneNode, Vec<SceneError>> {
+    let mut validator = Validator::new(origin, source, assets);
+    match validator.node(node, anchor) {
+        Some(built) if validator.errors.is_empty() => Ok(built),
+        _ => Err(validator.failure().0),
+    }
+}
+
 /// A scene's OSC aliases and MIDI mappings, resolved.
 type ControlMaps = (Vec<(String, Target)>, Vec<(MidiMapping, Target)>);
 
@@ -105,6 +121,7 @@ impl<'a> Validator<'a> {
                 self.error(&[&anchor], format!("a node id of {length} characters; at most {MAX_ID_CHARS}"));
             }
             if let Some(built) = self.node(node, &anchor) {
+                self.check_wiring(node, &built, &anchor);
                 if let Some(Err(e)) = built.technique.check.map(|check| check(&built.params)) {
                     self.error(&[&anchor], format!("node '{}': {e}", node.id));
                 }
@@ -330,22 +347,26 @@ impl<'a> Validator<'a> {
                 Some(v) => d.default = v,
             }
         }
+        let params = ParamSet::new(decls);
+        Some(SceneNode { id: node.id.clone(), technique, params, inputs: Vec::new(), slots, hears_audio })
+    }
+
+    /// Checks that `node` wires exactly the input slots `built` has.
+    fn check_wiring(&mut self, node: &super::schema::NodeFile, built: &SceneNode, anchor: &str) {
         for slot in node.inputs.keys() {
-            if !slots.contains(slot) {
+            if !built.slots.contains(slot) {
                 let key = format!("\"{slot}\"");
                 self.error(
                     &[anchor, "inputs", &key],
-                    format!("technique '{}' has no input '{slot}' (inputs: {slots:?})", technique.name),
+                    format!("technique '{}' has no input '{slot}' (inputs: {:?})", built.technique.name, built.slots),
                 );
             }
         }
-        for slot in &slots {
+        for slot in &built.slots {
             if !node.inputs.contains_key(slot) {
                 self.error(&[anchor], format!("node '{}' needs its input '{slot}' wired to a node", node.id));
             }
         }
-        let params = ParamSet::new(decls);
-        Some(SceneNode { id: node.id.clone(), technique, params, inputs: Vec::new(), slots, hears_audio })
     }
 
     /// Resolves input wiring into each node's `inputs` (file indices) and returns the node

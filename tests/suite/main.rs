@@ -9,6 +9,7 @@ mod browser;
 #[path = "../common/mod.rs"]
 mod common;
 mod control;
+mod effects;
 mod errors;
 mod file_imports;
 mod flood;

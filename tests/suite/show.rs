@@ -120,12 +120,15 @@ fn each_blend_mode_matches_a_cpu_reference() {
 /// A show of one layer with `kinds` transitions (enough to build a [`Mixer`]).
 fn mixer_show(kinds: &[&str]) -> Show {
     Show {
-        layers: vec![Layer { name: "one".into(), node: 0, clips: Vec::new(), start: None }],
+        layers: vec![Layer { name: "one".into(), node: 0, clips: Vec::new(), start: None, effects: Vec::new() }],
         clips: Vec::new(),
         columns: Vec::new(),
         cues: Vec::new(),
         loop_cues: true,
         master: 1,
+        master_effects: Vec::new(),
+        effects: Vec::new(),
+        mix_kind: None,
         cue_notes: Default::default(),
         kinds: kinds.iter().map(|k| k.to_string()).collect(),
         sources: Vec::new(),

@@ -73,6 +73,9 @@ pub struct ShowFile {
     /// The master fader at start, 0 (black) to 1.
     #[serde(default = "one")]
     pub master: f32,
+    /// The master's effect chain, in order: over the composited layers, before the fader.
+    #[serde(default)]
+    pub effects: Vec<EffectFile>,
     /// Output windows of the composition (sources default to the master).
     #[serde(default)]
     pub outputs: Vec<OutputFile>,
@@ -104,6 +107,9 @@ pub struct LayerFile {
     pub start: Option<u32>,
     /// The layer's clips.
     pub clips: Vec<ClipFile>,
+    /// The layer's effect chain, in order: after its transition, before its blend.
+    #[serde(default)]
+    pub effects: Vec<EffectFile>,
 }
 
 /// A clip: a scene and how it plays.
@@ -131,6 +137,27 @@ pub struct ClipFile {
     /// The note's MIDI channel, 1–16 (default any).
     #[serde(default)]
     pub channel: Option<u8>,
+    /// The clip's effect chain, in order: over the scene's output, before the transition.
+    #[serde(default)]
+    pub effects: Vec<EffectFile>,
+}
+
+/// One effect of a chain: an image filter with a bypass switch and a dry/wet mix.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EffectFile {
+    /// An ISF filter file (`shaders/isf/Kaleidoscope.fs`, or the performer's own) or a technique
+    /// that takes one image (`star_glow`, `warp`).
+    pub effect: String,
+    /// Start values of its parameters, over their defaults.
+    #[serde(default)]
+    pub params: BTreeMap<String, RawValue>,
+    /// Dry/wet at start, 0 (the input only) to 1 (the effect only; default).
+    #[serde(default = "one")]
+    pub mix: f32,
+    /// Bypassed at start: the input passes through and the effect costs no GPU time.
+    #[serde(default)]
+    pub bypass: bool,
 }
 
 /// What a clip does while it is not shown.

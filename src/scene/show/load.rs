@@ -7,7 +7,8 @@ use std::collections::BTreeSet;
 use std::path::Path;
 use std::sync::Arc;
 
-use super::file::{ClipFile, CueFile, Hold, ShowFile, TransitionFile};
+use super::effects::chain_nodes;
+use super::file::{ClipFile, CueFile, EffectFile, Hold, ShowFile, TransitionFile};
 use super::{Clip, Cue, CueNotes, Layer, Length, MAX_CLIPS_PER_LAYER, MAX_CUES, MAX_LAYERS, Show, Transition};
 use crate::assets::{AssetKind, Assets};
 use crate::params::{ParamSet, ParamValue, Target, coerce};
@@ -50,7 +51,8 @@ const SHOW_FILE_LIMIT: u64 = 4 << 20;
 /// Parses and validates show text; `origin` names it in errors and places relative clip paths.
 pub fn parse_show(assets: &Assets, origin: &str, source: &str, lenient: bool) -> Result<Scene, SceneErrors> {
     let file: ShowFile = read_ron(origin, source)?;
-    let mut builder = Builder { assets, origin, source, errors: Vec::new(), lenient, kinds: Vec::new() };
+    let mut builder =
+        Builder { assets, origin, source, errors: Vec::new(), lenient, kinds: Vec::new(), effects: Vec::new() };
     let scene = builder.build(file);
     match scene {
         Some(scene) if builder.errors.is_empty() => Ok(scene),
@@ -65,6 +67,8 @@ struct Builder<'a> {
     errors: Vec<SceneError>,
     lenient: bool,
     kinds: Vec<String>,
+    /// Every effect node appended so far, ascending.
+    effects: Vec<usize>,
 }
 
 impl Builder<'_> {
@@ -104,7 +108,7 @@ impl Builder<'_> {
                     format!("layer {} has {} clips; at most {MAX_CLIPS_PER_LAYER}", l + 1, layer.clips.len()),
                 );
                 // The layer stays, empty, so that every later index by layer holds.
-                layers.push(Layer { name, node: usize::MAX, clips: Vec::new(), start: None });
+                layers.push(Layer { name, node: usize::MAX, clips: Vec::new(), start: None, effects: Vec::new() });
                 continue;
             }
             let layer_transition = match &layer.transition {
@@ -154,7 +158,8 @@ impl Builder<'_> {
                             node.inputs.iter_mut().for_each(|i| *i += offset);
                             nodes.push(node);
                         }
-                        Some(offset + scene.output)
+                        let chain = self.chain(&id, &clip.effects, &mut nodes, Some(offset + scene.output));
+                        Some(chain.last().copied().unwrap_or(offset + scene.output))
                     }
                     Err(message) if self.lenient => {
                         broken.push((id.clone(), message));
@@ -190,9 +195,10 @@ impl Builder<'_> {
                 None if file.cues.is_empty() && !in_layer.is_empty() => Some(0),
                 None => None,
             };
-            layers.push(Layer { name, node: usize::MAX, clips: in_layer, start });
+            layers.push(Layer { name, node: usize::MAX, clips: in_layer, start, effects: Vec::new() });
         }
-        if nodes.len() + layers.len() + 1 > MAX_NODES {
+        let chains = file.layers.iter().map(|l| l.effects.len()).sum::<usize>() + file.effects.len();
+        if nodes.len() + chains + layers.len() + 1 > MAX_NODES {
             let message = format!("the clips have {} nodes in all; a show may have at most {MAX_NODES}", nodes.len());
             self.error(&["layers"], message);
             return None;
@@ -219,6 +225,7 @@ impl Builder<'_> {
                     );
                 }
             }
+            layers[l].effects = self.chain(&format!("layer/{}", l + 1), &layer.effects, &mut nodes, None);
             layers[l].node = nodes.len();
             nodes.push(SceneNode {
                 id: format!("layer/{}", l + 1),
@@ -234,6 +241,7 @@ impl Builder<'_> {
             self.error(&["master"], format!("master {} must be 0–1", file.master));
         }
         set_start(&mut master_params, 0, Start::Value(ParamValue::Float(file.master)));
+        let master_effects = self.chain("master", &file.effects, &mut nodes, None);
         let master = nodes.len();
         nodes.push(SceneNode {
             id: "master".into(),
@@ -254,6 +262,9 @@ impl Builder<'_> {
             loop_cues: file.loop_cues,
             cue_notes: CueNotes { go: file.go_note, back: file.back_note },
             master,
+            effects: std::mem::take(&mut self.effects),
+            master_effects,
+            mix_kind: None,
             kinds: Vec::new(),
             sources,
             broken,
@@ -265,6 +276,10 @@ impl Builder<'_> {
             self.error(&["cues"], format!("{} cues; at most {MAX_CUES}", file.cues.len()));
         } else {
             show.cues = file.cues.iter().enumerate().filter_map(|(i, c)| self.cue(&show, i, c)).collect();
+        }
+        if !show.effects.is_empty() {
+            // An effect's dry/wet mix is the crossfade transition at the mix amount.
+            show.mix_kind = self.transition(&TransitionFile::default(), &["effects"]).and_then(|t| t.kind);
         }
         show.kinds = std::mem::take(&mut self.kinds);
         let own_texture_bytes = crate::scene::model::own_texture_bytes(self.assets, &nodes, file.size);
@@ -333,6 +348,25 @@ impl Builder<'_> {
             }
         }
         Ok(scene)
+    }
+
+    /// Appends the nodes of `owner`'s effect chain (see [`chain_nodes`]); returns their indices
+    /// in chain order.
+    fn chain(
+        &mut self,
+        owner: &str,
+        effects: &[EffectFile],
+        nodes: &mut Vec<SceneNode>,
+        input: Option<usize>,
+    ) -> Vec<usize> {
+        let (chain, errors) =
+            chain_nodes((self.origin, self.source), self.assets, owner, effects, (nodes.len(), input));
+        let room = MAX_REPORTED_ERRORS.saturating_sub(self.errors.len());
+        self.errors.extend(errors.into_iter().take(room));
+        let indices: Vec<usize> = (nodes.len()..nodes.len() + chain.len()).collect();
+        self.effects.extend(&indices);
+        nodes.extend(chain);
+        indices
     }
 
     /// A transition, its shader kind registered; `None` after reporting what is wrong.

@@ -82,6 +82,9 @@ pub struct Mixer {
     passes: Vec<ImagePass>,
     /// Per kind: for an ISF kind, one node per layer.
     isf: Vec<Vec<IsfTransition>>,
+    /// The kind that mixes an effect's dry and wet images, and one pass per effect.
+    mix_kind: Option<usize>,
+    fx: Vec<ImagePass>,
 }
 
 impl Mixer {
@@ -113,7 +116,12 @@ impl Mixer {
             Some(k) => show.layers.iter().map(|_| ImagePass::new(device, k)).collect(),
             None => Vec::new(),
         };
-        Ok(Self { kernels, passes, isf })
+        let mix_kind = show.mix_kind.filter(|&k| matches!(kernels.get(k), Some(Some(_))));
+        let fx = match mix_kind.and_then(|k| kernels[k].as_ref()) {
+            Some(k) => show.effects.iter().map(|_| ImagePass::new(device, k)).collect(),
+            None => Vec::new(),
+        };
+        Ok(Self { kernels, passes, isf, mix_kind, fx })
     }
 
     /// The shader files a mixer for `show` is built from (an edit of one rebuilds it).
@@ -129,6 +137,8 @@ impl Mixer {
             kernels: &self.kernels,
             passes: self.passes.iter_mut().map(Some).collect(),
             isf: self.isf.iter_mut().map(|layers| layers.iter_mut().map(Some).collect()).collect(),
+            mix: self.mix_kind.and_then(|k| self.kernels[k].as_ref()),
+            fx: self.fx.iter_mut().map(Some).collect(),
         }
     }
 }
@@ -157,6 +167,8 @@ pub struct MixerFrame<'r> {
     kernels: &'r [Option<ImageKernel>],
     passes: Vec<Option<&'r mut ImagePass>>,
     isf: Vec<Vec<Option<&'r mut IsfTransition>>>,
+    mix: Option<&'r ImageKernel>,
+    fx: Vec<Option<&'r mut ImagePass>>,
 }
 
 impl<'r> MixerFrame<'r> {
@@ -190,6 +202,29 @@ impl<'r> MixerFrame<'r> {
             pad2: [0.0; 2],
         };
         pass.declare(graph, "show/transition", kernel, uniforms, &[from, to])
+    }
+
+    /// Declares effect `slot`'s (see [`Show::effect_slot`]) dry/wet mix: `amount` of the way from
+    /// `dry` to `wet` in linear light (`wet` if the pass was used this frame).
+    pub fn mix(
+        &mut self,
+        graph: &mut FrameGraph<'r>,
+        slot: usize,
+        dry: TextureHandle,
+        wet: TextureHandle,
+        amount: f32,
+    ) -> TextureHandle {
+        let (Some(kernel), Some(pass)) = (self.mix, self.fx.get_mut(slot).and_then(Option::take)) else { return wet };
+        let (w, h) = graph.output_size();
+        let uniforms = TransitionUniforms {
+            progress: amount,
+            seconds: 0.0,
+            aspect: w as f32 / h.max(1) as f32,
+            pad: 0.0,
+            size: [w as f32, h as f32],
+            pad2: [0.0; 2],
+        };
+        pass.declare(graph, "show/fx_mix", kernel, uniforms, &[dry, wet])
     }
 }
 

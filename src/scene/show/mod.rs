@@ -6,6 +6,7 @@
 //! clip each layer plays, running transitions, pending quantized triggers, the cue), the
 //! transition passes ([`Mixer`]) and the fresh copies of restarting clips ([`Spares`]).
 
+pub mod effects;
 mod file;
 mod load;
 mod mixer;
@@ -13,7 +14,9 @@ mod runtime;
 mod spares;
 mod state;
 
-pub use file::{ClipFile, ClipPolicy, CueFile, Hold, LayerFile, Quantize, ShowFile, TransitionFile, is_show};
+pub use file::{
+    ClipFile, ClipPolicy, CueFile, EffectFile, Hold, LayerFile, Quantize, ShowFile, TransitionFile, is_show,
+};
 pub use load::{load_show, parse_show};
 pub use mixer::{Mixer, MixerFrame, TRANSITION_BASE, TransitionUniforms, transition_file};
 pub use runtime::ShowRuntime;
@@ -46,6 +49,14 @@ pub struct Show {
     pub cue_notes: CueNotes,
     /// Index of the master fader node.
     pub master: usize,
+    /// The master's effect nodes, in chain order (before the fader).
+    pub master_effects: Vec<usize>,
+    /// Every effect node (clips', layers' and the master's), ascending: the position of a node
+    /// here is its dry/wet pass.
+    pub effects: Vec<usize>,
+    /// The transition kind that mixes an effect's dry and wet images (the crossfade, in linear
+    /// light), when the show has effects.
+    pub mix_kind: Option<usize>,
     /// Transition shader kinds in use (`crossfade` → `transition_crossfade.wgsl`), by index.
     pub kinds: Vec<String>,
     /// Every file the show was built from (the show file and its clips' scenes), for reload.
@@ -74,6 +85,8 @@ pub struct Layer {
     pub clips: Vec<usize>,
     /// The clip within the layer playing at start.
     pub start: Option<usize>,
+    /// Its effect nodes, in chain order (after the transition, before the blend).
+    pub effects: Vec<usize>,
 }
 
 /// One clip: a scene's nodes in the flat scene.
@@ -136,6 +149,16 @@ impl Show {
     /// The clip node `node` belongs to, if any.
     pub fn clip_of(&self, node: usize) -> Option<usize> {
         self.clips.iter().position(|c| c.nodes.contains(&node))
+    }
+
+    /// Effect node `node`'s place among [`Show::effects`] (its dry/wet pass), if it is one.
+    pub fn effect_slot(&self, node: usize) -> Option<usize> {
+        self.effects.binary_search(&node).ok()
+    }
+
+    /// Whether `node` is an effect of a layer's or the master's chain (drawn with its owner).
+    pub fn is_chain_effect(&self, node: usize) -> bool {
+        self.master_effects.contains(&node) || self.layers.iter().any(|l| l.effects.contains(&node))
     }
 
     /// The layer whose `blend` node is `node`, if any.

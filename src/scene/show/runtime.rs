@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use super::spares::{Build, Finished};
 use super::state::Clock;
-use super::{ClipPolicy, Mixer, Show, ShowState, Spares};
+use super::{ClipPolicy, Mixer, MixerFrame, Show, ShowState, Spares, effects};
 use crate::assets::Assets;
 use crate::gpu::{Gpu, ShaderError};
 use crate::graph::{FrameGraph, GraphError, GraphRuntime, PersistentTexture, TextureHandle};
@@ -243,8 +243,9 @@ impl ShowRuntime {
         clip_build(&self.plan, &self.gpu, &self.assets, self.output_size, clip, scene, params)
     }
 
-    /// Declares this frame of the show: every running clip's passes, each layer's transition and
-    /// blend, the master. Returns each node's image (a hidden clip's: none).
+    /// Declares this frame of the show: every running clip's passes (and its effects), each
+    /// layer's transition, effects and blend, the master's effects and fader. Returns each node's
+    /// image (a hidden clip's: none).
     pub fn declare<'r>(
         &'r mut self,
         graph: &mut FrameGraph<'r>,
@@ -257,36 +258,90 @@ impl ShowRuntime {
         let black = graph.import_texture("show/black", &self.black);
         let mut below = black;
         let Self { plan, state, mixer, node_clip, .. } = self;
-        let mut mixer = mixer.frame();
-        for (i, node) in nodes.iter_mut().enumerate() {
-            let image_of = |clip: Option<usize>, outputs: &[Option<TextureHandle>]| {
-                clip.and_then(|c| plan.clips[c].output).and_then(|n| outputs[n])
-            };
+        // Nodes are lent out one at a time: a layer's effects are drawn when its blend is.
+        let mut lent = Lent { plan, mixer: mixer.frame(), slots: nodes.iter_mut().map(Some).collect() };
+        for i in 0..outputs.len() {
+            if plan.is_chain_effect(i) {
+                continue;
+            }
+            let Some(node) = lent.slots[i].take() else { continue };
             outputs[i] = if let Some(l) = plan.layer_of_node(i) {
+                let image_of = |clip: Option<usize>, outputs: &[Option<TextureHandle>]| {
+                    clip.and_then(|c| plan.clips[c].output).and_then(|n| outputs[n])
+                };
                 let view = state.view(l);
                 let to = image_of(view.to, &outputs);
                 let image = if view.fading() {
                     let from = image_of(view.from, &outputs).unwrap_or(black);
-                    Some(mixer.declare(graph, l, &view, from, to.unwrap_or(black)))
+                    Some(lent.mixer.declare(graph, l, &view, from, to.unwrap_or(black)))
                 } else {
                     to
                 };
                 // An empty layer leaves the image below as it is.
                 if let Some(image) = image {
+                    let image = lent.chain(graph, &plan.layers[l].effects, image, (params, time), &mut outputs);
                     below = node.add_passes(graph, &params[i], time, &[below, image]);
                 }
                 Some(below)
             } else if i == plan.master {
-                Some(node.add_passes(graph, &params[i], time, &[below]))
+                let image = lent.chain(graph, &plan.master_effects, below, (params, time), &mut outputs);
+                Some(node.add_passes(graph, &params[i], time, &[image]))
             } else {
                 clip_time(plan, state, node_clip[i], time).map(|t| {
                     let inputs: Vec<TextureHandle> =
                         scene.nodes[i].inputs.iter().map(|&j| outputs[j].unwrap_or(black)).collect();
-                    node.add_passes(graph, &params[i], &t, &inputs)
+                    match inputs.first() {
+                        Some(&dry) if plan.effect_slot(i).is_some() => {
+                            lent.effect(node, graph, (&params[i], &t), dry, i)
+                        }
+                        _ => node.add_passes(graph, &params[i], &t, &inputs),
+                    }
                 })
             };
         }
         outputs
+    }
+}
+
+/// One frame's declaration: the nodes and the mixer's passes, each lent out once.
+struct Lent<'a, 'r> {
+    plan: &'a Show,
+    mixer: MixerFrame<'r>,
+    slots: Vec<Option<&'r mut Box<dyn Technique>>>,
+}
+
+impl<'r> Lent<'_, 'r> {
+    /// Declares the effects `chain` (node indices, in order) over `image`; returns the result.
+    fn chain(
+        &mut self,
+        graph: &mut FrameGraph<'r>,
+        chain: &[usize],
+        mut image: TextureHandle,
+        (params, time): (&[ParamSet], &FrameTime),
+        outputs: &mut [Option<TextureHandle>],
+    ) -> TextureHandle {
+        for &e in chain {
+            let Some(node) = self.slots.get_mut(e).and_then(Option::take) else { continue };
+            image = self.effect(node, graph, (&params[e], time), image, e);
+            outputs[e] = Some(image);
+        }
+        image
+    }
+
+    /// Declares effect node `index` over `dry`, with its bypass and dry/wet mix.
+    fn effect(
+        &mut self,
+        node: &'r mut Box<dyn Technique>,
+        graph: &mut FrameGraph<'r>,
+        (params, time): (&ParamSet, &FrameTime),
+        dry: TextureHandle,
+        index: usize,
+    ) -> TextureHandle {
+        let slot = self.plan.effect_slot(index).unwrap_or(usize::MAX);
+        let mixer = &mut self.mixer;
+        effects::declare(node, graph, params, time, dry, |graph, dry, wet, amount| {
+            mixer.mix(graph, slot, dry, wet, amount)
+        })
     }
 }
 

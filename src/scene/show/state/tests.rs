@@ -13,8 +13,8 @@ fn fade(seconds: f64, quantize: Quantize) -> Transition {
 fn show(transition: Transition, cues: Vec<Cue>) -> Show {
     Show {
         layers: vec![
-            Layer { name: "one".into(), node: 3, clips: vec![0, 1], start: Some(0) },
-            Layer { name: "two".into(), node: 4, clips: vec![2], start: None },
+            Layer { name: "one".into(), node: 3, clips: vec![0, 1], start: Some(0), effects: Vec::new() },
+            Layer { name: "two".into(), node: 4, clips: vec![2], start: None, effects: Vec::new() },
         ],
         clips: vec![
             clip("a", 0, ClipPolicy::Restart, transition),
@@ -26,6 +26,9 @@ fn show(transition: Transition, cues: Vec<Cue>) -> Show {
         loop_cues: true,
         cue_notes: Default::default(),
         master: 5,
+        master_effects: Vec::new(),
+        effects: Vec::new(),
+        mix_kind: None,
         kinds: vec!["crossfade".into()],
         sources: Vec::new(),
         broken: Vec::new(),

@@ -1,0 +1,217 @@
+//! Effect chains on a show's clips, layers and master: a layer's effect against the same ISF
+//! filter as a node of a scene; bypass and a dry mix byte for byte the image without the effect;
+//! dry/wet at one half the linear mix; two effects that do not commute, in both orders; the
+//! chain's parameters at their addresses and written live; seek = play; a golden of a two-effect
+//! chain; located errors for effects a show cannot play.
+
+use crate::common::{self, assets, golden, gpu};
+use indra::control::address::{AddressMap, Route};
+use indra::offscreen::OffscreenRenderer;
+use indra::params::{ControlEvent, ParamValue, ParamWrite, ShowCommand, Source};
+use indra::scene::show::parse_show;
+use indra::scene::{Scene, parse_scene_with};
+use indra::techniques::srgb_to_linear;
+
+const SIZE: (u32, u32) = (64, 36);
+
+fn show_from(text: &str) -> Scene {
+    parse_show(&assets(), "effects-show.ron", text, false).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A one-layer show of the classic limit set with `chains` spliced in: the clip's, the layer's
+/// and the master's effect lists (RON, empty for none).
+fn limit_set_show(clip: &str, layer: &str, master: &str) -> String {
+    format!(
+        r#"(
+    name: "effects",
+    size: (64, 36),
+    seed: 1,
+    layers: [(clips: [(scene: "kleinian_classic", effects: [{clip}])], effects: [{layer}])],
+    effects: [{master}],
+)"#
+    )
+}
+
+fn frame_of(text: &str, frame: u64) -> Vec<u8> {
+    common::render_scene(show_from(text), SIZE, frame).rgba
+}
+
+const KALEIDOSCOPE: &str = r#"(effect: "shaders/isf/Kaleidoscope.fs", params: { "sides": 5.0, "angle": 0.3 })"#;
+const DIAGONALIZE: &str = r#"(effect: "shaders/isf/Diagonalize.fs", params: { "width": 0.2 })"#;
+
+fn max_difference(a: &[u8], b: &[u8]) -> u8 {
+    a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0)
+}
+
+#[test]
+fn a_layer_effect_is_the_filter_applied_to_the_layer_alone() {
+    let show = frame_of(&limit_set_show("", KALEIDOSCOPE, ""), 0);
+    // The same filter as a node of a scene, over the same limit set.
+    let scene = r#"(
+        name: "alone", size: (64, 36), seed: 1,
+        nodes: [
+            (id: "limit_set", technique: "kleinian",
+             params: { "t": (2.0, 0.0), "iterations": 200, "scale": 2.4, "offset": (-2.0, -0.2), "samples": 4 }),
+            (id: "fx", technique: "isf",
+             params: { "file": "shaders/isf/Kaleidoscope.fs", "sides": 5.0, "angle": 0.3 },
+             inputs: { "inputImage": "limit_set" }),
+        ],
+        output: "fx",
+    )"#;
+    let alone = common::render_scene(parse_scene_with(&assets(), "alone.ron", scene).unwrap(), SIZE, 0).rgba;
+    let plain = frame_of(&limit_set_show("", "", ""), 0);
+    assert!(max_difference(&alone, &plain) > 32, "the filter changes nothing: the test would prove nothing");
+    assert_eq!(max_difference(&show, &alone), 0, "the layer's effect differs from the filter as a node");
+    // On one opaque layer, the clip's chain and the master's give the same picture.
+    assert!(frame_of(&limit_set_show(KALEIDOSCOPE, "", ""), 0) == show, "the clip's chain differs");
+    assert!(frame_of(&limit_set_show("", "", KALEIDOSCOPE), 0) == show, "the master's chain differs");
+}
+
+#[test]
+fn a_bypassed_or_dry_effect_gives_the_image_without_it_byte_for_byte() {
+    let plain = frame_of(&limit_set_show("", "", ""), 0);
+    let bypassed = KALEIDOSCOPE.replace("(effect:", "(bypass: true, effect:");
+    let dry = KALEIDOSCOPE.replace("(effect:", "(mix: 0.0, effect:");
+    for chain in [&bypassed, &dry] {
+        assert!(frame_of(&limit_set_show(chain, chain, chain), 0) == plain, "{chain} changed the image");
+    }
+}
+
+#[test]
+fn dry_wet_at_one_half_is_the_linear_mix_of_dry_and_wet() {
+    let dry = frame_of(&limit_set_show("", "", ""), 0);
+    let wet = frame_of(&limit_set_show("", KALEIDOSCOPE, ""), 0);
+    let half = frame_of(&limit_set_show("", &KALEIDOSCOPE.replace("(effect:", "(mix: 0.5, effect:"), ""), 0);
+    let lin = |b: u8| srgb_to_linear(f32::from(b) / 255.0);
+    let mut worst = 0.0f32;
+    for i in (0..dry.len()).filter(|i| i % 4 != 3) {
+        worst = worst.max((lin(half[i]) - 0.5 * (lin(dry[i]) + lin(wet[i]))).abs());
+    }
+    // 8-bit sRGB steps are up to ~0.01 in linear light near white.
+    assert!(worst < 0.02, "the half mix differs from the linear mix by up to {worst}");
+}
+
+#[test]
+fn two_effects_that_do_not_commute_give_two_images_in_their_two_orders() {
+    let forward = frame_of(&limit_set_show("", &format!("{KALEIDOSCOPE}, {DIAGONALIZE}"), ""), 0);
+    let backward = frame_of(&limit_set_show("", &format!("{DIAGONALIZE}, {KALEIDOSCOPE}"), ""), 0);
+    assert!(max_difference(&forward, &backward) > 32, "the order of the chain does not matter");
+    let again = frame_of(&limit_set_show("", &format!("{KALEIDOSCOPE}, {DIAGONALIZE}"), ""), 0);
+    assert!(again == forward, "the same chain gave another image");
+}
+
+/// A write from a live source to parameter `name` of node `node`.
+fn write(scene: &Scene, node: &str, name: &str, value: ParamValue) -> ControlEvent {
+    let n = scene.node_index(node).unwrap_or_else(|| panic!("no node {node}"));
+    let param = scene.nodes[n].params.index(name).unwrap_or_else(|| panic!("{node} has no {name}"));
+    ControlEvent::Write(ParamWrite { node: n, param, component: None, value, source: Source::Osc })
+}
+
+#[test]
+fn the_chains_parameters_have_addresses_and_take_live_writes() {
+    let text = limit_set_show(DIAGONALIZE, KALEIDOSCOPE, DIAGONALIZE);
+    let scene = show_from(&text);
+    let map = AddressMap::new(&scene);
+    for address in [
+        "/indra/layer/1/fx/1/sides",
+        "/indra/layer/1/fx/1/bypass",
+        "/indra/layer/1/fx/1/mix",
+        "/indra/master/fx/1/width",
+        "/indra/kleinian_classic/fx/1/mix",
+    ] {
+        assert!(matches!(map.route(address), Some(Route::Param(_))), "no parameter at {address}");
+    }
+    // Bypassing every effect live, then the layer's mix to 0.5: the same frames as the file's.
+    let mut r = OffscreenRenderer::new(gpu(), &assets(), scene.clone(), Some(SIZE), None, None).unwrap();
+    let off = ParamValue::Bool(true);
+    let writes =
+        ["kleinian_classic/fx/1", "layer/1/fx/1", "master/fx/1"].map(|node| write(&scene, node, "bypass", off));
+    r.schedule(2, writes.to_vec());
+    r.schedule(4, vec![write(&scene, "layer/1/fx/1", "bypass", ParamValue::Bool(false))]);
+    let frames: Vec<Vec<u8>> = (0..5).map(|_| r.render_next().unwrap().rgba).collect();
+    assert!(frames[0] != frames[2], "bypassing changed nothing");
+    assert!(frames[2] == frame_of(&limit_set_show("", "", ""), 2), "bypassed live is not the plain image");
+    assert!(frames[4] == frame_of(&limit_set_show("", KALEIDOSCOPE, ""), 4), "the layer's effect did not come back");
+}
+
+#[test]
+fn a_show_with_effects_renders_frame_n_the_same_played_or_sought() {
+    // A moving effect (the pulse runs on the clock) on a clip that restarts, over a layer change.
+    let pulse = r#"(effect: "shaders/isf/Shockwave Pulse.fs", mix: 0.7)"#;
+    let text = format!(
+        r#"(
+    name: "moving effects", size: (48, 32), seed: 3,
+    transition: (kind: "crossfade", seconds: 0.1),
+    layers: [(clips: [(scene: "kleinian_classic", effects: [{pulse}]), (scene: "star_glow", effects: [{DIAGONALIZE}])],
+              effects: [{KALEIDOSCOPE}])],
+    effects: [(effect: "star_glow", mix: 0.5)],
+)"#
+    );
+    let scene = show_from(&text);
+    let scripted = || {
+        let mut r = OffscreenRenderer::new(gpu(), &assets(), scene.clone(), Some((48, 32)), None, None).unwrap();
+        r.schedule(3, vec![ControlEvent::Show(ShowCommand::Trigger { layer: 0, clip: Some(1) })]);
+        r.schedule(9, vec![ControlEvent::Show(ShowCommand::Trigger { layer: 0, clip: Some(0) })]);
+        r.schedule(11, vec![write(&scene, "layer/1/fx/1", "mix", ParamValue::Float(0.25))]);
+        r
+    };
+    let mut played = scripted();
+    let played: Vec<Vec<u8>> = (0..16).map(|_| played.render_next().unwrap().rgba).collect();
+    assert!(played[1] != played[2], "nothing moves: the comparison proves nothing");
+    for start in [5, 10, 12] {
+        let mut sought = scripted();
+        sought.seek(start).unwrap();
+        for frame in start..16 {
+            assert!(sought.render_next().unwrap().rgba == played[frame as usize], "frame {frame} from {start} differs");
+        }
+    }
+}
+
+#[test]
+fn golden_a_two_effect_chain() {
+    // The limit set through a kaleidoscope, then diagonal stripes mixed in at 0.6.
+    let chain = format!("{KALEIDOSCOPE}, {}", DIAGONALIZE.replace("(effect:", "(mix: 0.6, effect:"));
+    let text = limit_set_show("", &chain, "").replace("(64, 36)", "(160, 90)");
+    let frame = common::render_scene(show_from(&text), (160, 90), 0);
+    golden(0.01, 0.3).check("show_two_effect_chain", frame.size, &frame.rgba).unwrap_or_else(|e| panic!("{e}"));
+}
+
+#[test]
+fn effects_a_show_cannot_play_are_located_errors() {
+    let cases = [
+        (r#"(effect: "shaders/isf/Mosaic.fs")"#, "takes 2 images"),
+        (r#"(effect: "kleinian")"#, "takes 0 images"),
+        (r#"(effect: "no_such_thing")"#, "not an ISF filter file"),
+        (r#"(effect: "shaders/isf/Nope.fs")"#, "Nope.fs"),
+        (r#"(effect: "star_glow", mix: 1.5)"#, "mix 1.5 must be 0–1"),
+        (r#"(effect: "star_glow", params: { "glare": 1.0 })"#, "glare"),
+    ];
+    for (effect, expected) in cases {
+        let text = limit_set_show("", effect, "");
+        let e = parse_show(&assets(), "bad.ron", &text, false).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains(expected) && e.contains("bad.ron:5:"), "{effect}: expected '{expected}', got: {e}");
+    }
+    let many = vec![DIAGONALIZE; 17].join(", ");
+    let e = parse_show(&assets(), "bad.ron", &limit_set_show("", "", &many), false).err().unwrap().to_string();
+    assert!(e.contains("a chain has at most 16"), "{e}");
+}
+
+#[test]
+fn every_bundled_isf_filter_and_image_technique_is_an_effect() {
+    let assets = assets();
+    let mut filters = 0;
+    for file in indra::techniques::isf::shader_names(&assets) {
+        let effect = format!(r#"(effect: "{file}")"#);
+        match parse_show(&assets, "all.ron", &limit_set_show("", &effect, ""), false) {
+            Ok(_) => filters += 1,
+            // Generators and transitions are not filters; nothing else may be refused.
+            Err(e) => assert!(e.to_string().contains("images"), "{file}: {e}"),
+        }
+    }
+    assert_eq!(filters, 43, "bundled ISF filters accepted as effects");
+    for technique in ["star_glow", "warp", "tessellation", "fader"] {
+        let effect = format!(r#"(effect: "{technique}")"#);
+        parse_show(&assets, "all.ron", &limit_set_show("", &effect, ""), false)
+            .unwrap_or_else(|e| panic!("{technique}: {e}"));
+    }
+}
