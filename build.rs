@@ -57,8 +57,13 @@ fn main() {
         ("SHOWS", "`shows/*.ron`", files(manifest, "shows", "ron")),
         (
             "ISF",
-            "`shaders/isf/*.fs` and `*.vs`",
-            [files(manifest, "shaders/isf", "fs"), files(manifest, "shaders/isf", "vs")].concat(),
+            "`shaders/isf/*.fs` and `*.vs`, and `shaders/gl-transitions/*.glsl`",
+            [
+                files(manifest, "shaders/isf", "fs"),
+                files(manifest, "shaders/isf", "vs"),
+                files(manifest, "shaders/gl-transitions", "glsl"),
+            ]
+            .concat(),
         ),
     ] {
         code.push_str(&format!("/// Every {what} at build time: (file name, path in the source tree, contents).\n"));

@@ -21,7 +21,7 @@ pub fn check(assets: &Assets, files: &[PathBuf]) -> Result<(), String> {
     } else {
         for f in files {
             let name = f.display().to_string();
-            if f.extension().is_some_and(|e| e == "fs") {
+            if f.extension().is_some_and(|e| e == "fs" || e == "glsl") {
                 isf_files.push(name);
                 continue;
             }

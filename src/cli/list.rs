@@ -35,7 +35,10 @@ pub fn list(assets: &Assets) -> Result<(), String> {
             }
         }
     }
-    say!("ISF shaders (technique \"isf\", params: {{ \"file\": PATH }}; each parameter at /indra/<node>/<name>):");
+    say!(
+        "ISF shaders and gl-transitions (technique \"isf\", params: {{ \"file\": PATH }}, or a show's transition \
+         kind or effect; each parameter at /indra/<node>/<name>):"
+    );
     for name in indra::techniques::isf::shader_names(assets) {
         match indra::techniques::isf::describe(assets, &name) {
             Ok(line) => say!("  {name} — {line}"),
@@ -53,6 +56,12 @@ fn list_show(show: &indra::scene::show::Show) {
             let clip = &show.clips[clip];
             say!("    clip {} {} ({}): /indra/layer/{}/clip/{}/connect", c + 1, clip.id, clip.scene, l + 1, c + 1);
         }
+        for (k, _) in layer.effects.iter().enumerate() {
+            say!("    effect {}: /indra/layer/{}/fx/{}/<param>, …/bypass, …/mix", k + 1, l + 1, k + 1);
+        }
+    }
+    for (k, _) in show.master_effects.iter().enumerate() {
+        say!("  master effect {}: /indra/master/fx/{}/<param>, …/bypass, …/mix", k + 1, k + 1);
     }
     for (i, cue) in show.cues.iter().enumerate() {
         say!("  cue {} {}", i + 1, cue.name);

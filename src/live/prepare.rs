@@ -46,7 +46,7 @@ impl Job {
         match self.path.extension().and_then(|e| e.to_str()) {
             Some("wgsl") => self.shader(),
             Some("ron") => self.scene(),
-            Some("fs" | "vs") => self.declared(),
+            Some("fs" | "vs" | "glsl") => self.declared(),
             _ => Ok(Prepared::Unused),
         }
     }

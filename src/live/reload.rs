@@ -354,7 +354,7 @@ fn pin_declared_files(assets: Assets, dirs: &[PathBuf]) -> Assets {
     for dir in dirs {
         let Ok(entries) = std::fs::read_dir(dir) else { continue };
         for path in entries.flatten().map(|e| e.path()) {
-            if !path.extension().is_some_and(|e| e == "fs" || e == "vs") {
+            if !path.extension().is_some_and(|e| e == "fs" || e == "vs" || e == "glsl") {
                 continue;
             }
             let Ok(real) = path.canonicalize() else { continue };

@@ -51,7 +51,7 @@ impl Watcher {
 }
 
 fn is_asset(path: &Path) -> bool {
-    path.extension().is_some_and(|e| e == "wgsl" || e == "ron" || e == "fs" || e == "vs")
+    path.extension().is_some_and(|e| e == "wgsl" || e == "ron" || e == "fs" || e == "vs" || e == "glsl")
 }
 
 /// Reads a file until two reads 10 ms apart agree (an editor may still be writing it).

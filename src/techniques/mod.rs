@@ -101,9 +101,9 @@ pub struct TechniqueInfo {
 pub struct Declarer {
     /// The text parameter naming the file.
     pub file_param: &'static str,
-    /// The extension of such files (`fs`): a file of it named on the command line plays as a
-    /// scene of its own, and names a show transition.
-    pub extension: &'static str,
+    /// The extensions of such files (`fs`, `glsl`): a file of one named on the command line
+    /// plays as a scene of its own, and names a show transition.
+    pub extensions: &'static [&'static str],
     /// Reads the file a node names: its parameters and input slots, or one located sentence.
     pub declare: fn(&Assets, &str) -> Result<Declared, String>,
     /// The scene text that plays such a file on its own (inputs wired to default sources).
@@ -117,7 +117,7 @@ pub struct Declarer {
 /// The technique that plays files like `path` (by extension; see [`Declarer`]).
 pub fn file_technique(path: &str) -> Option<(&'static TechniqueInfo, Declarer)> {
     let ext = std::path::Path::new(path).extension()?.to_str()?;
-    REGISTRY.iter().find_map(|t| t.declare.filter(|d| d.extension == ext).map(|d| (t, d)))
+    REGISTRY.iter().find_map(|t| t.declare.filter(|d| d.extensions.contains(&ext)).map(|d| (t, d)))
 }
 
 /// What a file declares for a node (see [`Declarer`]).

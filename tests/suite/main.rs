@@ -13,6 +13,7 @@ mod effects;
 mod errors;
 mod file_imports;
 mod flood;
+mod gl_transitions;
 mod graph_gpu;
 mod live;
 #[path = "../support/live_show.rs"]

@@ -17,7 +17,7 @@ use indra::scene::{Scene, load_scene};
 use indra::techniques::{NodeSetup, blend, srgb_to_linear};
 use indra::time::FrameTime;
 
-const SIZE: (u32, u32) = (32, 16);
+pub(crate) const SIZE: (u32, u32) = (32, 16);
 
 /// Texels with every kind of value a node gives: dark, mid, bright, HDR above 1, and (in `over`)
 /// alpha from transparent to opaque.
@@ -118,7 +118,7 @@ fn each_blend_mode_matches_a_cpu_reference() {
 }
 
 /// A show of one layer with `kinds` transitions (enough to build a [`Mixer`]).
-fn mixer_show(kinds: &[&str]) -> Show {
+pub(crate) fn mixer_show(kinds: &[&str]) -> Show {
     Show {
         layers: vec![Layer { name: "one".into(), node: 0, clips: Vec::new(), start: None, effects: Vec::new() }],
         clips: Vec::new(),
@@ -136,7 +136,14 @@ fn mixer_show(kinds: &[&str]) -> Show {
     }
 }
 
-fn mix(gpu: &Gpu, mixer: &mut Mixer, kind: usize, progress: f32, a: &[[f32; 4]], b: &[[f32; 4]]) -> Vec<[f32; 4]> {
+pub(crate) fn mix(
+    gpu: &Gpu,
+    mixer: &mut Mixer,
+    kind: usize,
+    progress: f32,
+    a: &[[f32; 4]],
+    b: &[[f32; 4]],
+) -> Vec<[f32; 4]> {
     let view = LayerView { from: Some(0), to: Some(1), progress, kind: Some(kind), seconds: 0.0 };
     let (ta, tb) = (common::float_texture(gpu, SIZE, a), common::float_texture(gpu, SIZE, b));
     let mut graph = FrameGraph::new(SIZE);

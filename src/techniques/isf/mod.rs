@@ -17,6 +17,7 @@
 
 pub mod compile;
 pub mod expr;
+pub mod gl_transition;
 pub mod header;
 mod node;
 mod pipeline;
@@ -47,7 +48,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     stage: None,
     declare: Some(Declarer {
         file_param: "file",
-        extension: "fs",
+        extensions: &["fs", gl_transition::EXTENSION],
         declare,
         scene_for,
         texture_bytes: targets::declared_bytes,
@@ -77,6 +78,8 @@ pub struct IsfFiles {
     pub vs: Option<(String, String)>,
     /// The `.fs` on disk (`None`: the built-in copy), for IMPORTED files beside it.
     pub path: Option<std::path::PathBuf>,
+    /// Whether the file is a gl-transition, translated to ISF (its errors' lines are moved back).
+    pub gl_transition: bool,
 }
 
 impl IsfFiles {
@@ -99,19 +102,28 @@ impl IsfFiles {
         let fs = read(file).map_err(|e| e.to_string())?;
         let path = fs.path.clone();
         let fs = (fs.origin.clone(), text(fs.bytes.into_owned(), &fs.origin)?);
+        if gl_transition::is_gl_transition(file) {
+            let isf = gl_transition::to_isf(&fs.1).map_err(|(line, e)| format!("{}:{line}: {e}", fs.0))?;
+            return Ok(Self { fs: (fs.0, isf), vs: None, path, gl_transition: true });
+        }
         let vs_name = format!("{}.vs", file.strip_suffix(".fs").unwrap_or(file));
         let vs = match read(&vs_name) {
             Ok(vs) => Some((vs.origin.clone(), text(vs.bytes.into_owned(), &vs.origin)?)),
             Err(FileError::NotFound(_)) => None,
             Err(e) => return Err(e.to_string()),
         };
-        Ok(Self { fs, vs, path })
+        Ok(Self { fs, vs, path, gl_transition: false })
     }
 
     /// Parses, translates and validates the shader.
     pub fn compile(&self) -> Result<compile::Compiled, crate::gpu::ShaderError> {
         let vs = self.vs.as_ref().map(|(o, t)| (o.as_str(), t.as_str()));
-        compile::compile(&compile::Sources { fs: (&self.fs.0, &self.fs.1), vs })
+        compile::compile(&compile::Sources { fs: (&self.fs.0, &self.fs.1), vs }).map_err(|mut e| {
+            if self.gl_transition {
+                e.line = e.line.saturating_sub(gl_transition::GL_LINE_OFFSET).max(1);
+            }
+            e
+        })
     }
 }
 
@@ -173,16 +185,19 @@ pub fn scene_for(assets: &Assets, file: &str) -> Result<String, crate::gpu::Shad
     ))
 }
 
-/// The ISF shaders there are: those in `shaders/isf/` on disk and the built-in ones, as the
-/// paths scenes name them by, sorted.
+/// The ISF shaders and gl-transitions there are: those in `shaders/isf/` and
+/// `shaders/gl-transitions/` on disk and the built-in ones, as the paths scenes and shows name
+/// them by, sorted.
 pub fn shader_names(assets: &Assets) -> Vec<String> {
-    let mut names: Vec<String> =
-        crate::assets::bundled_isf().map(|(p, _)| p.to_string()).filter(|p| p.ends_with(".fs")).collect();
-    if let Some(Ok(entries)) = assets.root().map(|r| std::fs::read_dir(r.join("shaders/isf"))) {
-        for entry in entries.flatten() {
-            let name = entry.file_name().to_string_lossy().into_owned();
-            if name.ends_with(".fs") {
-                names.push(format!("shaders/isf/{name}"));
+    let ours = |name: &str| name.ends_with(".fs") || gl_transition::is_gl_transition(name);
+    let mut names: Vec<String> = crate::assets::bundled_isf().map(|(p, _)| p.to_string()).filter(|p| ours(p)).collect();
+    for dir in ["shaders/isf", "shaders/gl-transitions"] {
+        if let Some(Ok(entries)) = assets.root().map(|r| std::fs::read_dir(r.join(dir))) {
+            for entry in entries.flatten() {
+                let name = entry.file_name().to_string_lossy().into_owned();
+                if ours(&name) {
+                    names.push(format!("{dir}/{name}"));
+                }
             }
         }
     }
