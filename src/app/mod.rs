@@ -3,6 +3,8 @@
 //! errors. F11 toggles fullscreen, Esc leaves it (never the show), F1 hides the panel, F2 gives
 //! taken-over parameters back to their tracks, 1–9 recall presets.
 
+mod chain_edits;
+mod effects_panel;
 mod input;
 mod outputs;
 mod panel;

@@ -35,6 +35,8 @@ pub(super) struct Running {
     pub(super) overlay: Overlay,
     pub(super) hub: ControlHub,
     pub(super) live: Option<LiveReload>,
+    /// Effect chain edits built ahead.
+    pub(super) chain_edits: super::chain_edits::ChainEdits,
     /// Panel events of the last frame, applied before the next step.
     pub(super) ui_events: Vec<crate::scene::ControlEvent>,
     /// Last cursor position over the window, in physical pixels.
@@ -127,6 +129,7 @@ impl Running {
         self.reload();
         let mut events = std::mem::take(&mut self.ui_events);
         events.extend(self.hub.poll(self.player.instance().view(), self.player.last_step().seconds));
+        self.edit_chains(&mut events);
         self.hub.record(self.player.now().frame, &events, self.player.instance().scene());
         self.player.apply(&events);
         self.act_on_record_requests();
@@ -404,6 +407,28 @@ impl Running {
     }
 
     /// Applies edited shader and scene files; errors go to the overlay, once each.
+    /// Queues the chain edits among `events` to be built ahead, and applies one whose build is
+    /// ready: recorded, applied, and everything holding parameter positions moved (`events`, the
+    /// control maps).
+    fn edit_chains(&mut self, events: &mut Vec<crate::scene::ControlEvent>) {
+        for message in self.chain_edits.take_from(events) {
+            self.overlay.report(message);
+        }
+        match self.chain_edits.poll(self.player.instance_mut()) {
+            None => {}
+            Some(Err(message)) => self.overlay.report(message),
+            Some(Ok(edit)) => {
+                let edit = [edit];
+                self.hub.record(self.player.now().frame, &edit, self.player.instance().scene());
+                self.player.apply(&edit);
+                if let Some(remap) = self.player.instance_mut().take_replaced() {
+                    remap.events(events);
+                    self.hub.set_scene(self.player.instance().scene(), Some(&remap));
+                }
+            }
+        }
+    }
+
     fn reload(&mut self) {
         let Some(live) = self.live.as_mut() else { return };
         let size = (self.config.width, self.config.height);

@@ -199,6 +199,7 @@ impl WindowApp {
             overlay,
             hub,
             live,
+            chain_edits: Default::default(),
             ui_events: Vec::new(),
             pointer: [0.0, 0.0],
             dragging: false,

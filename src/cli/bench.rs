@@ -36,6 +36,14 @@ pub struct BenchArgs {
     /// the worst frame at a switch against the median frame.
     #[arg(long, value_name = "SECONDS")]
     pub cue_every: Option<f64>,
+    /// For a show: add an effect to layer 1 every this many seconds and remove it the next time,
+    /// each built ahead on a worker thread as a live show does, and report the worst frame at an
+    /// edit against the frames after it.
+    #[arg(long, value_name = "SECONDS", conflicts_with = "cue_every")]
+    pub fx_every: Option<f64>,
+    /// The effect `--fx-every` adds.
+    #[arg(long, default_value = "shaders/isf/Kaleidoscope.fs")]
+    pub fx: String,
     /// Every frame waits for its files and clip frames, as `render` does (default: as live, a
     /// frame whose clip frame is not decoded yet shows an older one): the frame time then
     /// includes decoding that does not keep up.
@@ -67,6 +75,13 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         }
         Some(_) => return Err("--cue-every takes a positive number of seconds and a show with a cue list".into()),
     };
+    let fx_steps = match args.fx_every {
+        None => None,
+        Some(s) if s.is_finite() && s > 0.0 && scene.show.is_some() => {
+            Some(((s / f64::from(scene.dt)).round() as u64).max(1))
+        }
+        Some(_) => return Err("--fx-every takes a positive number of seconds and a show".into()),
+    };
     // Measured as it plays live: clips prepare on worker threads, files load in the background —
     // or, with --wait-for-media, each frame waiting for its files and clip frames as a render
     // does, so the wall time includes any decoding that does not keep up.
@@ -84,15 +99,22 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         renderer.render_only().map_err(|e| e.to_string())?;
     }
     renderer.restart_timings();
-    let mut record = super::bench_record::FrameRecord::new(cue_steps.unwrap_or(1));
+    let mut record = match fx_steps {
+        Some(n) => super::bench_record::FrameRecord::new(n).calling_them("edit", "edits"),
+        None => super::bench_record::FrameRecord::new(cue_steps.unwrap_or(1)),
+    };
+    let mut edits = fx_steps.map(|every| super::bench_fx::EffectToggle::new(&mut renderer, &args.fx, every));
     let mut last = Instant::now();
     let mut stats = None;
     let mut in_flight = None;
     for i in 0..args.frames {
-        let go = cue_steps.is_some_and(|n| i > 0 && i % n == 0);
+        let mut go = cue_steps.is_some_and(|n| i > 0 && i % n == 0);
         if go {
             let frame = renderer.next_frame();
             renderer.schedule(frame, vec![indra::params::ControlEvent::Show(indra::params::ShowCommand::CueGo)]);
+        }
+        if let Some(edits) = &mut edits {
+            go = edits.before_frame(&mut renderer, i)?;
         }
         let (time, s) = renderer.render_only().map_err(|e| e.to_string())?;
         // Stepping, recording and submitting a frame: the CPU's share of its wall time.

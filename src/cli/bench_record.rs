@@ -36,6 +36,8 @@ pub struct FrameRecord {
     switches: usize,
     /// The worst switch frame's milliseconds, and the worst ratio to the frames after it.
     worst: (f64, f64),
+    /// What a switch is called in the report (a cue's `switch`, an effect `edit`), and its plural.
+    noun: (&'static str, &'static str),
 }
 
 impl FrameRecord {
@@ -49,7 +51,15 @@ impl FrameRecord {
             lines: Vec::new(),
             switches: 0,
             worst: (0.0, 0.0),
+            noun: ("switch", "switches"),
         }
+    }
+
+    /// The same record, its switches called `singular` (`plural`) in the report.
+    #[must_use]
+    pub fn calling_them(mut self, singular: &'static str, plural: &'static str) -> Self {
+        self.noun = (singular, plural);
+        self
     }
 
     /// Adds a frame's wall and CPU milliseconds; `switch` is the show's frame where a cue was
@@ -90,16 +100,22 @@ impl FrameRecord {
         let median = self.wall_median();
         let mut lines = std::mem::take(&mut self.lines);
         if self.switches > MAX_SWITCH_LINES {
-            lines.push(format!("switch     … and {} more", self.switches - MAX_SWITCH_LINES));
+            lines.push(format!("{:<10} … and {} more", self.noun.0, self.switches - MAX_SWITCH_LINES));
         }
         let (ms, ratio) = self.worst;
         lines.push(format!(
             "{:<28} {:>9.3} ms  ({:.2}× the median frame)",
-            "worst frame at a switch",
+            format!("worst frame at {} {}", if self.noun.0.starts_with('e') { "an" } else { "a" }, self.noun.0),
             ms,
             ms / median.max(1e-9)
         ));
-        lines.push(format!("{:<28} {:>9.2}×  ({} switches)", "worst switch / frames after", ratio, self.switches));
+        let (one, many) = self.noun;
+        lines.push(format!(
+            "{:<28} {:>9.2}×  ({} {many})",
+            format!("worst {one} / frames after"),
+            ratio,
+            self.switches
+        ));
         lines
     }
 
@@ -111,7 +127,8 @@ impl FrameRecord {
         let ratio = ms / steady.max(1e-9);
         if self.lines.len() < MAX_SWITCH_LINES {
             self.lines.push(format!(
-                "switch     frame {frame}: {ms:.3} ms ({cpu:.3} ms on the CPU), then {steady:.3} ms: {ratio:.2}×"
+                "{:<10} frame {frame}: {ms:.3} ms ({cpu:.3} ms on the CPU), then {steady:.3} ms: {ratio:.2}×",
+                self.noun.0
             ));
         }
         self.switches += 1;

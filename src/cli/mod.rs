@@ -15,6 +15,7 @@ macro_rules! say {
 }
 
 mod bench;
+mod bench_fx;
 mod bench_record;
 mod check;
 mod list;

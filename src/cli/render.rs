@@ -79,7 +79,7 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     let assets = &with_scene_folder(assets, &args.scene);
     let scene = scene_with_edits(assets, &args.scene, &args.edits)?;
     let mut script = match &args.replay {
-        Some(path) => indra::control::record::read_replay(path, &scene)?,
+        Some(path) => indra::control::record::read_replay(path, &scene, assets)?,
         None => Default::default(),
     };
     let dt = f64::from(args.dt.unwrap_or(scene.dt));

@@ -41,6 +41,27 @@ pub enum Route {
     Command(Command),
     /// A show's clip, column or cue command (the address holds its numbers).
     Show(ShowCommand),
+    /// An edit of a layer's effect chain (`None`: the master's); the arguments say which.
+    Effect(Option<usize>, EffectOp),
+}
+
+/// What an effect chain address does with its arguments.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EffectOp {
+    /// `…/fx/add s`: append the effect (an ISF filter file or a technique) `s`.
+    Add,
+    /// `…/fx/remove i`: remove effect i (from 1).
+    Remove,
+    /// `…/fx/move i j`: move effect i to place j (from 1).
+    Move,
+    /// `…/fx/bypass i b`: bypass effect i (from 1), or not.
+    Bypass,
+}
+
+impl EffectOp {
+    /// Each, with the last part of its address.
+    pub const ALL: [(EffectOp, &'static str); 4] =
+        [(EffectOp::Add, "add"), (EffectOp::Remove, "remove"), (EffectOp::Move, "move"), (EffectOp::Bypass, "bypass")];
 }
 
 /// The address tree of one scene.
@@ -89,6 +110,12 @@ impl AddressMap {
                 let clear = ShowCommand::Trigger { layer: l, clip: None };
                 routes.insert(format!("/indra/layer/{}/clear", l + 1), Route::Show(clear));
             }
+            let chains = (0..show.layers.len()).map(|l| (Some(l), format!("layer/{}", l + 1)));
+            for (layer, owner) in chains.chain([(None, "master".to_string())]) {
+                for (op, name) in EffectOp::ALL {
+                    routes.insert(format!("/indra/{owner}/fx/{name}"), Route::Effect(layer, op));
+                }
+            }
             for c in 0..show.columns.len() {
                 routes.insert(format!("/indra/column/{}/connect", c + 1), Route::Show(ShowCommand::Column(c)));
             }
@@ -116,7 +143,7 @@ impl AddressMap {
             .iter()
             .filter_map(|(address, route)| match route {
                 Route::Param(t) => Some((address, *t)),
-                Route::Command(_) | Route::Show(_) => None,
+                Route::Command(_) | Route::Show(_) | Route::Effect(..) => None,
             })
             .filter(|(address, _)| {
                 rosc::address::OscAddress::new((*address).clone()).is_ok_and(|a| matcher.match_address(&a))

@@ -6,10 +6,14 @@ use std::sync::atomic::Ordering;
 
 use rosc::{OscMessage, OscType};
 
-use super::address::{AddressMap, Command, Route, is_pattern};
+use super::address::{AddressMap, Command, EffectOp, Route, is_pattern};
 use super::osc::{OscReceiver, describe_args};
-use crate::params::{ControlEvent, ParamDecl, ParamType, ParamValue, ParamWrite, ShowCommand, Source, Target};
+use crate::params::{
+    ControlEvent, EffectEdit, ParamDecl, ParamType, ParamValue, ParamWrite, ShowCommand, Source, Target, Text,
+};
 use crate::scene::Scene;
+use crate::scene::show::chain_edit::{MAX_EFFECT_NAME, chain_owner};
+use crate::scene::show::effects::BYPASS;
 
 /// An OSC message turned into what it asks for.
 #[derive(Clone, Debug, PartialEq)]
@@ -114,6 +118,7 @@ impl OscRouter {
             Route::Command(command) => route_command(command, &msg.args),
             Route::Param(t) => write_for(t, &msg.args, scene),
             Route::Show(command) => show_trigger(command, &msg.args),
+            Route::Effect(layer, op) => effect_edit(layer, op, &msg.args, scene),
         };
         count(routed.is_some(), msg, rx);
         routed
@@ -190,6 +195,33 @@ fn show_trigger(command: ShowCommand, args: &[OscType]) -> Option<Routed> {
         Some(_) => numbers(&args[..1]).is_some_and(|n| n[0] != 0.0 && n[0].is_finite()),
     };
     Some(if pressed { Routed::Event(ControlEvent::Show(command)) } else { Routed::Released })
+}
+
+/// `/indra/<layer/n|master>/fx/<op> …`: an edit of the chain (add s, remove i, move i j), or a
+/// write of an effect's bypass (bypass i b); numbers from 1.
+fn effect_edit(layer: Option<usize>, op: EffectOp, args: &[OscType], scene: &Scene) -> Option<Routed> {
+    let place = |arg: &OscType| {
+        let n = numbers(std::slice::from_ref(arg))?[0];
+        (n.fract() == 0.0 && (1.0..=64.0).contains(&n)).then(|| n as usize - 1)
+    };
+    let edit = match (op, args) {
+        (EffectOp::Add, [OscType::String(effect)]) if effect.len() <= MAX_EFFECT_NAME => {
+            EffectEdit::Add(Text::new(effect))
+        }
+        (EffectOp::Remove, [n]) => EffectEdit::Remove(place(n)?),
+        (EffectOp::Move, [from, to]) => EffectEdit::Move { from: place(from)?, to: place(to)? },
+        (EffectOp::Bypass, [n, on]) => {
+            let id = format!("{}/fx/{}", chain_owner(layer), place(n)? + 1);
+            let node = scene.node_index(&id)?;
+            let param = scene.nodes[node].params.index(BYPASS)?;
+            let on = numbers(std::slice::from_ref(on)).filter(|v| v[0].is_finite())?[0] != 0.0;
+            let value = ParamValue::Bool(on);
+            let write = ParamWrite { node, param, component: None, value, source: Source::Osc };
+            return Some(Routed::Event(ControlEvent::Write(write)));
+        }
+        _ => return None,
+    };
+    Some(Routed::Event(ControlEvent::Show(ShowCommand::Effect { layer, edit })))
 }
 
 /// `/indra/cue/goto i|s`: the cue numbered from 1 or named.

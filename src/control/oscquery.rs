@@ -138,6 +138,29 @@ pub fn tree(instance: SceneView<'_>, presets: &[String]) -> Value {
             let path = format!("layer/{}/clear", l + 1);
             put(path.clone(), trigger(path, format!("empty {}", layer.name)));
         }
+        // Each chain's edits (a bypass is each effect's own `bypass` parameter in the tree).
+        let chains = show.layers.iter().enumerate().map(|(l, layer)| (format!("layer/{}", l + 1), layer.effects.len()));
+        for (owner, len) in chains.chain([("master".to_string(), show.master_effects.len())]) {
+            let mut add = json!({ "FULL_PATH": format!("/indra/{owner}/fx/add"), "TYPE": "s", "ACCESS": 2,
+                "DESCRIPTION": "add an effect: an ISF filter file or a technique that takes an image" });
+            if let Some(names) = crate::scene::show::effects::library::names() {
+                add["RANGE"] = json!([{ "VALS": names }]);
+            }
+            put(format!("{owner}/fx/add"), add);
+            if len > 0 {
+                let range = json!({ "MIN": 1, "MAX": len });
+                put(
+                    format!("{owner}/fx/remove"),
+                    json!({ "FULL_PATH": format!("/indra/{owner}/fx/remove"),
+                    "TYPE": "i", "ACCESS": 2, "RANGE": [range], "DESCRIPTION": "remove effect i (from 1)" }),
+                );
+                put(
+                    format!("{owner}/fx/move"),
+                    json!({ "FULL_PATH": format!("/indra/{owner}/fx/move"),
+                    "TYPE": "ii", "ACCESS": 2, "RANGE": [range, range], "DESCRIPTION": "move effect i to place j" }),
+                );
+            }
+        }
         for (c, name) in show.columns.iter().enumerate() {
             let path = format!("column/{}/connect", c + 1);
             put(path.clone(), trigger(path, format!("play column {name}")));

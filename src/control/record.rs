@@ -10,8 +10,12 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::params::{Addressing, ControlEvent, ParamWrite, RawValue, Source, raw_from_value, value_from_raw};
+use crate::assets::Assets;
+use crate::params::{
+    Addressing, ControlEvent, ParamSet, ParamWrite, RawValue, ShowCommand, Source, raw_from_value, value_from_raw,
+};
 use crate::scene::Scene;
+use crate::scene::show::chain_edit::edited_show;
 
 /// One line of a control-stream file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -148,15 +152,16 @@ fn to_recorded(event: &ControlEvent, scene: &Scene) -> Option<ControlEvent<Named
 /// The largest recording read: hours of dense control at a few hundred bytes an event.
 const REPLAY_FILE_LIMIT: u64 = 256 << 20;
 
-/// Reads a recording for `scene`: events by frame. Errors name the line. A last line cut short
-/// (a crash mid-write: no newline after it) is left out, so the take replays up to its last
-/// complete line.
-pub fn read_replay(path: &Path, scene: &Scene) -> Result<BTreeMap<u64, Vec<ControlEvent>>, String> {
+/// Reads a recording for `scene` (its effect edits followed with `assets`): events by frame.
+/// Errors name the line. A last line cut short (a crash mid-write: no newline after it) is left
+/// out, so the take replays up to its last complete line.
+pub fn read_replay(path: &Path, scene: &Scene, assets: &Assets) -> Result<BTreeMap<u64, Vec<ControlEvent>>, String> {
     let bytes = crate::files::read_limited(path, REPLAY_FILE_LIMIT).map_err(|e| format!("cannot read {e}"))?;
     let text = String::from_utf8_lossy(&bytes);
     let cut_short = !text.is_empty() && !text.ends_with('\n');
     let lines: Vec<&str> = text.lines().collect();
     let mut out: BTreeMap<u64, Vec<ControlEvent>> = BTreeMap::new();
+    let mut current = std::borrow::Cow::Borrowed(scene);
     for (i, line) in lines.iter().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
         let at = |msg: String| format!("{}:{}: {msg}", path.display(), i + 1);
         let rec: Recorded = match ron_options().from_str(line) {
@@ -167,7 +172,15 @@ pub fn read_replay(path: &Path, scene: &Scene) -> Result<BTreeMap<u64, Vec<Contr
             }
             Err(e) => return Err(at(e.to_string())),
         };
-        let event = from_recorded(&rec.event, scene).map_err(at)?;
+        let event = from_recorded(&rec.event, &current).map_err(at)?;
+        // After a chain edit, the events that follow name the parameters of the edited show.
+        if let ControlEvent::Show(ShowCommand::Effect { layer, edit }) = event {
+            let defaults: Vec<ParamSet> = current.nodes.iter().map(|n| n.params.clone()).collect();
+            match edited_show(assets, &current, &defaults, layer, edit) {
+                Ok(edited) => current = std::borrow::Cow::Owned(edited),
+                Err(e) => log::warn!("{}:{}: the effect edit will be refused: {e}", path.display(), i + 1),
+            }
+        }
         out.entry(rec.frame).or_default().push(event);
     }
     Ok(out)

@@ -9,7 +9,7 @@ use std::sync::Arc;
 use super::watcher::read_stable;
 use crate::assets::{Asset, AssetKind, Assets};
 use crate::gpu::{Gpu, validate_as_used};
-use crate::scene::show::parse_show;
+use crate::scene::show::{build_show, parse_show};
 use crate::scene::{NodeRebuild, Replacement, SceneNode, SceneSnapshot, load_scene, parse_scene_with};
 
 /// Everything one file's reload needs, owned (it may travel to a worker thread).
@@ -89,8 +89,13 @@ impl Job {
                     return Ok(Prepared::Unused);
                 }
                 let origin = &running.origin;
-                let source = read(Path::new(origin))?;
-                parse_show(&self.running, origin, &source, false).map_err(|e| e.to_string())?
+                match show.file.as_deref().filter(|_| !same_file(origin)) {
+                    // A clip's scene changed: the show as it runs (its chains as edited live)
+                    // is built again with it.
+                    Some(running) => build_show(&self.running, origin, &running.text, running.file.clone(), false),
+                    None => parse_show(&self.running, origin, &read(Path::new(origin))?, false),
+                }
+                .map_err(|e| e.to_string())?
             }
             None => {
                 if !same_file(&running.origin) {

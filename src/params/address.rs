@@ -107,6 +107,30 @@ pub enum ShowCommand {
     CueBack,
     /// Cue `n`.
     CueGoto(usize),
+    /// Edit the effect chain of layer `layer` (`None`: the master's); see [`EffectEdit`].
+    Effect {
+        /// The layer, or the master.
+        layer: Option<usize>,
+        /// What changes.
+        edit: EffectEdit,
+    },
+}
+
+/// A change to an effect chain's structure (its effects' switches and values are parameters).
+/// Effects are numbered from 0 here (from 1 in OSC addresses and on the panel).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum EffectEdit {
+    /// Append an effect: an ISF filter file or a technique that takes one image.
+    Add(super::Text),
+    /// Remove effect `n`.
+    Remove(usize),
+    /// Move effect `from` to place `to`.
+    Move {
+        /// Where it is.
+        from: usize,
+        /// Where it goes.
+        to: usize,
+    },
 }
 
 impl ControlEvent {
@@ -167,6 +191,17 @@ impl Remap {
     /// Where parameter `param` of old node `node` is now, if anywhere.
     pub fn param(&self, node: usize, param: usize) -> Option<(usize, usize)> {
         *self.map.get(node)?.get(param)?
+    }
+
+    /// This map followed by `next` (two scene changes in a row, as one).
+    #[must_use]
+    pub fn then(&self, next: &Remap) -> Remap {
+        let map = self
+            .map
+            .iter()
+            .map(|params| params.iter().map(|to| to.and_then(|(n, p)| next.param(n, p))).collect())
+            .collect();
+        Remap { map }
     }
 
     /// Where an old target is now, if anywhere (components keep their index).

@@ -13,7 +13,9 @@ mod typed;
 mod value;
 mod write;
 
-pub use address::{Addressing, AudioSnapshot, ControlEvent, Indexed, NodeValues, Remap, ShowCommand, Target};
+pub use address::{
+    Addressing, AudioSnapshot, ControlEvent, EffectEdit, Indexed, NodeValues, Remap, ShowCommand, Target,
+};
 pub use lfo::{Lfo, LfoRate, LfoShape, TempoClock};
 pub use morph::Morph;
 pub use raw::{RawValue, coerce, raw_from_value, value_from_raw};

@@ -123,7 +123,8 @@ pub enum ParamValue {
 
 /// A short UTF-8 string stored inline, so that values stay `Copy` (they are written from
 /// control threads and snapshotted every frame). Longer input is cut at a character boundary.
-#[derive(Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(from = "String", into = "String")]
 pub struct Text {
     len: u8,
     bytes: [u8; Text::CAPACITY],
@@ -148,6 +149,18 @@ impl Text {
     pub fn as_str(&self) -> &str {
         // Only `new` writes the bytes, from a &str cut at a boundary.
         std::str::from_utf8(&self.bytes[..usize::from(self.len)]).unwrap_or_default()
+    }
+}
+
+impl From<String> for Text {
+    fn from(text: String) -> Self {
+        Self::new(&text)
+    }
+}
+
+impl From<Text> for String {
+    fn from(text: Text) -> Self {
+        text.as_str().to_string()
     }
 }
 

@@ -109,10 +109,10 @@ impl Player {
         if frame < from {
             return Err(SeekError::Backwards { from, to: frame });
         }
-        let on_gpu = self.instance.simulates_on_gpu();
         for skipped in from..frame {
             let time = self.step();
-            if !on_gpu {
+            // Asked each step: a chain edit on the way may add a node that simulates.
+            if !self.instance.simulates_on_gpu() {
                 continue;
             }
             let mut encoder =

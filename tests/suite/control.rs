@@ -295,7 +295,7 @@ fn a_recorded_session_replays_frame_exactly() {
         .filter(|e| e.file_name().to_string_lossy().ends_with(".recording"))
         .collect();
     assert!(leftovers.is_empty(), "the temporary recording is renamed, not left: {leftovers:?}");
-    let replay = read_replay(&path, &s).unwrap();
+    let replay = read_replay(&path, &s, &crate::common::assets()).unwrap();
     let original: std::collections::BTreeMap<u64, Vec<ControlEvent>> = session.into_iter().collect();
     assert_eq!(replay, original, "recording loses nothing");
     let (a, b) = (render(&s, &replay), render(&s, &replay));
@@ -303,7 +303,7 @@ fn a_recorded_session_replays_frame_exactly() {
     assert!(a != render(&s, &Default::default()), "the session changes the pictures");
     // A malformed line is an error that names it.
     std::fs::write(&path, "(frame: 1, event: Nonsense)\n").unwrap();
-    assert!(read_replay(&path, &s).unwrap_err().contains("session.ron:1:"));
+    assert!(read_replay(&path, &s, &crate::common::assets()).unwrap_err().contains("session.ron:1:"));
 }
 
 #[test]

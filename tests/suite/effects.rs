@@ -7,7 +7,7 @@
 use crate::common::{self, assets, golden, gpu};
 use indra::control::address::{AddressMap, Route};
 use indra::offscreen::OffscreenRenderer;
-use indra::params::{ControlEvent, ParamValue, ParamWrite, ShowCommand, Source};
+use indra::params::{ControlEvent, EffectEdit, ParamValue, ParamWrite, ShowCommand, Source, Text};
 use indra::scene::show::parse_show;
 use indra::scene::{Scene, parse_scene_with};
 use indra::techniques::srgb_to_linear;
@@ -214,4 +214,126 @@ fn every_bundled_isf_filter_and_image_technique_is_an_effect() {
         parse_show(&assets, "all.ron", &limit_set_show("", &effect, ""), false)
             .unwrap_or_else(|e| panic!("{technique}: {e}"));
     }
+}
+
+/// A chain edit of layer 1's chain (`None`: the master's).
+fn edit(layer: Option<usize>, edit: EffectEdit) -> ControlEvent {
+    ControlEvent::Show(ShowCommand::Effect { layer, edit })
+}
+
+const PLAIN_DIAGONALIZE: &str = r#"(effect: "shaders/isf/Diagonalize.fs")"#;
+
+#[test]
+fn effects_added_moved_and_removed_live_give_the_chain_the_file_would() {
+    let scene = show_from(&limit_set_show("", KALEIDOSCOPE, ""));
+    let mut r = OffscreenRenderer::new(gpu(), &assets(), scene, Some(SIZE), None, None).unwrap();
+    let diagonalize = Text::new("shaders/isf/Diagonalize.fs");
+    r.schedule(2, vec![edit(Some(0), EffectEdit::Add(diagonalize))]);
+    r.schedule(4, vec![edit(Some(0), EffectEdit::Move { from: 1, to: 0 })]);
+    r.schedule(6, vec![edit(Some(0), EffectEdit::Remove(0)), edit(None, EffectEdit::Add(diagonalize))]);
+    // Refused, told, and the show plays on: no effect 9, no such file.
+    r.schedule(7, vec![edit(Some(0), EffectEdit::Remove(8)), edit(Some(0), EffectEdit::Add(Text::new("nope.fs")))]);
+    let frames: Vec<Vec<u8>> = (0..8).map(|_| r.render_next().unwrap().rgba).collect();
+    let want = |layer: String, master: &str, frame| frame_of(&limit_set_show("", &layer, master), frame);
+    assert!(frames[1] == want(KALEIDOSCOPE.into(), "", 1), "before the edits");
+    assert!(frames[2] == want(format!("{KALEIDOSCOPE}, {PLAIN_DIAGONALIZE}"), "", 2), "after the add");
+    assert!(frames[4] == want(format!("{PLAIN_DIAGONALIZE}, {KALEIDOSCOPE}"), "", 4), "after the move");
+    assert!(frames[6] == want(KALEIDOSCOPE.into(), PLAIN_DIAGONALIZE, 6), "after the remove and the master's add");
+    assert!(frames[7] == frames[6], "a refused edit changed the picture");
+    let messages = r.instance_mut().take_messages().join("\n");
+    assert!(messages.contains("no effect 9") && messages.contains("nope.fs"), "{messages}");
+    let scene = r.instance_mut().scene().clone();
+    assert!(AddressMap::new(&scene).route("/indra/master/fx/1/width").is_some(), "the tree lacks the new effect");
+}
+
+#[test]
+fn frame_n_is_the_same_played_or_sought_across_adds_moves_and_bypasses() {
+    let pulse = Text::new("shaders/isf/Shockwave Pulse.fs");
+    let scene = show_from(&limit_set_show("", KALEIDOSCOPE, ""));
+    let scripted = || {
+        let mut r = OffscreenRenderer::new(gpu(), &assets(), scene.clone(), Some(SIZE), None, None).unwrap();
+        r.schedule(3, vec![edit(Some(0), EffectEdit::Add(pulse))]);
+        r.schedule(6, vec![edit(Some(0), EffectEdit::Move { from: 1, to: 0 })]);
+        // After the move the pulse is effect 1: its bypass, by the positions of the edited show.
+        let edited = show_from(&limit_set_show("", &format!(r#"(effect: "{}"), {KALEIDOSCOPE}"#, pulse.as_str()), ""));
+        r.schedule(9, vec![write(&edited, "layer/1/fx/1", "bypass", ParamValue::Bool(true))]);
+        r
+    };
+    let mut played = scripted();
+    let played: Vec<Vec<u8>> = (0..12).map(|_| played.render_next().unwrap().rgba).collect();
+    assert!(played[3] != played[2] && played[6] != played[5] && played[9] != played[8], "an edit changed nothing");
+    for start in [4, 7, 10] {
+        let mut sought = scripted();
+        sought.seek(start).unwrap();
+        for frame in start..12 {
+            assert!(sought.render_next().unwrap().rgba == played[frame as usize], "frame {frame} from {start} differs");
+        }
+    }
+}
+
+#[test]
+fn effects_edited_over_osc_in_a_running_show_change_the_tree_and_replay_to_the_same_picture() {
+    use crate::live_show::{Show, VirtualDisplay, scratch_dir, send};
+    use rosc::OscType;
+    let display = VirtualDisplay::start();
+    let dir = scratch_dir("effects-osc");
+    let file = dir.join("effects.ron");
+    std::fs::write(&file, limit_set_show("", "", "")).unwrap();
+    let query = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap();
+    let recording = dir.join("take.ron");
+    let args: Vec<std::ffi::OsString> =
+        vec!["--oscquery".into(), query.to_string().into(), "--record-controls".into(), recording.clone().into()];
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+    let (mut show, port) = Show::start(&display, &dir, file.to_str().unwrap(), &args);
+    show.wait_for("OSCQuery on");
+    show.wait_for("plays clip 'kleinian_classic'");
+    let (mut socket, _) = tungstenite::connect(format!("ws://{query}/")).unwrap();
+    let osc = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    let text = |s: &str| vec![OscType::String(s.into())];
+    send(&osc, port, "/indra/layer/1/fx/add", text("shaders/isf/Kaleidoscope.fs"));
+    show.wait_for("layer/1's effect chain: Add");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    while !crate::osc::next_message(&mut socket, std::time::Duration::from_secs(5))
+        .is_some_and(|m| matches!(m, tungstenite::Message::Text(t) if t.contains("PATH_CHANGED")))
+    {
+        assert!(std::time::Instant::now() < deadline, "no PATH_CHANGED after the effect was added");
+    }
+    let (_, tree) = crate::osc::http_get(query, "/");
+    let fx = &tree["CONTENTS"]["indra"]["CONTENTS"]["layer"]["CONTENTS"]["1"]["CONTENTS"]["fx"]["CONTENTS"];
+    assert!(!fx["1"]["CONTENTS"]["sides"].is_null() && !fx["remove"].is_null(), "the tree lacks the effect: {fx}");
+    // Its value, a second effect, a move, a bypass and a remove on the master's empty chain
+    // (refused: there is nothing to remove), each over OSC.
+    send(&osc, port, "/indra/layer/1/fx/1/sides", vec![OscType::Float(5.0)]);
+    send(&osc, port, "/indra/layer/1/fx/add", text("shaders/isf/Diagonalize.fs"));
+    show.wait_for("Add(\"shaders/isf/Diagonalize.fs\")");
+    send(&osc, port, "/indra/layer/1/fx/move", vec![OscType::Int(2), OscType::Int(1)]);
+    show.wait_for("Move");
+    send(&osc, port, "/indra/layer/1/fx/bypass", vec![OscType::Int(2), OscType::Int(1)]);
+    send(&osc, port, "/indra/master/fx/remove", vec![OscType::Int(1)]);
+    show.wait_for("no effect 1 to remove");
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    // Ctrl-C: the show ends cleanly and the recording is complete.
+    let _ = std::process::Command::new("kill").args(["-INT", &show.pid().to_string()]).status();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    while show.child.try_wait().unwrap().is_none() {
+        assert!(std::time::Instant::now() < deadline, "the show did not end on Ctrl-C");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    // The take replays in a render to the chain the performer built: Diagonalize, then the
+    // kaleidoscope with 5 sides, bypassed.
+    let scene = show_from(&limit_set_show("", "", ""));
+    let script = indra::control::record::read_replay(&recording, &scene, &assets()).unwrap();
+    let last = *script.keys().last().expect("the take holds the edits");
+    let mut r = OffscreenRenderer::new(gpu(), &assets(), scene, Some(SIZE), None, None).unwrap();
+    for (frame, events) in script {
+        r.schedule(frame, events);
+    }
+    r.seek(last + 1).unwrap();
+    let replayed = r.render_next().unwrap().rgba;
+    let chain = format!(
+        r#"{PLAIN_DIAGONALIZE}, (effect: "shaders/isf/Kaleidoscope.fs", params: {{ "sides": 5.0 }}, bypass: true)"#
+    );
+    assert!(replayed == frame_of(&limit_set_show("", &chain, ""), last + 1), "the replay differs from the chain built");
+    let bypass_off = chain.replace("bypass: true", "bypass: false");
+    assert!(replayed != frame_of(&limit_set_show("", &bypass_off, ""), last + 1), "the bypass was not replayed");
 }

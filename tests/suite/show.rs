@@ -129,6 +129,7 @@ pub(crate) fn mixer_show(kinds: &[&str]) -> Show {
         master_effects: Vec::new(),
         effects: Vec::new(),
         mix_kind: None,
+        file: None,
         cue_notes: Default::default(),
         kinds: kinds.iter().map(|k| k.to_string()).collect(),
         sources: Vec::new(),
@@ -584,6 +585,6 @@ fn show_commands_survive_a_recording_and_midi_notes_trigger_clips() {
         [trigger(0, 1), ControlEvent::Show(ShowCommand::CueGoto(0)), ControlEvent::Show(ShowCommand::Column(1))];
     recorder.record(12, &events, &scene).unwrap();
     recorder.finish().unwrap();
-    let replay = indra::control::record::read_replay(&path, &scene).unwrap();
+    let replay = indra::control::record::read_replay(&path, &scene, &assets()).unwrap();
     assert_eq!(replay.get(&12).map(Vec::as_slice), Some(&events[..]));
 }

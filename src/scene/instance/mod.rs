@@ -7,6 +7,7 @@
 //! A live write (UI, OSC, MIDI) to a parameter a track drives stops that track for that parameter
 //! until `resume_tracks`, so a performer's fader is never yanked back by automation.
 
+mod chain;
 mod rebuild;
 
 use std::collections::BTreeSet;
@@ -64,6 +65,10 @@ pub struct SceneInstance {
     /// Counts the changes of scene and nodes (reloads, a new device): what a rebuild made ahead
     /// checks before it is installed.
     revision: u64,
+    /// A chain edit built ahead, installed when its event is applied.
+    prepared: Option<(crate::params::ShowCommand, Replacement)>,
+    /// Where parameters went since the last look, when chain edits replaced the scene.
+    replaced: Option<Remap>,
 }
 
 impl SceneInstance {
@@ -90,6 +95,8 @@ impl SceneInstance {
             refused: BTreeSet::new(),
             messages,
             revision: 0,
+            prepared: None,
+            replaced: None,
         })
     }
 
@@ -145,10 +152,15 @@ impl SceneInstance {
         self.nodes.get(node).map_or_else(Vec::new, |n| n.handles())
     }
 
-    /// Applies control events in order; they take effect from the next step.
+    /// Applies control events in order; they take effect from the next step. A chain edit
+    /// changes the scene: the events after it name parameters where they are after it (a
+    /// replay reads them so; a live source's are moved with [`Self::take_replaced`]).
     pub fn apply(&mut self, events: &[ControlEvent]) {
         for event in events {
             match event {
+                ControlEvent::Show(command @ crate::params::ShowCommand::Effect { .. }) => {
+                    self.edit_chain(*command);
+                }
                 ControlEvent::Write(w) => self.write(w),
                 ControlEvent::Morph { values, seconds } => self.pending_morph = Some((values.clone(), *seconds)),
                 ControlEvent::ResumeTracks => self.overridden.clear(),

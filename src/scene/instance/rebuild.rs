@@ -134,6 +134,7 @@ impl SceneInstance {
         if revision != self.revision {
             return Err(Outdated);
         }
+        let in_place: Vec<bool> = kept.iter().enumerate().map(|(i, k)| *k == Some(i)).collect();
         let mut old_nodes: Vec<Option<Box<dyn Technique>>> = self.nodes.drain(..).map(Some).collect();
         let mut params = Vec::with_capacity(scene.nodes.len());
         for ((n, new), kept) in scene.nodes.iter().zip(fresh.iter_mut()).zip(kept) {
@@ -160,7 +161,7 @@ impl SceneInstance {
         self.params = params;
         self.scene = scene;
         if let (Some(show), Some(old)) = (&mut show, &self.show) {
-            let messages = show.carry_over(old, &self.scene, &self.params, &mut self.nodes);
+            let messages = show.carry_over(old, &self.scene, &self.params, &mut self.nodes, &|n| in_place[n]);
             self.messages.extend(messages);
         }
         self.show = show;

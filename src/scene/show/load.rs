@@ -9,7 +9,9 @@ use std::sync::Arc;
 
 use super::effects::chain_nodes;
 use super::file::{ClipFile, CueFile, EffectFile, Hold, ShowFile, TransitionFile};
-use super::{Clip, Cue, CueNotes, Layer, Length, MAX_CLIPS_PER_LAYER, MAX_CUES, MAX_LAYERS, Show, Transition};
+use super::{
+    Clip, Cue, CueNotes, Layer, Length, MAX_CLIPS_PER_LAYER, MAX_CUES, MAX_LAYERS, Show, ShowSource, Transition,
+};
 use crate::assets::{AssetKind, Assets};
 use crate::params::{ParamSet, ParamValue, Target, coerce};
 use crate::scene::error::{SceneError, SceneErrors, locate};
@@ -50,7 +52,18 @@ const SHOW_FILE_LIMIT: u64 = 4 << 20;
 
 /// Parses and validates show text; `origin` names it in errors and places relative clip paths.
 pub fn parse_show(assets: &Assets, origin: &str, source: &str, lenient: bool) -> Result<Scene, SceneErrors> {
-    let file: ShowFile = read_ron(origin, source)?;
+    build_show(assets, origin, source, read_ron(origin, source)?, lenient)
+}
+
+/// Validates a parsed show file (`source` is the text errors are located in; it may be older
+/// than `file`, for a show edited live).
+pub fn build_show(
+    assets: &Assets,
+    origin: &str,
+    source: &str,
+    file: ShowFile,
+    lenient: bool,
+) -> Result<Scene, SceneErrors> {
     let mut builder =
         Builder { assets, origin, source, errors: Vec::new(), lenient, kinds: Vec::new(), effects: Vec::new() };
     let scene = builder.build(file);
@@ -265,6 +278,7 @@ impl Builder<'_> {
             effects: std::mem::take(&mut self.effects),
             master_effects,
             mix_kind: None,
+            file: None,
             kinds: Vec::new(),
             sources,
             broken,
@@ -312,6 +326,7 @@ impl Builder<'_> {
         if let Err(e) = budget(&scene, &show) {
             self.error(&["size"], e);
         }
+        show.file = Some(Arc::new(ShowSource { file, text: self.source.into() }));
         scene.show = Some(Arc::new(show));
         Some(scene)
     }

@@ -6,6 +6,7 @@
 //! clip each layer plays, running transitions, pending quantized triggers, the cue), the
 //! transition passes ([`Mixer`]) and the fresh copies of restarting clips ([`Spares`]).
 
+pub mod chain_edit;
 pub mod effects;
 mod file;
 mod load;
@@ -17,13 +18,14 @@ mod state;
 pub use file::{
     ClipFile, ClipPolicy, CueFile, EffectFile, Hold, LayerFile, Quantize, ShowFile, TransitionFile, is_show,
 };
-pub use load::{load_show, parse_show};
+pub use load::{build_show, load_show, parse_show};
 pub use mixer::{Mixer, MixerFrame, TRANSITION_BASE, TransitionUniforms, transition_file};
 pub use runtime::ShowRuntime;
 pub use spares::Spares;
 pub use state::{BEATS_PER_BAR, Clock, LayerView, ShowState, StepChanges};
 
 use std::ops::Range;
+use std::sync::Arc;
 
 /// The most layers a show may have.
 pub const MAX_LAYERS: usize = 8;
@@ -57,12 +59,23 @@ pub struct Show {
     /// The transition kind that mixes an effect's dry and wet images (the crossfade, in linear
     /// light), when the show has effects.
     pub mix_kind: Option<usize>,
+    /// The file it was built from, as edited live since (effect chains), to rebuild it from.
+    pub file: Option<Arc<ShowSource>>,
     /// Transition shader kinds in use (`crossfade` → `transition_crossfade.wgsl`), by index.
     pub kinds: Vec<String>,
     /// Every file the show was built from (the show file and its clips' scenes), for reload.
     pub sources: Vec<String>,
     /// Clips that could not be loaded (a lenient load, for a running show): clip id and why.
     pub broken: Vec<(String, String)>,
+}
+
+/// A show file as parsed (and edited live since), and the text errors are located in.
+#[derive(Clone, Debug)]
+pub struct ShowSource {
+    /// The file.
+    pub file: ShowFile,
+    /// The text it was read from.
+    pub text: String,
 }
 
 /// MIDI notes that move through the cue list.

@@ -61,23 +61,38 @@ impl ShowRuntime {
         &self.plan
     }
 
+    /// What the show builds with: the device, the assets and the output size.
+    pub fn context(&self) -> (&Gpu, &Assets, (u32, u32)) {
+        (&self.gpu, &self.assets, self.output_size)
+    }
+
     /// The play state.
     pub fn state(&self) -> &ShowState {
         &self.state
     }
 
-    /// Takes over the play state of the show this one replaces (a hot reload); clips whose nodes
-    /// ran before are no longer fresh, and hidden ones get fresh copies.
+    /// Takes over the play state of the show this one replaces (a hot reload, a chain edit);
+    /// clips whose nodes ran before are no longer fresh, and hidden ones get fresh copies — but a
+    /// clip whose nodes were all kept in place (`kept_in_place`, by node) and are still fresh
+    /// stays fresh: an effect added to a layer rebuilds no clip.
     pub fn carry_over(
         &mut self,
         old: &ShowRuntime,
         scene: &Scene,
         params: &[ParamSet],
         nodes: &mut [Box<dyn Technique>],
+        kept_in_place: &dyn Fn(usize) -> bool,
     ) -> Vec<String> {
         self.state = old.state.carried(&old.plan, &self.plan);
         let mut messages = Vec::new();
         for c in 0..self.plan.clips.len() {
+            let clip = &self.plan.clips[c];
+            let untouched = old.plan.clips.get(c).is_some_and(|o| o.id == clip.id && o.nodes == clip.nodes)
+                && clip.nodes.clone().all(kept_in_place)
+                && old.spares.is_fresh(c);
+            if untouched {
+                continue;
+            }
             self.spares.mark_stale(c);
             if self.plan.clips[c].policy == ClipPolicy::Restart && !self.state.visible(c) {
                 self.prepare(c, scene, params, nodes, &mut messages);

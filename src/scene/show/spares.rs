@@ -125,6 +125,11 @@ impl Spares {
         }
     }
 
+    /// Whether `clip`'s nodes have not run since they were built.
+    pub fn is_fresh(&self, clip: usize) -> bool {
+        matches!(self.slots.get(clip), Some(Slot::Fresh))
+    }
+
     /// Marks `clip` stale (its nodes ran, or were rebuilt for another device); a copy on its way
     /// is dropped.
     pub fn mark_stale(&mut self, clip: usize) {

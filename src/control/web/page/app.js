@@ -320,6 +320,36 @@ function group(title, subtitle, klass, ...body) {
 /** A clip's name from its trigger's description ("play red on layer 1"). */
 const clipName = (leaf, fallback) => (/^play (.+) on /.exec(leaf.DESCRIPTION || "") || [])[1] || fallback;
 
+/**
+ * An effect chain (the `fx` of a layer or of the master): each effect in order with buttons that
+ * move it up or down or remove it, and a menu that adds one from the library. An effect's bypass,
+ * mix and own parameters are in its own group.
+ */
+function chainRow(title, fx) {
+  const c = (fx && fx.CONTENTS) || {};
+  if (!c.add) return null;
+  const button = (text, leaf, args, label) => {
+    const b = el("button", { type: "button", "data-path": leaf.FULL_PATH, "aria-label": label }, text);
+    b.addEventListener("click", () => sendNow(leaf.FULL_PATH, args));
+    return b;
+  };
+  const effects = childrenOf(fx).filter(([k]) => /^[0-9]+$/.test(k)).sort((a, b) => a[0] - b[0]);
+  const items = effects.map(([k, effect]) => {
+    const n = Number(k);
+    const file = effect.CONTENTS && effect.CONTENTS.file && effect.CONTENTS.file.VALUE;
+    const name = file ? String(file[0]).replace(/^.*\//, "").replace(/\.fs$/, "") : (effect.DESCRIPTION || `effect ${k}`);
+    return el("div", { class: "row" }, el("span", {}, `${k} ${name}`),
+      n > 1 && c.move ? button("▲", c.move, [["i", n], ["i", n - 1]], `move ${name} up`) : null,
+      n < effects.length && c.move ? button("▼", c.move, [["i", n], ["i", n + 1]], `move ${name} down`) : null,
+      c.remove ? button("✕", c.remove, [["i", n]], `remove ${name}`) : null);
+  });
+  const names = rangeOf(c.add, 0).VALS || [];
+  const add = el("select", { "data-path": c.add.FULL_PATH, "aria-label": `add an effect to ${title}` },
+    el("option", { value: "" }, "add an effect…"), ...names.map((v) => el("option", { value: v }, v)));
+  add.addEventListener("change", () => { if (add.value) sendNow(c.add.FULL_PATH, [["s", add.value]]); add.value = ""; });
+  return el("div", { class: "chain" }, el("h4", {}, `effects · ${title}`), ...items, add);
+}
+
 /** The show: a row per layer (its clips, its fader and blend), the columns, the cue list. */
 function showGroup(root) {
   const layers = root.layer;
@@ -338,8 +368,9 @@ function showGroup(root) {
       .map(([name, leaf]) => { const c = controlFor(name, leaf); return c && adopt(leaf, c); });
     const name = ((contents.clear && contents.clear.DESCRIPTION) || "").replace(/^empty /, "") || `layer ${n}`;
     return el("div", { class: "layer" }, el("h3", {}, name),
-      el("div", { class: "grid" }, ...clips, clear), ...params);
+      el("div", { class: "grid" }, ...clips, clear), ...params, chainRow(name, contents.fx));
   });
+  rows.push(chainRow("master", root.master && root.master.CONTENTS && root.master.CONTENTS.fx));
   const columns = childrenOf(root.column).map(([n, column]) => {
     const leaf = column.CONTENTS && column.CONTENTS.connect;
     return leaf ? triggerButton((leaf.DESCRIPTION || `column ${n}`).replace(/^play column /, "▶ "), leaf.FULL_PATH) : null;
@@ -392,6 +423,8 @@ function nodeGroups(contents, prefix, out) {
   const leaves = [];
   for (const [name, child] of Object.entries(contents)) {
     if (isLeaf(child)) {
+      // A chain's edits have their own row in the show group.
+      if (prefix.endsWith("/fx") || prefix === "fx") continue;
       if (!(child.ACCESS & 1) && child.TYPE === "I") leaves.push(triggerButton(name, child.FULL_PATH));
       else { const c = controlFor(name, child); if (c) leaves.push(adopt(child, c)); }
     } else if (child && child.CONTENTS) {

@@ -117,6 +117,8 @@ impl ShowState {
             ShowCommand::Column(n) => n < show.columns.len(),
             ShowCommand::CueGoto(n) => n < show.cues.len(),
             ShowCommand::CueGo | ShowCommand::CueBack => !show.cues.is_empty(),
+            // A chain edit changes the scene itself: the instance applies it, never the play state.
+            ShowCommand::Effect { .. } => return Err(format!("{command:?}: not a play-state command")),
         };
         if !ok {
             return Err(format!("{command:?}: the show has no such layer, clip, column or cue"));
@@ -223,6 +225,7 @@ impl ShowState {
                     self.go_cue(show, back, clock, &mut changes);
                 }
                 ShowCommand::CueGoto(n) => self.go_cue(show, n, clock, &mut changes),
+                ShowCommand::Effect { .. } => {}
             }
         }
         let (due, waiting): (Vec<Pending>, Vec<Pending>) =

@@ -29,6 +29,7 @@ fn show(transition: Transition, cues: Vec<Cue>) -> Show {
         master_effects: Vec::new(),
         effects: Vec::new(),
         mix_kind: None,
+        file: None,
         kinds: vec!["crossfade".into()],
         sources: Vec::new(),
         broken: Vec::new(),

@@ -18,6 +18,8 @@ use crate::scene::validate::build_node;
 use crate::techniques::{self, Technique};
 use crate::time::FrameTime;
 
+pub mod library;
+
 /// The parameter that bypasses an effect.
 pub const BYPASS: &str = "bypass";
 /// The parameter that mixes an effect's input (0) with its output (1).

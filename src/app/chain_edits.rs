@@ -1,0 +1,77 @@
+//! Effect chain edits in a live show (add, remove, move): each is built on a worker thread from
+//! a snapshot of the running show — parsing, effect files, pipelines — one at a time in the order
+//! they came, and applied at the start of the frame after it is ready, so the frame an effect
+//! appears in is not late. The edit is then applied (and recorded) like any control event.
+
+use std::collections::VecDeque;
+use std::sync::mpsc::{Receiver, TryRecvError};
+
+use crate::params::{ControlEvent, ShowCommand};
+use crate::scene::{Replacement, SceneInstance};
+
+/// The most edits waiting for their build; past it an edit is dropped, told.
+pub const MAX_QUEUED_EDITS: usize = 16;
+
+/// The chain edits asked for and the one being built.
+#[derive(Default)]
+pub struct ChainEdits {
+    queue: VecDeque<ShowCommand>,
+    building: Option<(ShowCommand, Receiver<Result<Replacement, String>>)>,
+}
+
+impl ChainEdits {
+    /// Takes the chain edits out of `events` into the queue; returns what to tell the performer.
+    pub fn take_from(&mut self, events: &mut Vec<ControlEvent>) -> Vec<String> {
+        let mut messages = Vec::new();
+        events.retain(|event| match event {
+            ControlEvent::Show(command @ ShowCommand::Effect { .. }) => {
+                if self.queue.len() < MAX_QUEUED_EDITS {
+                    self.queue.push_back(*command);
+                } else {
+                    messages.push(format!("{command:?} dropped: {MAX_QUEUED_EDITS} effect edits are waiting"));
+                }
+                false
+            }
+            _ => true,
+        });
+        messages
+    }
+
+    /// Starts the next build if none runs; returns the edit whose build is ready (offered to
+    /// `instance`, to apply now), or why it could not be built.
+    pub fn poll(&mut self, instance: &mut SceneInstance) -> Option<Result<ControlEvent, String>> {
+        if let Some((command, receiver)) = &self.building {
+            let command = *command;
+            let done = match receiver.try_recv() {
+                Ok(result) => result,
+                Err(TryRecvError::Empty) => return None,
+                Err(TryRecvError::Disconnected) => Err("its build stopped".into()),
+            };
+            self.building = None;
+            return Some(match done {
+                Ok(replacement) => {
+                    instance.offer_prepared(command, replacement);
+                    Ok(ControlEvent::Show(command))
+                }
+                Err(e) => Err(format!("the effect edit was refused: {e}")),
+            });
+        }
+        let command = self.queue.pop_front()?;
+        let ShowCommand::Effect { layer, edit } = command else { return None };
+        let Some((gpu, assets, size)) = instance.show_context() else {
+            return Some(Err(format!("{command:?}: this is a scene, not a show")));
+        };
+        let snapshot = instance.snapshot();
+        let (sender, receiver) = std::sync::mpsc::channel();
+        let spawned = std::thread::Builder::new().name("indra-chain-edit".into()).spawn(move || {
+            let built = SceneInstance::prepare_chain_edit(&snapshot, &gpu, &assets, size, (layer, edit));
+            let _ = sender.send(built);
+        });
+        match spawned {
+            Ok(_) => self.building = Some((command, receiver)),
+            // No thread to be had: the edit is built when it is applied.
+            Err(_) => return Some(Ok(ControlEvent::Show(command))),
+        }
+        None
+    }
+}
