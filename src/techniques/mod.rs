@@ -34,6 +34,7 @@ pub mod text_mesh;
 pub mod video;
 pub mod visibility;
 pub mod warp;
+pub mod wgsl_effect;
 
 use crate::assets::{AssetKind, Assets};
 use crate::gpu::{Gpu, ShaderError};
@@ -61,6 +62,7 @@ pub const REGISTRY: &[TechniqueInfo] = &[
     camera::INFO,
     ndi::INFO,
     isf::INFO,
+    wgsl_effect::INFO,
 ];
 
 /// Finds a technique by the name scenes use.

@@ -181,7 +181,8 @@ fn effects_a_show_cannot_play_are_located_errors() {
     let cases = [
         (r#"(effect: "shaders/isf/Mosaic.fs")"#, "takes 2 images"),
         (r#"(effect: "kleinian")"#, "takes 0 images"),
-        (r#"(effect: "no_such_thing")"#, "not an ISF filter file"),
+        (r#"(effect: "no_such_thing")"#, "not an ISF filter (.fs), a WGSL effect"),
+        (r#"(effect: "kleinian.wgsl")"#, "starts with `// extends: effect.wgsl`"),
         (r#"(effect: "shaders/isf/Nope.fs")"#, "Nope.fs"),
         (r#"(effect: "star_glow", mix: 1.5)"#, "mix 1.5 must be 0–1"),
         (r#"(effect: "star_glow", params: { "glare": 1.0 })"#, "glare"),
@@ -209,6 +210,13 @@ fn every_bundled_isf_filter_and_image_technique_is_an_effect() {
         }
     }
     assert_eq!(filters, 43, "bundled ISF filters accepted as effects");
+    let library = indra::scene::show::effects::library::read_library(&assets);
+    assert_eq!(library.iter().filter(|n| n.ends_with(".fs")).count(), 43, "{library:?}");
+    for wgsl in ["effect_mirror.wgsl", "effect_grade.wgsl"] {
+        assert!(library.iter().any(|n| n == wgsl), "{wgsl} is not in the library");
+        parse_show(&assets, "all.ron", &limit_set_show("", &format!(r#"(effect: "{wgsl}")"#), ""), false)
+            .unwrap_or_else(|e| panic!("{wgsl}: {e}"));
+    }
     for technique in ["star_glow", "warp", "tessellation", "fader"] {
         let effect = format!(r#"(effect: "{technique}")"#);
         parse_show(&assets, "all.ron", &limit_set_show("", &effect, ""), false)
@@ -336,4 +344,25 @@ fn effects_edited_over_osc_in_a_running_show_change_the_tree_and_replay_to_the_s
     assert!(replayed == frame_of(&limit_set_show("", &chain, ""), last + 1), "the replay differs from the chain built");
     let bypass_off = chain.replace("bypass: true", "bypass: false");
     assert!(replayed != frame_of(&limit_set_show("", &bypass_off, ""), last + 1), "the bypass was not replayed");
+}
+
+#[test]
+fn a_wgsl_effect_mirrors_the_left_half_by_its_amount() {
+    let plain = frame_of(&limit_set_show("", "", ""), 0);
+    let mirror = |amount: f32| {
+        let effect = format!(r#"(effect: "effect_mirror.wgsl", params: {{ "amount": {amount:?} }})"#);
+        frame_of(&limit_set_show("", &effect, ""), 0)
+    };
+    assert!(mirror(0.0) == plain, "amount 0 changed the image");
+    let full = mirror(1.0);
+    let (w, h) = (SIZE.0 as usize, SIZE.1 as usize);
+    let at = |img: &[u8], x: usize, y: usize| img[(y * w + x) * 4..(y * w + x) * 4 + 3].to_vec();
+    for y in 0..h {
+        for x in 0..w / 2 {
+            // The left half is the image; the right half its mirror.
+            assert_eq!(at(&full, x, y), at(&plain, x, y), "left ({x}, {y})");
+            assert_eq!(at(&full, w - 1 - x, y), at(&plain, x, y), "right ({}, {y})", w - 1 - x);
+        }
+    }
+    assert!(full != plain, "the limit set is symmetric: the test would prove nothing");
 }

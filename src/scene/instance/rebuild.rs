@@ -100,8 +100,15 @@ impl NodeRebuild {
         output_size: (u32, u32),
     ) -> Result<Self, ShaderError> {
         let scene = &snapshot.scene;
+        // A technique's own shaders, or the file a node names (a WGSL effect's).
+        let names_file = |i: usize| {
+            let node = &scene.nodes[i];
+            let file = node.technique.declare.and_then(|d| node.params.index(d.file_param));
+            matches!(file.map(|p| snapshot.params[i].value_at(p)),
+                Some(crate::params::ParamValue::Text(f)) if f.as_str().rsplit('/').next() == Some(name))
+        };
         let nodes = (0..scene.nodes.len())
-            .filter(|&i| scene.nodes[i].technique.shaders.contains(&name))
+            .filter(|&i| scene.nodes[i].technique.shaders.contains(&name) || names_file(i))
             .map(|i| Ok((i, create_node(scene, i, &snapshot.params[i], gpu, assets, output_size)?)))
             .collect::<Result<Vec<_>, ShaderError>>()?;
         let mixer = match &scene.show {

@@ -60,7 +60,10 @@ fn effect_node(
             technique.name.to_string()
         }
         None if techniques::find(&effect.effect).is_some() => effect.effect.clone(),
-        None => return Err(located("not an ISF filter file (.fs) nor a technique that takes an image".into())),
+        None => {
+            let message = "not an ISF filter (.fs), a WGSL effect (.wgsl) nor a technique that takes an image";
+            return Err(located(message.into()));
+        }
     };
     let node = NodeFile {
         id: id.to_string(),
