@@ -238,7 +238,8 @@ fn effects_added_moved_and_removed_live_give_the_chain_the_file_would() {
     let diagonalize = Text::new("shaders/isf/Diagonalize.fs");
     r.schedule(2, vec![edit(Some(0), EffectEdit::Add(diagonalize))]);
     r.schedule(4, vec![edit(Some(0), EffectEdit::Move { from: 1, to: 0 })]);
-    r.schedule(6, vec![edit(Some(0), EffectEdit::Remove(0)), edit(None, EffectEdit::Add(diagonalize))]);
+    r.schedule(5, vec![edit(Some(0), EffectEdit::Move { from: 0, to: 1 })]);
+    r.schedule(6, vec![edit(Some(0), EffectEdit::Remove(1)), edit(None, EffectEdit::Add(diagonalize))]);
     // Refused, told, and the show plays on: no effect 9, no such file.
     r.schedule(7, vec![edit(Some(0), EffectEdit::Remove(8)), edit(Some(0), EffectEdit::Add(Text::new("nope.fs")))]);
     let frames: Vec<Vec<u8>> = (0..8).map(|_| r.render_next().unwrap().rgba).collect();
@@ -246,6 +247,8 @@ fn effects_added_moved_and_removed_live_give_the_chain_the_file_would() {
     assert!(frames[1] == want(KALEIDOSCOPE.into(), "", 1), "before the edits");
     assert!(frames[2] == want(format!("{KALEIDOSCOPE}, {PLAIN_DIAGONALIZE}"), "", 2), "after the add");
     assert!(frames[4] == want(format!("{PLAIN_DIAGONALIZE}, {KALEIDOSCOPE}"), "", 4), "after the move");
+    assert!(frames[4] != frames[3], "the move changed nothing");
+    assert!(frames[5] == frames[3], "moving the effect back did not restore the picture");
     assert!(frames[6] == want(KALEIDOSCOPE.into(), PLAIN_DIAGONALIZE, 6), "after the remove and the master's add");
     assert!(frames[7] == frames[6], "a refused edit changed the picture");
     let messages = r.instance_mut().take_messages().join("\n");
