@@ -100,6 +100,8 @@ fn main() -> ExitCode {
         Some(Command::Bench(args)) => cli::bench(&assets, &gpu, &args),
         Some(Command::Triangulate(args)) => cli::triangulate(&args),
     };
+    // GPU objects let go of off the render thread are released before the driver unloads.
+    indra::gpu::wait_for_drops(std::time::Duration::from_secs(5));
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {

@@ -74,4 +74,16 @@ impl ChainEdits {
         }
         None
     }
+
+    /// Waits (at most [`FINISH_WAIT`]) for the build under way, if any, and drops it: the show is
+    /// ending.
+    pub fn finish(&mut self) {
+        if let Some((_, receiver)) = self.building.take() {
+            let _ = receiver.recv_timeout(FINISH_WAIT);
+        }
+        self.queue.clear();
+    }
 }
+
+/// How long the end of the show waits for an edit's build.
+pub const FINISH_WAIT: std::time::Duration = std::time::Duration::from_secs(10);

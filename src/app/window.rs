@@ -223,6 +223,8 @@ impl ApplicationHandler for WindowApp {
         if let Some(r) = self.running.as_mut() {
             r.stop_recording();
             r.wait_for_takes();
+            // A build still running when the process ends would call the driver as it unloads.
+            r.chain_edits.finish();
             for (_, send) in std::mem::take(&mut r.sends) {
                 match send.finish(&r.gpu.device) {
                     Ok(report) => log::info!("send ended: {report}"),

@@ -134,6 +134,9 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         stats = Some(s);
     }
     renderer.finish_timings();
+    if let Some(edits) = edits {
+        edits.finish();
+    }
     let wall_median = record.wall_median();
     say!("scene      {name}");
     say!("adapter    {adapter}");

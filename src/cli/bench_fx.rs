@@ -55,4 +55,12 @@ impl EffectToggle {
         self.due = i + self.every;
         Ok(true)
     }
+
+    /// Waits for the edit being built, if any: a build still running at exit would call the
+    /// driver as it unloads.
+    pub fn finish(self) {
+        if let Some((_, receiver)) = self.building {
+            let _ = receiver.recv();
+        }
+    }
 }

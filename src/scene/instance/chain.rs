@@ -58,7 +58,9 @@ impl SceneInstance {
         let (gpu, assets, size) = show.context();
         let (gpu, assets) = (gpu.clone(), assets.clone());
         let prepared = self.prepared.take().filter(|(c, _)| *c == command).map(|(_, r)| r);
+        let started = std::time::Instant::now();
         let installed = prepared.map(|r| self.install(r));
+        log::debug!("chain edit installed in {:.3} ms", started.elapsed().as_secs_f64() * 1e3);
         let remap = match installed {
             Some(Ok(remap)) => remap,
             // Not built ahead, or built for a scene that has changed since: built now.

@@ -166,12 +166,13 @@ impl SceneInstance {
         );
         self.nodes = fresh.into_iter().map(|n| n.expect("every node kept or created")).collect();
         self.params = params;
-        self.scene = scene;
+        crate::gpu::drop_later(std::mem::replace(&mut self.scene, scene));
         if let (Some(show), Some(old)) = (&mut show, &self.show) {
             let messages = show.carry_over(old, &self.scene, &self.params, &mut self.nodes, &|n| in_place[n]);
             self.messages.extend(messages);
         }
-        self.show = show;
+        // What the switch lets go of (GPU objects) is released off the render thread.
+        crate::gpu::drop_later((std::mem::replace(&mut self.show, show), old_nodes));
         self.overridden.clear();
         self.morph = None;
         self.pending_morph = None;
