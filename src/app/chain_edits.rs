@@ -57,20 +57,11 @@ impl ChainEdits {
             });
         }
         let command = self.queue.pop_front()?;
-        let ShowCommand::Effect { layer, edit } = command else { return None };
-        let Some((gpu, assets, size)) = instance.show_context() else {
-            return Some(Err(format!("{command:?}: this is a scene, not a show")));
-        };
-        let snapshot = instance.snapshot();
-        let (sender, receiver) = std::sync::mpsc::channel();
-        let spawned = std::thread::Builder::new().name("indra-chain-edit".into()).spawn(move || {
-            let built = SceneInstance::prepare_chain_edit(&snapshot, &gpu, &assets, size, (layer, edit));
-            let _ = sender.send(built);
-        });
-        match spawned {
-            Ok(_) => self.building = Some((command, receiver)),
+        match instance.build_ahead(command) {
+            Ok(receiver) => self.building = Some((command, receiver)),
             // No thread to be had: the edit is built when it is applied.
-            Err(_) => return Some(Ok(ControlEvent::Show(command))),
+            Err(_) if instance.show().is_some() => return Some(Ok(ControlEvent::Show(command))),
+            Err(e) => return Some(Err(e)),
         }
         None
     }

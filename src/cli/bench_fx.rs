@@ -6,7 +6,7 @@ use std::sync::mpsc::Receiver;
 
 use indra::offscreen::OffscreenRenderer;
 use indra::params::{ControlEvent, EffectEdit, ShowCommand, Text};
-use indra::scene::{Replacement, SceneInstance};
+use indra::scene::Replacement;
 
 /// The effect's turns: the next edit, its build, and when it is due.
 pub struct EffectToggle {
@@ -32,13 +32,7 @@ impl EffectToggle {
         let Some((command, receiver)) = &self.building else {
             let edit = if self.added { EffectEdit::Remove(self.place) } else { EffectEdit::Add(self.effect) };
             let command = ShowCommand::Effect { layer: Some(0), edit };
-            let instance = renderer.instance_mut();
-            let (gpu, assets, size) = instance.show_context().ok_or("--fx-every needs a show")?;
-            let snapshot = instance.snapshot();
-            let (sender, receiver) = std::sync::mpsc::channel();
-            std::thread::spawn(move || {
-                let _ = sender.send(SceneInstance::prepare_chain_edit(&snapshot, &gpu, &assets, size, (Some(0), edit)));
-            });
+            let receiver = renderer.instance_mut().build_ahead(command)?;
             self.building = Some((command, receiver));
             return Ok(false);
         };

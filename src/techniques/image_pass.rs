@@ -30,6 +30,51 @@ pub fn bindings(inputs: usize) -> Vec<(&'static str, u32)> {
     names
 }
 
+/// The uniform block of the kernels a performer writes (show transitions, WGSL effects): one
+/// value (a transition's progress, an effect's amount), the clock, and the output's shape.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct PatternUniforms {
+    /// The kernel's one value, 0–1.
+    pub value: f32,
+    /// Seconds of its clock.
+    pub seconds: f32,
+    /// Width / height of the output.
+    pub aspect: f32,
+    /// Padding.
+    pub pad: f32,
+    /// Output size in pixels.
+    pub size: [f32; 2],
+    /// Padding to 32 bytes.
+    pub pad2: [f32; 2],
+}
+
+impl PatternUniforms {
+    /// The block for `value` at `seconds`, over an output of `size`.
+    pub fn new(value: f32, seconds: f32, (w, h): (u32, u32)) -> Self {
+        let aspect = w as f32 / h.max(1) as f32;
+        Self { value, seconds, aspect, pad: 0.0, size: [w as f32, h as f32], pad2: [0.0; 2] }
+    }
+}
+
+/// The compute entry point `name` that indra appends to a performer's kernel: one invocation
+/// per output pixel, writing `color` (a WGSL expression of `uv`, 0–1 from the top left) to `dst`.
+pub fn pixel_entry_point(name: &str, color: &str) -> String {
+    format!(
+        "
+@compute @workgroup_size(8, 8)
+fn {name}(@builtin(global_invocation_id) id: vec3<u32>) {{
+    let size = textureDimensions(dst);
+    if id.x >= size.x || id.y >= size.y {{
+        return;
+    }}
+    let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(size);
+    textureStore(dst, vec2<i32>(id.xy), {color});
+}}
+"
+    )
+}
+
 /// A compiled image kernel: pipeline, layout and sampler.
 pub struct ImageKernel {
     compute: ComputeKernel,

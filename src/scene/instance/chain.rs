@@ -4,6 +4,8 @@
 //! then [`SceneInstance::offer_prepared`]); a render builds it when the event is applied. Either
 //! way it takes effect at the step the event is applied before, so a recording replays it exactly.
 
+use std::sync::mpsc::Receiver;
+
 use super::SceneInstance;
 use super::rebuild::{Replacement, SceneSnapshot};
 use crate::assets::Assets;
@@ -26,6 +28,25 @@ impl SceneInstance {
         // The chain's effects are built anew: an effect moved to another place is another node.
         Replacement::prepare(snapshot, scene, gpu, assets, output_size, &|n| in_chain(&n.id, &owner))
             .map_err(|e| e.to_string())
+    }
+
+    /// Starts building chain edit `command` ahead on a worker thread, from a snapshot of the show
+    /// now; its result arrives on the receiver (offer it with [`Self::offer_prepared`]).
+    pub fn build_ahead(&self, command: ShowCommand) -> Result<Receiver<Result<Replacement, String>>, String> {
+        let ShowCommand::Effect { layer, edit } = command else {
+            return Err(format!("{command:?} is not a chain edit"));
+        };
+        let (gpu, assets, size) =
+            self.show_context().ok_or_else(|| format!("{command:?}: '{}' is a scene, not a show", self.scene.name))?;
+        let snapshot = self.snapshot();
+        let (sender, receiver) = std::sync::mpsc::channel();
+        std::thread::Builder::new()
+            .name("indra-chain-edit".into())
+            .spawn(move || {
+                let _ = sender.send(Self::prepare_chain_edit(&snapshot, &gpu, &assets, size, (layer, edit)));
+            })
+            .map_err(|e| format!("no thread to build the edit on: {e}"))?;
+        Ok(receiver)
     }
 
     /// What a show builds with — the device, the assets and the output size — for building a

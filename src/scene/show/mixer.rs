@@ -16,7 +16,7 @@ use crate::assets::{AssetKind, Assets};
 use crate::gpu::{Gpu, JoinedSource, ShaderError};
 use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamSet, ParamValue, Text};
-use crate::techniques::image_pass::{ImageKernel, ImagePass};
+use crate::techniques::image_pass::{ImageKernel, ImagePass, PatternUniforms, pixel_entry_point};
 use crate::techniques::{self, NodeSetup, Technique};
 use crate::time::FrameTime;
 
@@ -30,36 +30,13 @@ pub fn transition_file(kind: &str) -> String {
     format!("transition_{kind}.wgsl")
 }
 
-/// The entry point indra appends to every transition: one invocation per output pixel.
-const ENTRY_POINT: &str = "
-@compute @workgroup_size(8, 8)
-fn transition_main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = textureDimensions(dst);
-    if id.x >= size.x || id.y >= size.y {
-        return;
-    }
-    let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(size);
-    textureStore(dst, vec2<i32>(id.xy), transition(uv, clamp(u.progress, 0.0, 1.0)));
+/// The entry point indra appends to every transition.
+fn entry_point() -> String {
+    pixel_entry_point("transition_main", "transition(uv, clamp(u.progress, 0.0, 1.0))")
 }
-";
 
-/// The base's uniform block.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct TransitionUniforms {
-    /// 0 → 1.
-    pub progress: f32,
-    /// Seconds since the transition began.
-    pub seconds: f32,
-    /// Width / height of the output.
-    pub aspect: f32,
-    /// Padding.
-    pub pad: f32,
-    /// Output size in pixels.
-    pub size: [f32; 2],
-    /// Padding to 32 bytes.
-    pub pad2: [f32; 2],
-}
+/// The base's uniform block (`progress` is its value).
+pub type TransitionUniforms = PatternUniforms;
 
 /// Whether transition kind `kind` is a shader file a technique plays (an ISF transition:
 /// `startImage`, `endImage`, `progress`) rather than a WGSL transition's name.
@@ -106,7 +83,7 @@ impl Mixer {
             let located = |message: String| ShaderError { origin: file.clone(), line: 1, column: 1, message };
             let (origin, source) = load(&file).map_err(located)?;
             let joined = JoinedSource::with_bases(&origin, &source, load).map_err(located)?;
-            let text = format!("{}\n{ENTRY_POINT}", joined.source);
+            let text = format!("{}\n{}", joined.source, entry_point());
             let size = size_of::<TransitionUniforms>() as u64;
             let kernel = ImageKernel::new(device, (joined.origin(), &text), "transition_main", 2, size)
                 .map_err(|e| joined.relocate(e))?;
@@ -192,15 +169,7 @@ impl<'r> MixerFrame<'r> {
         }
         let Some(Some(kernel)) = self.kernels.get(kind) else { return to };
         let Some(pass) = self.passes.get_mut(layer).and_then(Option::take) else { return to };
-        let (w, h) = graph.output_size();
-        let uniforms = TransitionUniforms {
-            progress: view.progress,
-            seconds: view.seconds,
-            aspect: w as f32 / h.max(1) as f32,
-            pad: 0.0,
-            size: [w as f32, h as f32],
-            pad2: [0.0; 2],
-        };
+        let uniforms = TransitionUniforms::new(view.progress, view.seconds, graph.output_size());
         pass.declare(graph, "show/transition", kernel, uniforms, &[from, to])
     }
 
@@ -215,15 +184,7 @@ impl<'r> MixerFrame<'r> {
         amount: f32,
     ) -> TextureHandle {
         let (Some(kernel), Some(pass)) = (self.mix, self.fx.get_mut(slot).and_then(Option::take)) else { return wet };
-        let (w, h) = graph.output_size();
-        let uniforms = TransitionUniforms {
-            progress: amount,
-            seconds: 0.0,
-            aspect: w as f32 / h.max(1) as f32,
-            pad: 0.0,
-            size: [w as f32, h as f32],
-            pad2: [0.0; 2],
-        };
+        let uniforms = TransitionUniforms::new(amount, 0.0, graph.output_size());
         pass.declare(graph, "show/fx_mix", kernel, uniforms, &[dry, wet])
     }
 }
@@ -248,7 +209,7 @@ mod tests {
             ("wipe", include_str!("../../../shaders/transition_wipe.wgsl")),
             ("luma", include_str!("../../../shaders/transition_luma.wgsl")),
         ] {
-            let text = format!("{base}\n{source}\n{ENTRY_POINT}");
+            let text = format!("{base}\n{source}\n{}", entry_point());
             crate::gpu::validate_wgsl(name, &text).unwrap_or_else(|e| panic!("{name}: {e}"));
         }
     }

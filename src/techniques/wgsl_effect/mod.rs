@@ -10,7 +10,7 @@ use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue, Text};
 use crate::time::FrameTime;
 
-use super::image_pass::{ImageKernel, ImagePass, bindings};
+use super::image_pass::{ImageKernel, ImagePass, PatternUniforms, bindings, pixel_entry_point};
 use super::{Declared, Declarer, NodeSetup, Technique, TechniqueInfo};
 
 /// The registry entry.
@@ -40,36 +40,13 @@ crate::technique_params! {
     }
 }
 
-/// The base's uniform block.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct EffectUniforms {
-    /// 0–1.
-    pub amount: f32,
-    /// The clock's seconds.
-    pub seconds: f32,
-    /// Width / height of the output.
-    pub aspect: f32,
-    /// Padding.
-    pub pad: f32,
-    /// Output size in pixels.
-    pub size: [f32; 2],
-    /// Padding to 32 bytes.
-    pub pad2: [f32; 2],
-}
+/// The base's uniform block (`amount` is its value).
+pub type EffectUniforms = PatternUniforms;
 
-/// The entry point indra appends to every effect: one invocation per output pixel.
-const ENTRY_POINT: &str = "
-@compute @workgroup_size(8, 8)
-fn effect_main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = textureDimensions(dst);
-    if id.x >= size.x || id.y >= size.y {
-        return;
-    }
-    let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(size);
-    textureStore(dst, vec2<i32>(id.xy), effect(uv));
+/// The entry point indra appends to every effect.
+fn entry_point() -> String {
+    pixel_entry_point("effect_main", "effect(uv)")
 }
-";
 
 /// The asset name of effect file `file` (`shaders/effect_x.wgsl` or `effect_x.wgsl`).
 fn asset_name(file: &str) -> &str {
@@ -110,7 +87,7 @@ struct WgslEffect {
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     let file = Settings::read(setup.params).file;
     let joined = setup.joined_shader_source(asset_name(file.as_str()), &bindings(1))?;
-    let text = format!("{}\n{ENTRY_POINT}", joined.source);
+    let text = format!("{}\n{}", joined.source, entry_point());
     let size = size_of::<EffectUniforms>() as u64;
     let kernel = ImageKernel::new(&setup.gpu.device, (joined.origin(), &text), "effect_main", 1, size)
         .map_err(|e| joined.relocate(e))?;
@@ -127,15 +104,7 @@ impl Technique for WgslEffect {
         inputs: &[TextureHandle],
     ) -> TextureHandle {
         let Some(&image) = inputs.first() else { return super::image_pass::black(graph) };
-        let (w, h) = graph.output_size();
-        let uniforms = EffectUniforms {
-            amount: Settings::read(params).amount,
-            seconds: time.seconds as f32,
-            aspect: w as f32 / h.max(1) as f32,
-            pad: 0.0,
-            size: [w as f32, h as f32],
-            pad2: [0.0; 2],
-        };
+        let uniforms = EffectUniforms::new(Settings::read(params).amount, time.seconds as f32, graph.output_size());
         self.pass.declare(graph, "wgsl_effect", &self.kernel, uniforms, &[image])
     }
 }
@@ -157,7 +126,7 @@ mod tests {
             ("mirror", include_str!("../../../shaders/effect_mirror.wgsl")),
             ("grade", include_str!("../../../shaders/effect_grade.wgsl")),
         ] {
-            let text = format!("{base}\n{source}\n{ENTRY_POINT}");
+            let text = format!("{base}\n{source}\n{}", entry_point());
             crate::gpu::validate_wgsl(name, &text).unwrap_or_else(|e| panic!("{name}: {e}"));
         }
     }
