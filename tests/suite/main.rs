@@ -6,6 +6,8 @@
 mod architecture;
 mod audio;
 mod browser;
+#[path = "../support/chromium.rs"]
+mod chromium;
 #[path = "../common/mod.rs"]
 mod common;
 mod control;
@@ -15,6 +17,7 @@ mod file_imports;
 mod flood;
 mod gl_transitions;
 mod graph_gpu;
+mod isf_reference;
 mod live;
 #[path = "../support/live_show.rs"]
 mod live_show;

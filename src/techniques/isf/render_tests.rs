@@ -128,6 +128,25 @@ fn a_bare_file_gets_a_scene_with_its_inputs_wired() {
     }
 }
 
+#[test]
+fn pow_and_smoothstep_give_what_gl_hosts_give_where_glsl_leaves_them_open() {
+    let (dir, assets) = shader_dir("gl-as-hosts");
+    let file = dir.join("edges.fs");
+    // Red: smoothstep with equal edges, a step; green: a negative base to an odd power, |x|^y;
+    // blue: reversed edges, a falling ramp.
+    std::fs::write(
+        &file,
+        "/*{}*/\nvoid main() { float x = isf_FragNormCoord.x;\n\
+         gl_FragColor = vec4(smoothstep(0.5, 0.5, x), pow(-0.5, 1.0), smoothstep(0.8, 0.2, x), 1.0); }\n",
+    )
+    .unwrap();
+    let frame = &render(&assets, &scene(&file, "", ""), (16, 16), &[0])[0];
+    let (left, right) = (rgb(frame, 0, 8), rgb(frame, 15, 8));
+    assert_eq!((left[0], right[0]), (0, 255), "the step at 0.5: left {left:?}, right {right:?}");
+    assert!(left[1].abs_diff(128) <= 1 && right[1].abs_diff(128) <= 1, "pow(-0.5, 1.0) = 0.5: {left:?} {right:?}");
+    assert_eq!((left[2], right[2]), (255, 0), "reversed edges fall: left {left:?}, right {right:?}");
+}
+
 /// Whether two colours are within one step of rounding.
 fn near(a: [u8; 3], b: [u8; 3]) -> bool {
     a.iter().zip(&b).all(|(x, y)| x.abs_diff(*y) <= 1)

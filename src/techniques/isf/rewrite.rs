@@ -249,6 +249,9 @@ fn replace_word(word: &str, stage: StageKind, cx: &Context<'_>) -> String {
         "vv_FragNormCoord" => return "isf_FragNormCoord".into(),
         "vv_vertShaderInit" => return "isf_vertShaderInit".into(),
         "attribute" => return "in".into(),
+        // GLSL leaves these undefined where GL hosts agree on a value (see GL_AS_HOSTS_DO).
+        "pow" => return "_isf_pow".into(),
+        "smoothstep" => return "_isf_smoothstep".into(),
         _ => {}
     }
     if cx.bools.iter().any(|b| b == word) {

@@ -113,7 +113,9 @@ pub fn translate(header: &Header, fs: &str, vs: Option<&str>) -> Result<Program,
         &[
             "#version 450".into(),
             declarations.clone(),
-            format!("{COMMON} layout(location = 0) in vec2 isf_FragNormCoord; layout(location = 0) out vec4 _isf_out;"),
+            format!(
+                "{COMMON} {GL_AS_HOSTS_DO} layout(location = 0) in vec2 isf_FragNormCoord; layout(location = 0) out vec4 _isf_out;"
+            ),
             "vec4 isf_FragColor; vec4 isf_FragCoord;".into(),
         ],
         &fs_out.text,
@@ -128,7 +130,7 @@ pub fn translate(header: &Header, fs: &str, vs: Option<&str>) -> Result<Program,
         &[
             "#version 450".into(),
             declarations.clone(),
-            format!("{COMMON} layout(location = 0) out vec2 isf_FragNormCoord; {VERT_INIT}"),
+            format!("{COMMON} {GL_AS_HOSTS_DO} layout(location = 0) out vec2 isf_FragNormCoord; {VERT_INIT}"),
         ],
         &vs_out.text,
         &format!(
@@ -150,7 +152,7 @@ pub fn translate(header: &Header, fs: &str, vs: Option<&str>) -> Result<Program,
                     "#version 450".into(),
                     format!("layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in; {declarations}"),
                     format!(
-                        "layout(set = 0, binding = {binding}, {format}) uniform writeonly image2D _isf_dst; {COMMON} \
+                        "layout(set = 0, binding = {binding}, {format}) uniform writeonly image2D _isf_dst; {COMMON} {GL_AS_HOSTS_DO} \
                          vec2 isf_FragNormCoord;"
                     ),
                     "vec4 isf_FragColor; vec4 isf_FragCoord;".into(),
@@ -184,6 +186,26 @@ fn contains_word(text: &str, word: &str) -> bool {
 
 /// The vertex stage when a shader has no `.vs`.
 const DEFAULT_VS: &str = "void main() { isf_vertShaderInit(); }\n";
+
+/// Built-ins as GL hosts compute them where GLSL leaves the result undefined and shaders rely on
+/// the hosts' answer (the reference renderer's, on SwiftShader, and desktop drivers'): `pow` of
+/// a negative base is `pow(|x|, y)` (Butterfly Wave Scrawler raises a sine to the 5th, which
+/// Vulkan drivers make NaN), and `smoothstep` is the spec's formula whatever its edges, with equal
+/// edges a step at them (RGB Halftone's dots of a channel at 0: GL divides by zero to ±∞).
+const GL_AS_HOSTS_DO: &str = "float _isf_pow(float x, float y) { return pow(abs(x), y); } \
+    vec2 _isf_pow(vec2 x, vec2 y) { return pow(abs(x), y); } vec3 _isf_pow(vec3 x, vec3 y) { return pow(abs(x), y); } \
+    vec4 _isf_pow(vec4 x, vec4 y) { return pow(abs(x), y); } \
+    float _isf_smoothstep(float a, float b, float x) { if (a == b) { return x > a ? 1.0 : 0.0; } \
+    float t = clamp((x - a) / (b - a), 0.0, 1.0); return t * t * (3.0 - 2.0 * t); } \
+    vec2 _isf_smoothstep(vec2 a, vec2 b, vec2 x) { \
+    return vec2(_isf_smoothstep(a.x, b.x, x.x), _isf_smoothstep(a.y, b.y, x.y)); } \
+    vec3 _isf_smoothstep(vec3 a, vec3 b, vec3 x) { \
+    return vec3(_isf_smoothstep(a.xy, b.xy, x.xy), _isf_smoothstep(a.z, b.z, x.z)); } \
+    vec4 _isf_smoothstep(vec4 a, vec4 b, vec4 x) { \
+    return vec4(_isf_smoothstep(a.xy, b.xy, x.xy), _isf_smoothstep(a.zw, b.zw, x.zw)); } \
+    vec2 _isf_smoothstep(float a, float b, vec2 x) { return _isf_smoothstep(vec2(a), vec2(b), x); } \
+    vec3 _isf_smoothstep(float a, float b, vec3 x) { return _isf_smoothstep(vec3(a), vec3(b), x); } \
+    vec4 _isf_smoothstep(float a, float b, vec4 x) { return _isf_smoothstep(vec4(a), vec4(b), x); }";
 
 /// Helpers both stages get (one line).
 /// `_isf_encode` takes a node's image (linear, premultiplied) to what ISF shaders expect
