@@ -9,8 +9,9 @@ use std::sync::mpsc::{Receiver, TryRecvError};
 use crate::params::{ControlEvent, ShowCommand};
 use crate::scene::{Replacement, SceneInstance};
 
-/// The most edits waiting for their build; past it an edit is dropped, told.
-pub const MAX_QUEUED_EDITS: usize = 16;
+/// The most edits waiting for their build; past it an edit is dropped, told. A preset's recall
+/// may change two chains of 16 effects: removals, additions and moves.
+pub const MAX_QUEUED_EDITS: usize = 64;
 
 /// The chain edits asked for and the one being built.
 #[derive(Default)]
@@ -64,6 +65,11 @@ impl ChainEdits {
             Err(e) => return Some(Err(e)),
         }
         None
+    }
+
+    /// Whether no edit waits or builds.
+    pub fn is_idle(&self) -> bool {
+        self.queue.is_empty() && self.building.is_none()
     }
 
     /// Waits (at most [`FINISH_WAIT`]) for the build under way, if any, and drops it: the show is

@@ -427,6 +427,12 @@ impl Running {
                 }
             }
         }
+        // A preset's values morph once the chains are as the preset holds them.
+        if self.chain_edits.is_idle()
+            && let Some(morph) = self.hub.recall_after_chain_edits(self.player.instance().scene())
+        {
+            events.push(morph);
+        }
     }
 
     fn reload(&mut self) {

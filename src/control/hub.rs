@@ -11,7 +11,7 @@ use super::midi::{LearnStore, MidiInput, MidiMapper, MidiParser};
 use super::osc::OscReceiver;
 use super::osc_route::{OscRouter, RecordRequest, Routed};
 use super::oscquery::OscQueryServer;
-use super::presets::PresetStore;
+use super::presets::{PresetFile, PresetStore};
 use super::record::Recorder;
 use super::site::SiteRules;
 use super::tempo::TempoInput;
@@ -116,6 +116,8 @@ pub struct ControlHub {
     /// Preset names, re-read on save and every [`PRESET_RESCAN_FRAMES`] frames (not per frame:
     /// the panel shows them every frame).
     preset_names: Vec<String>,
+    /// A recall waiting for its effect chain edits: name, preset, morph seconds.
+    pending_recall: Option<(String, PresetFile, f64)>,
 }
 
 /// Frames between re-reads of the preset folder (files may be copied in by hand).
@@ -199,6 +201,7 @@ impl ControlHub {
             link,
             frame_count: 0,
             preset_names,
+            pending_recall: None,
         }
     }
 
@@ -326,20 +329,44 @@ impl ControlHub {
         events
     }
 
-    /// The event that recalls preset `name` over `seconds`, or nothing (with a notice).
-    pub fn recall(&mut self, name: &str, seconds: f64, scene: &Scene) -> Option<ControlEvent> {
-        match self.presets.load(name, scene) {
-            Ok((values, warnings)) => {
-                for w in warnings {
-                    self.notice(w);
-                }
-                Some(ControlEvent::Morph { values, seconds })
-            }
+    /// The events that recall preset `name` over `seconds`: its values' morph; or, where its
+    /// effect chains differ from the show's, the chain edits first, the morph then coming from
+    /// [`Self::recall_after_chain_edits`] once they are applied (its new effects have no
+    /// parameters before). Nothing, with a notice, for a preset that cannot be read.
+    pub fn recall(&mut self, name: &str, seconds: f64, scene: &Scene) -> Vec<ControlEvent> {
+        let file = match self.presets.read(name) {
+            Ok(file) => file,
             Err(e) => {
                 self.notice(e);
-                None
+                return Vec::new();
             }
+        };
+        let (edits, warnings) = file.chain_edits_for(scene);
+        for w in warnings {
+            self.notice(w);
         }
+        if edits.is_empty() {
+            self.pending_recall = None;
+            return vec![self.morph_to(name, &file, seconds, scene)];
+        }
+        self.pending_recall = Some((name.to_string(), file, seconds));
+        edits.into_iter().map(ControlEvent::Show).collect()
+    }
+
+    /// The morph of a recall that waited for its chain edits, if one waits: call when no edit
+    /// waits to be applied, with the scene they made.
+    pub fn recall_after_chain_edits(&mut self, scene: &Scene) -> Option<ControlEvent> {
+        let (name, file, seconds) = self.pending_recall.take()?;
+        Some(self.morph_to(&name, &file, seconds, scene))
+    }
+
+    /// The morph to preset `file`'s values in `scene`, telling what does not fit.
+    fn morph_to(&mut self, name: &str, file: &PresetFile, seconds: f64, scene: &Scene) -> ControlEvent {
+        let (values, warnings) = file.values_for(name, scene);
+        for w in warnings {
+            self.notice(w);
+        }
+        ControlEvent::Morph { values, seconds }
     }
 
     /// Saves the current values as preset `name`.

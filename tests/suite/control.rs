@@ -178,8 +178,8 @@ fn presets_save_recall_and_morph() {
     ]);
     inst.advance(&at(0));
     // Morph over 1 s: halfway at 0.5 s the number is halfway, the bool has not switched yet.
-    let recall = h.recall("bright", 1.0, &s).unwrap();
-    inst.apply(&[recall]);
+    let recall = h.recall("bright", 1.0, &s);
+    inst.apply(&recall);
     for f in 1..=6 {
         inst.advance(&at(f));
     }
@@ -201,7 +201,7 @@ fn presets_save_recall_and_morph() {
         (ParamValue::Float(4.0), ParamValue::Bool(true))
     );
     assert_eq!(h.presets.names(), ["bright"]);
-    assert!(h.recall("missing", 0.0, &s).is_none());
+    assert!(h.recall("missing", 0.0, &s).is_empty());
     assert!(h.notices.iter().any(|n| n.contains("no preset 'missing'")));
     // MIDI program change 0 recalls the first preset by name.
     assert!(matches!(h.midi_bytes(&[0xC0, 0], &s, 0.0).as_slice(), [ControlEvent::Morph { .. }]));
@@ -261,7 +261,7 @@ fn script(s: &Scene, dir: &std::path::Path) -> Vec<(u64, Vec<ControlEvent>)> {
         (2, vec![write(scale, ParamValue::Float(3.3), Source::Osc)]),
         (3, h.midi_bytes(&[0xB0, 7, 100, 0x90, 60, 90], s, 0.3)),
         (4, vec![ControlEvent::Tempo { bpm: 90.0, resync: true }]),
-        (5, vec![h.recall("zoomed", 0.2, s).unwrap()]),
+        (5, h.recall("zoomed", 0.2, s)),
         (7, vec![ControlEvent::ResumeTracks, write(scale, ParamValue::Float(1.5), Source::Ui)]),
     ]
 }

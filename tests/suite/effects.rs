@@ -369,3 +369,77 @@ fn a_wgsl_effect_mirrors_the_left_half_by_its_amount() {
     }
     assert!(full != plain, "the limit set is symmetric: the test would prove nothing");
 }
+
+#[test]
+fn a_preset_holds_a_layers_chain_and_its_recall_rebuilds_it_and_morphs_its_values() {
+    use crate::live_show::{Show, VirtualDisplay, scratch_dir, send};
+    use rosc::OscType;
+    let display = VirtualDisplay::start();
+    let dir = scratch_dir("effects-preset");
+    let file = dir.join("effects.ron");
+    let saved_chain = format!(r#"{KALEIDOSCOPE}, (effect: "shaders/isf/Diagonalize.fs", params: {{ "width": 0.35 }})"#);
+    std::fs::write(&file, limit_set_show("", &saved_chain, "")).unwrap();
+    let query = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap();
+    // The show's presets are in `dir/presets` (live_show passes it).
+    let (presets, recording) = (dir.join("presets"), dir.join("take.ron"));
+    let args: Vec<std::ffi::OsString> =
+        vec!["--oscquery".into(), query.to_string().into(), "--record-controls".into(), recording.clone().into()];
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+    let (mut show, port) = Show::start(&display, &dir, file.to_str().unwrap(), &args);
+    show.wait_for("OSCQuery on");
+    show.wait_for("plays clip 'kleinian_classic'");
+    let osc = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    let text = |s: &str| vec![OscType::String(s.into())];
+    send(&osc, port, "/indra/preset/save", text("look"));
+    show.wait_for("saved preset");
+    let saved = std::fs::read_to_string(presets.join("look.ron")).unwrap();
+    assert!(saved.contains("chains") && saved.contains("Kaleidoscope.fs"), "the preset lacks the chain: {saved}");
+
+    // The performer changes the chain: the kaleidoscope out, a solarize in, Diagonalize wider.
+    send(&osc, port, "/indra/layer/1/fx/remove", vec![OscType::Int(1)]);
+    show.wait_for("Remove(0)");
+    send(&osc, port, "/indra/layer/1/fx/add", text("shaders/isf/Solarize.fs"));
+    show.wait_for("Add(\"shaders/isf/Solarize.fs\")");
+    send(&osc, port, "/indra/layer/1/fx/1/width", vec![OscType::Float(0.1)]);
+    // The recall edits the chain back (Solarize out, the kaleidoscope in and first), then morphs
+    // the values: the kaleidoscope's 5 sides (its default is 6) and Diagonalize's 0.35.
+    send(&osc, port, "/indra/preset/recall", text("look"));
+    show.wait_for("Remove(1)");
+    show.wait_for("Add(\"shaders/isf/Kaleidoscope.fs\")");
+    show.wait_for("Move { from: 1, to: 0 }");
+    let published = |path: &str| {
+        let (status, leaf) = crate::osc::http_get(query, path);
+        (status == 200).then(|| leaf["VALUE"][0].as_f64()).flatten()
+    };
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    loop {
+        let (sides, width) = (published("/indra/layer/1/fx/1/sides"), published("/indra/layer/1/fx/2/width"));
+        let solarize = published("/indra/layer/1/fx/3/mix");
+        if sides == Some(5.0) && width.is_some_and(|w| (w - 0.35).abs() < 1e-6) && solarize.is_none() {
+            break;
+        }
+        assert!(
+            std::time::Instant::now() < deadline,
+            "after the recall: sides {sides:?}, width {width:?}, a third {solarize:?}"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let _ = std::process::Command::new("kill").args(["-INT", &show.pid().to_string()]).status();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    while show.child.try_wait().unwrap().is_none() {
+        assert!(std::time::Instant::now() < deadline, "the show did not end on Ctrl-C");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    // The take replays to the saved look: the recall's edits and its morph are in it.
+    let scene = show_from(&limit_set_show("", &saved_chain, ""));
+    let script = indra::control::record::read_replay(&recording, &scene, &assets()).unwrap();
+    let last = *script.keys().last().expect("the take holds the edits");
+    let mut r = OffscreenRenderer::new(gpu(), &assets(), scene, Some(SIZE), None, None).unwrap();
+    for (frame, events) in script {
+        r.schedule(frame, events);
+    }
+    r.seek(last + 1).unwrap();
+    let replayed = r.render_next().unwrap().rgba;
+    assert!(replayed == frame_of(&limit_set_show("", &saved_chain, ""), last + 1), "the replay is not the saved look");
+}

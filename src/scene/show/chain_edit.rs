@@ -98,3 +98,114 @@ pub fn edited_show(
 
 /// The longest effect file name an edit carries.
 pub const MAX_EFFECT_NAME: usize = Text::CAPACITY;
+
+/// Each layer's chain and the master's as they play now: (owner, effect names in order).
+pub fn chains(show: &Show) -> Vec<(String, Vec<String>)> {
+    let Some(source) = show.file.as_deref() else { return Vec::new() };
+    let names = |effects: &[EffectFile]| effects.iter().map(|e| e.effect.clone()).collect();
+    let layers = source.file.layers.iter().enumerate().map(|(l, layer)| (chain_owner(Some(l)), names(&layer.effects)));
+    layers.chain([(chain_owner(None), names(&source.file.effects))]).collect()
+}
+
+/// The layer a chain owner names (`layer/<n>` → `Some(Some(n − 1))`, `master` → `Some(None)`).
+pub fn owner_layer(owner: &str) -> Option<Option<usize>> {
+    if owner == "master" {
+        return Some(None);
+    }
+    let n: usize = owner.strip_prefix("layer/")?.parse().ok()?;
+    n.checked_sub(1).map(Some)
+}
+
+/// The edits that make chain `current` into `target`, fewest moves of the effects both have
+/// (those keep their state): removals of what `target` lacks (from the end, so positions hold),
+/// additions of what `current` lacks, then moves into `target`'s order. Or the name too long for
+/// an edit.
+pub fn edits_between(current: &[String], target: &[String]) -> Result<Vec<EffectEdit>, String> {
+    if let Some(long) = target.iter().find(|t| t.len() > MAX_EFFECT_NAME) {
+        return Err(format!("the effect name '{long}' is longer than {MAX_EFFECT_NAME} bytes"));
+    }
+    // Which of the current effects stay: for each wanted one, the first unclaimed of its name.
+    let mut kept = vec![false; current.len()];
+    let mut missing = Vec::new();
+    for t in target {
+        match (0..current.len()).find(|&i| !kept[i] && current[i] == *t) {
+            Some(i) => kept[i] = true,
+            None => missing.push(t.clone()),
+        }
+    }
+    let mut edits = Vec::new();
+    let mut chain: Vec<String> = Vec::new();
+    for i in (0..current.len()).rev() {
+        if !kept[i] {
+            edits.push(EffectEdit::Remove(i));
+        }
+    }
+    chain.extend(current.iter().zip(&kept).filter(|(_, k)| **k).map(|(c, _)| c.clone()));
+    for name in missing {
+        edits.push(EffectEdit::Add(Text::new(&name)));
+        chain.push(name);
+    }
+    for (to, wanted) in target.iter().enumerate() {
+        let from = (to..chain.len()).find(|&j| chain[j] == *wanted).expect("every wanted effect is in the chain");
+        if from != to {
+            let moved = chain.remove(from);
+            chain.insert(to, moved);
+            edits.push(EffectEdit::Move { from, to });
+        }
+    }
+    Ok(edits)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Applies `edits` to `chain` as `edited_show` does.
+    fn apply(chain: &[&str], edits: &[EffectEdit]) -> Vec<String> {
+        let mut chain: Vec<String> = chain.iter().map(|s| s.to_string()).collect();
+        for edit in edits {
+            match *edit {
+                EffectEdit::Add(name) => chain.push(name.as_str().to_string()),
+                EffectEdit::Remove(n) => {
+                    chain.remove(n);
+                }
+                EffectEdit::Move { from, to } => {
+                    let moved = chain.remove(from);
+                    chain.insert(to, moved);
+                }
+            }
+        }
+        chain
+    }
+
+    #[test]
+    fn the_edits_between_two_chains_make_the_one_into_the_other() {
+        let s = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        let cases: [(&[&str], &[&str]); 6] = [
+            (&["a", "b"], &["a", "b"]),
+            (&[], &["a", "b"]),
+            (&["a", "b", "c"], &[]),
+            (&["a", "b", "c"], &["c", "a"]),
+            (&["a", "x", "b"], &["b", "y", "a", "a"]),
+            (&["a", "a", "b"], &["a", "b", "a"]),
+        ];
+        for (current, target) in cases {
+            let edits = edits_between(&s(current), &s(target)).unwrap();
+            assert_eq!(apply(current, &edits), s(target), "{current:?} → {target:?} by {edits:?}");
+        }
+        // Equal chains need nothing; kept effects are moved, never removed and added again.
+        assert!(edits_between(&s(&["a", "b"]), &s(&["a", "b"])).unwrap().is_empty());
+        let swap = edits_between(&s(&["a", "b"]), &s(&["b", "a"])).unwrap();
+        assert_eq!(swap, [EffectEdit::Move { from: 1, to: 0 }]);
+        assert!(edits_between(&[], &[("x".repeat(MAX_EFFECT_NAME + 1))]).is_err());
+    }
+
+    #[test]
+    fn owners_name_layers_from_one_and_the_master() {
+        assert_eq!(owner_layer("layer/1"), Some(Some(0)));
+        assert_eq!(owner_layer("master"), Some(None));
+        assert_eq!(owner_layer("layer/0"), None);
+        assert_eq!(owner_layer("clip/2"), None);
+        assert_eq!(chain_owner(owner_layer("layer/3").unwrap()), "layer/3");
+    }
+}
