@@ -2,13 +2,15 @@
 //! bypass, its dry/wet mix and buttons to move it up or down or remove it, and a picker that adds
 //! one from the library (every ISF filter there is, and the techniques that take an image). Every
 //! click is a control event, as OSC sends them; an added effect is built off the render thread.
+//! A right-click on a button or a library entry learns a MIDI note for that edit.
 
+use crate::control::hub::ControlHub;
 use crate::params::{ControlEvent, EffectEdit, ParamValue, ParamWrite, ShowCommand, Source, Text};
 use crate::scene::SceneInstance;
 use crate::scene::show::effects::{BYPASS, MIX, library};
 
 /// Draws every chain of `instance`'s show (nothing for a scene); returns what was clicked.
-pub fn effects_panel(ui: &mut egui::Ui, instance: &SceneInstance) -> Vec<ControlEvent> {
+pub fn effects_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub) -> Vec<ControlEvent> {
     let mut events = Vec::new();
     let Some((show, _)) = instance.show() else { return events };
     let chains = show.layers.iter().enumerate().map(|(l, layer)| (Some(l), layer.name.clone(), &layer.effects));
@@ -17,7 +19,7 @@ pub fn effects_panel(ui: &mut egui::Ui, instance: &SceneInstance) -> Vec<Control
         library::start(&assets);
     }
     for (layer, name, effects) in chains {
-        let edit = |edit| ControlEvent::Show(ShowCommand::Effect { layer, edit });
+        let command = |edit| ShowCommand::Effect { layer, edit };
         ui.push_id(("effects", layer), |ui| {
             egui::CollapsingHeader::new(format!("effects: {name} ({})", effects.len())).show(ui, |ui| {
                 for (k, &node) in effects.iter().enumerate() {
@@ -33,15 +35,21 @@ pub fn effects_panel(ui: &mut egui::Ui, instance: &SceneInstance) -> Vec<Control
                                 events.push(ControlEvent::Write(write));
                             }
                         }
-                        if k > 0 && ui.small_button("up").clicked() {
-                            events.push(edit(EffectEdit::Move { from: k, to: k - 1 }));
+                        let mut button = |label: &str, edit| {
+                            let command = command(edit);
+                            let clicked = ui.small_button(learn_mark(label, command, hub)).on_hover_text(LEARN_HINT);
+                            if clicked.secondary_clicked() {
+                                hub.learn_command(command);
+                            }
+                            clicked.clicked().then_some(ControlEvent::Show(command))
+                        };
+                        if k > 0 {
+                            events.extend(button("up", EffectEdit::Move { from: k, to: k - 1 }));
                         }
-                        if k + 1 < effects.len() && ui.small_button("down").clicked() {
-                            events.push(edit(EffectEdit::Move { from: k, to: k + 1 }));
+                        if k + 1 < effects.len() {
+                            events.extend(button("down", EffectEdit::Move { from: k, to: k + 1 }));
                         }
-                        if ui.small_button("remove").clicked() {
-                            events.push(edit(EffectEdit::Remove(k)));
-                        }
+                        events.extend(button("remove", EffectEdit::Remove(k)));
                     });
                 }
                 let Some(names) = library::names() else {
@@ -50,8 +58,14 @@ pub fn effects_panel(ui: &mut egui::Ui, instance: &SceneInstance) -> Vec<Control
                 };
                 egui::ComboBox::from_id_salt("add").selected_text("add an effect").show_ui(ui, |ui| {
                     for effect in names {
-                        if ui.selectable_label(false, effect.as_str()).clicked() {
-                            events.push(edit(EffectEdit::Add(Text::new(effect))));
+                        let command = command(EffectEdit::Add(Text::new(effect)));
+                        let entry =
+                            ui.selectable_label(false, learn_mark(effect, command, hub)).on_hover_text(LEARN_HINT);
+                        if entry.clicked() {
+                            events.push(ControlEvent::Show(command));
+                        }
+                        if entry.secondary_clicked() {
+                            hub.learn_command(command);
                         }
                     }
                 });
@@ -59,6 +73,20 @@ pub fn effects_panel(ui: &mut egui::Ui, instance: &SceneInstance) -> Vec<Control
         });
     }
     events
+}
+
+/// What a right-click does.
+const LEARN_HINT: &str = "right-click, then play a note: MIDI learn";
+
+/// `label` with a mark of its MIDI learn state (ASCII: egui's bundled fonts lack dot glyphs).
+fn learn_mark(label: &str, command: ShowCommand, hub: &ControlHub) -> String {
+    if hub.mapper.learning_command == Some(command) {
+        format!("{label} ?")
+    } else if hub.mapper.command_bindings().iter().any(|b| b.command == command) {
+        format!("{label} M")
+    } else {
+        label.to_string()
+    }
 }
 
 /// What effect node `node` plays: its file's name, else its technique's.

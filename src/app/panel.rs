@@ -188,7 +188,7 @@ pub fn draw_ui(
                 ui.small(hub.status());
                 super::web_panel::web_panel(ui, &hub.web_urls);
                 events.extend(super::show_panel::show_panel(ui, instance, hub));
-                events.extend(super::effects_panel::effects_panel(ui, instance));
+                events.extend(super::effects_panel::effects_panel(ui, instance, hub));
                 events.extend(param_panel(ui, instance, hub).into_iter().map(ControlEvent::Write));
                 ui.separator();
                 events.extend(preset_panel(ui, instance, overlay, hub));

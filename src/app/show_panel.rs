@@ -38,8 +38,9 @@ pub fn show_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut Control
                 if broken {
                     hint.push_str(" — could not be loaded");
                 }
-                let learning = hub.mapper.learning_clip == Some((l, c));
-                let learned = hub.mapper.clip_bindings().iter().any(|b| (b.layer, b.clip) == (l, c));
+                let command = ShowCommand::Trigger { layer: l, clip: Some(c) };
+                let learning = hub.mapper.learning_command == Some(command);
+                let learned = hub.mapper.command_bindings().iter().any(|b| b.command == command);
                 // ASCII marks: egui's bundled fonts lack the usual dot glyphs.
                 let mark = match (broken, learning, learned) {
                     (true, _, _) => " !",

@@ -16,7 +16,7 @@ use super::record::Recorder;
 use super::site::SiteRules;
 use super::tempo::TempoInput;
 use super::web::WebOptions;
-use crate::params::{ControlEvent, Remap, Target};
+use crate::params::{ControlEvent, Remap, ShowCommand, Target};
 use crate::scene::{AudioSource, Scene, SceneView};
 
 /// Which control sources to open.
@@ -312,7 +312,7 @@ impl ControlHub {
         for e in self.parser.feed(bytes) {
             // The note that is being learned only binds; it triggers from then on.
             if !self.mapper.is_learning() {
-                let commands = super::midi::cue_commands(e, scene).into_iter().chain(self.mapper.clip_commands(e));
+                let commands = super::midi::cue_commands(e, scene).into_iter().chain(self.mapper.note_commands(e));
                 events.extend(commands.map(ControlEvent::Show));
             }
             let (writes, program) = self.mapper.handle(e, scene, seconds);
@@ -393,15 +393,21 @@ impl ControlHub {
 
     /// Starts MIDI learn for `target`: the next control moved is bound to it.
     pub fn learn(&mut self, target: Target) {
-        self.mapper.learning_clip = None;
+        self.mapper.learning_command = None;
         self.mapper.learning = Some(target);
     }
 
     /// Starts MIDI learn for clip `clip` of layer `layer` of a show (from 0): the next note
     /// triggers it from then on, and is saved in the learn file.
     pub fn learn_clip(&mut self, layer: usize, clip: usize) {
+        self.learn_command(ShowCommand::Trigger { layer, clip: Some(clip) });
+    }
+
+    /// Starts MIDI learn for a show command (a clip trigger, an effect chain edit): the next note
+    /// sends it from then on, and is saved in the learn file.
+    pub fn learn_command(&mut self, command: ShowCommand) {
         self.mapper.learning = None;
-        self.mapper.learning_clip = Some((layer, clip));
+        self.mapper.learning_command = Some(command);
     }
 
     /// Removes a parameter's MIDI bindings and saves the learn file.

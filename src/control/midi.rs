@@ -5,7 +5,8 @@
 use std::collections::VecDeque;
 use std::path::PathBuf;
 
-use crate::params::{ParamDecl, ParamType, ParamValue, ParamWrite, Source, Target};
+use super::midi_commands::{CommandBinding, command_address, note_mapping, parse_command_address, show_clip_notes};
+use crate::params::{ParamDecl, ParamType, ParamValue, ParamWrite, ShowCommand, Source, Target};
 use crate::scene::{MidiCurve, MidiMapping, Scene, resolve_target, ron_options};
 
 /// One decoded MIDI message. Channels are 1–16.
@@ -124,35 +125,6 @@ pub fn cue_commands(event: MidiEvent, scene: &Scene) -> Vec<crate::params::ShowC
     go.into_iter().chain(back).collect()
 }
 
-/// The clip notes a show file gives (`note`, `channel`), as bindings.
-fn show_clip_notes(scene: &Scene) -> Vec<ClipBinding> {
-    let Some(show) = &scene.show else { return Vec::new() };
-    let mut bindings = Vec::new();
-    for (layer, l) in show.layers.iter().enumerate() {
-        for (clip, &c) in l.clips.iter().enumerate() {
-            let Some((channel, note)) = show.clips[c].note else { continue };
-            let target = format!("layer/{}/clip/{}", layer + 1, clip + 1);
-            let mapping = note_mapping(channel, note, target);
-            bindings.push(ClipBinding { mapping, learned: false, layer, clip });
-        }
-    }
-    bindings
-}
-
-/// A note mapping to `target` (a clip trigger's).
-fn note_mapping(channel: Option<u8>, note: u8, target: String) -> MidiMapping {
-    MidiMapping {
-        channel,
-        cc: None,
-        note: Some(note),
-        target,
-        range: None,
-        curve: Default::default(),
-        invert: false,
-        fine: false,
-    }
-}
-
 /// Tempo from MIDI clock (24 pulses per quarter note) and transport state.
 #[derive(Debug, Default)]
 pub struct MidiClock {
@@ -188,36 +160,14 @@ pub struct Binding {
     pub target: Target,
 }
 
-/// A note bound to a show's clip: a clip's `note` in the show file, or one learned on the panel
-/// (saved with the target `layer/<n>/clip/<m>`, numbered from 1).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ClipBinding {
-    /// The note and channel, and the target as the learn file writes it.
-    pub mapping: MidiMapping,
-    /// Learned (saved in the learn file), not from the show file.
-    pub learned: bool,
-    /// The layer, from 0.
-    pub layer: usize,
-    /// The clip within the layer, from 0.
-    pub clip: usize,
-}
-
-/// The layer and clip (from 0) of a learn file target `layer/<n>/clip/<m>`, if `scene` has them.
-fn clip_target(target: &str, scene: &Scene) -> Option<(usize, usize)> {
-    let rest = target.strip_prefix("layer/")?;
-    let (layer, clip) = rest.split_once("/clip/")?;
-    let (layer, clip) = (layer.parse::<usize>().ok()?.checked_sub(1)?, clip.parse::<usize>().ok()?.checked_sub(1)?);
-    scene.show.as_ref()?.clip_at(layer, clip).map(|_| (layer, clip))
-}
-
 /// Maps events to writes; pairs 14-bit controllers; learns new bindings.
 #[derive(Debug, Default)]
 pub struct MidiMapper {
     bindings: Vec<Binding>,
-    /// Notes learned for a show's clips.
-    clips: Vec<ClipBinding>,
-    /// The show clip (layer, clip) waiting for a note (MIDI learn).
-    pub learning_clip: Option<(usize, usize)>,
+    /// Notes bound to show commands: clip triggers, effect chain edits.
+    commands: Vec<CommandBinding>,
+    /// The show command waiting for a note (MIDI learn).
+    pub learning_command: Option<ShowCommand>,
     /// Last MSB per (channel, controller 0–31), for 14-bit pairs.
     msb: [[u8; 32]; 16],
     /// The parameter waiting for a control to be moved (MIDI learn).
@@ -231,36 +181,36 @@ impl MidiMapper {
     pub fn new(scene: &Scene, learned: &[MidiMapping]) -> Self {
         let mut bindings: Vec<Binding> =
             scene.midi.iter().map(|(mapping, target)| Binding { mapping: mapping.clone(), target: *target }).collect();
-        let mut clips = show_clip_notes(scene);
+        let mut commands = show_clip_notes(scene);
         for m in learned {
-            if let Some((layer, clip)) = clip_target(&m.target, scene).filter(|_| m.note.is_some()) {
+            if let Some(command) = parse_command_address(&m.target, scene).filter(|_| m.note.is_some()) {
                 // A learned note replaces the show file's for that clip.
-                clips.retain(|b| (b.layer, b.clip) != (layer, clip));
-                clips.push(ClipBinding { mapping: m.clone(), learned: true, layer, clip });
+                commands.retain(|b| b.command != command);
+                commands.push(CommandBinding { mapping: m.clone(), learned: true, command });
             } else if let Ok(target) = resolve_target(&scene.nodes, &m.target) {
                 bindings.push(Binding { mapping: m.clone(), target });
             }
         }
-        Self { bindings, clips, ..Default::default() }
+        Self { bindings, commands, ..Default::default() }
     }
 
-    /// Whether a parameter or a clip waits for a control to be moved.
+    /// Whether a parameter or a show command waits for a control to be moved.
     pub fn is_learning(&self) -> bool {
-        self.learning.is_some() || self.learning_clip.is_some()
+        self.learning.is_some() || self.learning_command.is_some()
     }
 
-    /// The notes learned for clips.
-    pub fn clip_bindings(&self) -> &[ClipBinding] {
-        &self.clips
+    /// The notes bound to show commands.
+    pub fn command_bindings(&self) -> &[CommandBinding] {
+        &self.commands
     }
 
-    /// The triggers of the clips whose learned note `event` is.
-    pub fn clip_commands(&self, event: MidiEvent) -> Vec<crate::params::ShowCommand> {
+    /// The show commands whose note `event` is.
+    pub fn note_commands(&self, event: MidiEvent) -> Vec<ShowCommand> {
         let MidiEvent::NoteOn { channel, note, .. } = event else { return Vec::new() };
-        self.clips
+        self.commands
             .iter()
             .filter(|b| b.mapping.note == Some(note) && b.mapping.channel.is_none_or(|c| c == channel))
-            .map(|b| crate::params::ShowCommand::Trigger { layer: b.layer, clip: Some(b.clip) })
+            .map(|b| b.command)
             .collect()
     }
 
@@ -289,13 +239,14 @@ impl MidiMapper {
             MidiEvent::Program { program, .. } => return (Vec::new(), Some(program)),
             _ => {}
         }
-        if let (Some((layer, clip)), MidiEvent::NoteOn { channel, note, .. }) = (self.learning_clip, event) {
-            self.learning_clip = None;
-            self.clips.retain(|b| (b.layer, b.clip) != (layer, clip));
-            let target = format!("layer/{}/clip/{}", layer + 1, clip + 1);
-            log::info!("MIDI learn: note {note} on channel {channel} → {target}");
-            let mapping = note_mapping(Some(channel), note, target);
-            self.clips.push(ClipBinding { mapping, learned: true, layer, clip });
+        if let (Some(command), MidiEvent::NoteOn { channel, note, .. }) = (self.learning_command, event) {
+            self.learning_command = None;
+            self.commands.retain(|b| b.command != command);
+            if let Some(target) = command_address(&command) {
+                log::info!("MIDI learn: note {note} on channel {channel} → {target}");
+                let mapping = note_mapping(Some(channel), note, target);
+                self.commands.push(CommandBinding { mapping, learned: true, command });
+            }
             return (Vec::new(), None);
         }
         if let Some(target) = self.learning {
@@ -463,7 +414,7 @@ impl LearnStore {
             .iter()
             .map(|b| &b.mapping)
             .filter(|m| !scene.midi.iter().any(|(s, _)| s == *m))
-            .chain(mapper.clip_bindings().iter().filter(|b| b.learned).map(|b| &b.mapping))
+            .chain(mapper.command_bindings().iter().filter(|b| b.learned).map(|b| &b.mapping))
             .collect();
         let text = ron::ser::to_string_pretty(&learned, Default::default()).map_err(|e| e.to_string())?;
         crate::atomic_file::write(&self.path, text.as_bytes())

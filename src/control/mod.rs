@@ -15,6 +15,7 @@ pub mod hub;
 pub mod link;
 pub mod listen;
 pub mod midi;
+pub mod midi_commands;
 pub mod osc;
 mod osc_guard;
 pub mod osc_route;

@@ -443,3 +443,33 @@ fn a_preset_holds_a_layers_chain_and_its_recall_rebuilds_it_and_morphs_its_value
     let replayed = r.render_next().unwrap().rgba;
     assert!(replayed == frame_of(&limit_set_show("", &saved_chain, ""), last + 1), "the replay is not the saved look");
 }
+
+#[test]
+fn a_note_learned_for_a_chain_edit_sends_it_and_is_kept_for_the_next_run() {
+    let two_layers = limit_set_show("", KALEIDOSCOPE, "")
+        .replace("layers: [", r#"layers: [(clips: [(scene: "kleinian_classic", id: "second")]), "#);
+    let scene = show_from(&two_layers);
+    let dir = crate::live_show::scratch_dir("effects-learn");
+    let add = ShowCommand::Effect { layer: Some(1), edit: EffectEdit::Add(Text::new("shaders/isf/Diagonalize.fs")) };
+    let remove = ShowCommand::Effect { layer: None, edit: EffectEdit::Remove(0) };
+    let mut hub = crate::control::hub(&dir, &scene);
+    // The note being learned binds and does nothing else; then it sends the edit.
+    hub.learn_command(add);
+    assert!(hub.midi_bytes(&[0x90, 36, 100], &scene, 0.0).is_empty(), "the learned note fired at once");
+    hub.learn_command(remove);
+    assert!(hub.midi_bytes(&[0x90, 37, 100], &scene, 0.0).is_empty());
+    assert_eq!(hub.midi_bytes(&[0x90, 36, 100], &scene, 0.0), [ControlEvent::Show(add)]);
+    assert_eq!(hub.midi_bytes(&[0x90, 37, 100], &scene, 0.0), [ControlEvent::Show(remove)]);
+    let saved = std::fs::read_to_string(dir.join("midi-learn.ron")).unwrap();
+    assert!(
+        saved.contains("layer/2/fx/add shaders/isf/Diagonalize.fs") && saved.contains("master/fx/remove 1"),
+        "{saved}"
+    );
+    // The next run reads them back; a show without that layer drops the layer's.
+    let mut next = crate::control::hub(&dir, &scene);
+    assert_eq!(next.midi_bytes(&[0x90, 36, 1], &scene, 0.0), [ControlEvent::Show(add)]);
+    let one_layer = show_from(&limit_set_show("", "", ""));
+    let mut other = crate::control::hub(&dir, &one_layer);
+    assert!(other.midi_bytes(&[0x90, 36, 1], &one_layer, 0.0).is_empty());
+    assert_eq!(other.midi_bytes(&[0x90, 37, 1], &one_layer, 0.0), [ControlEvent::Show(remove)]);
+}
