@@ -77,6 +77,8 @@ pub struct Assets {
     files: FileRules,
     /// Whether a step waits for the files it asks for.
     load_wait: LoadWait,
+    /// The size scenes and shows are loaded to render at (the command line's `--size`).
+    output_size: Option<(u32, u32)>,
 }
 
 impl Assets {
@@ -84,7 +86,8 @@ impl Assets {
     /// Files that parameters name may lie under `root` only (see [`Assets::allowing`]).
     pub fn new(root: Option<PathBuf>) -> Self {
         let files = FileRules::new(root.clone());
-        Self { root, pinned: Arc::default(), pinned_files: Arc::default(), files, load_wait: LoadWait::default() }
+        let (pinned, pinned_files) = (Arc::default(), Arc::default());
+        Self { root, pinned, pinned_files, files, load_wait: LoadWait::default(), output_size: None }
     }
 
     /// The built-in shaders and scenes only, with these assets' file rules and load mode (what a
@@ -101,6 +104,17 @@ impl Assets {
     /// These assets with file loads running as `wait` says (a live show loads in the background).
     pub fn with_load_wait(&self, wait: LoadWait) -> Self {
         Self { load_wait: wait, ..self.clone() }
+    }
+
+    /// These assets for scenes that render at `size` (the command line's `--size`): their
+    /// texture budget is checked there rather than at each file's own size.
+    pub fn rendering_at(&self, size: Option<(u32, u32)>) -> Self {
+        Self { output_size: size, ..self.clone() }
+    }
+
+    /// The size scenes render at, if the command line gave one (see [`Assets::rendering_at`]).
+    pub fn output_size(&self) -> Option<(u32, u32)> {
+        self.output_size
     }
 
     /// Where the files that parameters name may be.

@@ -65,7 +65,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         return Err(format!("--warmup {} and --frames {} together pass {MAX_START} frames", args.warmup, args.frames));
     }
     check_timing(args.start, args.frames, None)?;
-    let assets = &with_scene_folder(assets, &args.scene);
+    let assets = &with_scene_folder(assets, &args.scene).rendering_at(Some(args.size));
     let scene = scene_with_edits(assets, &args.scene, &args.edits)?;
     scene.check_texture_budget(args.size)?;
     let cue_steps = match args.cue_every {

@@ -94,14 +94,14 @@ pub struct SceneEdits {
 }
 
 impl SceneEdits {
-    /// Applies the `--set` assignments and `--msaa` to a loaded scene.
+    /// Applies the `--set` assignments and `--msaa` to a loaded scene (the texture budget is
+    /// checked at the size it renders at, by the caller).
     fn apply(&self, mut scene: Scene) -> Result<Scene, String> {
         for assignment in &self.sets {
             scene.set_from_str(assignment)?;
         }
         if let Some(samples) = self.msaa {
             scene.msaa = samples;
-            scene.check_texture_budget(scene.size)?;
         }
         Ok(scene)
     }

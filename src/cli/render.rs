@@ -76,7 +76,7 @@ pub struct RenderArgs {
 /// Renders a PNG sequence.
 pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<(), String> {
     check_timing(args.start, args.frames, args.dt)?;
-    let assets = &with_scene_folder(assets, &args.scene);
+    let assets = &with_scene_folder(assets, &args.scene).rendering_at(args.size);
     let scene = scene_with_edits(assets, &args.scene, &args.edits)?;
     let mut script = match &args.replay {
         Some(path) => indra::control::record::read_replay(path, &scene, assets)?,

@@ -162,6 +162,7 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
     for spec in &args.output_windows {
         scene.add_output(spec)?;
     }
+    scene.check_texture_budget(scene.size)?;
     let options = indra::app::WindowOptions {
         fullscreen: args.fullscreen,
         monitor: args.monitor,

@@ -174,18 +174,49 @@ mod tests {
 
     #[test]
     fn a_scene_asking_for_too_much_texture_memory_is_refused_at_check_time() {
-        let nodes: Vec<String> = (0..100).map(|i| format!("(id: \"k{i}\", technique: \"kleinian\")")).collect();
-        let scene = |size: &str, msaa: u32| {
+        let scene = |n: usize, size: &str, msaa: u32| {
+            let nodes: Vec<String> = (0..n).map(|i| format!("(id: \"k{i}\", technique: \"kleinian\")")).collect();
             format!("(name: \"big\", size: {size}, msaa: {msaa}, nodes: [{}], output: \"k0\")", nodes.join(", "))
         };
         // 100 nodes at 4K: 100 × 8.3 Mpx × 16 B = 12.4 GiB without multisampling.
-        let e = first_error(&scene("(3840, 2160)", 1));
+        let e = first_error(&scene(100, "(3840, 2160)", 1));
         assert!(e.message.contains("12.4 GiB") && e.message.contains("at most 8 GiB"), "{e}");
-        assert!(parse_scene("ok.ron", &scene("(1920, 1080)", 1)).is_ok(), "100 nodes at 1080p fit (3.1 GiB)");
-        let e = first_error(&scene("(1920, 1080)", 8));
-        assert!(e.message.contains("msaa 8"), "{e}");
-        let one = parse_scene("one.ron", &scene("(64, 64)", 1)).unwrap();
+        assert!(parse_scene("ok.ron", &scene(100, "(1920, 1080)", 1)).is_ok(), "100 nodes at 1080p fit (3.1 GiB)");
+        // 60 nodes at 4K fit (7.4 GiB); two sets of 8 samples (1.5 GiB more) do not.
+        assert!(parse_scene("ok.ron", &scene(60, "(3840, 2160)", 1)).is_ok());
+        let e = first_error(&scene(60, "(3840, 2160)", 8));
+        assert!(e.message.contains("msaa 8") && e.message.contains("8.9 GiB"), "{e}");
+        let one = parse_scene("one.ron", &scene(100, "(64, 64)", 1)).unwrap();
         assert!(one.check_texture_budget((16384, 16384)).is_err(), "an override of the size is checked too");
+        // Loaded to render at another size (`--size`), the check is made there, not at the file's.
+        let at = |size| crate::assets::Assets::new(None).rendering_at(Some(size));
+        let big = scene(100, "(3840, 2160)", 1);
+        assert!(parse_scene_with(&at((1920, 1080)), "big.ron", &big).is_ok(), "4K in the file, rendered at 1080p");
+        let small = scene(100, "(1920, 1080)", 1);
+        let e = parse_scene_with(&at((3840, 2160)), "big.ron", &small).err().expect("refused").to_string();
+        assert!(e.contains("at 3840x2160") && e.contains("12.4 GiB"), "{e}");
+    }
+
+    #[test]
+    fn a_show_counts_the_clips_that_can_be_on_screen_at_once() {
+        // 8 layers of 8 single-node clips at 4K with msaa 4: all 72 nodes would be 9.9 GiB, but a
+        // layer shows one clip (two in a transition): 16 clips, the 8 blends and the master draw
+        // at once, 25 nodes and two multisampled sets, 3.9 GiB.
+        let clip = |l: usize, c: usize| format!(r#"(scene: "kleinian_classic", id: "c{l}_{c}")"#);
+        let layer = |l: usize| format!("(clips: [{}])", (0..8).map(|c| clip(l, c)).collect::<Vec<_>>().join(", "));
+        let layers: Vec<String> = (0..8).map(layer).collect();
+        let show = format!(r#"(name: "wall", size: (3840, 2160), layers: [{}])"#, layers.join(", "));
+        let assets = crate::assets::Assets::new(None);
+        let wall = crate::scene::show::parse_show(&assets, "wall.ron", &show, false).unwrap_or_else(|e| panic!("{e}"));
+        let drawn = wall.show.as_deref().unwrap().nodes_drawn_at_once(wall.nodes.len());
+        assert_eq!(wall.nodes.len() - drawn, 8 * 6, "six clips of each layer cannot be on screen");
+        let pixels = 3840 * 2160;
+        assert_eq!(wall.texture_bytes((3840, 2160)), drawn as u64 * pixels * 16 + 2 * pixels * 48);
+        // With every clip running while hidden, all of them draw: refused, naming the clips.
+        let continuing = show.replace(r#"id: "c"#, r#"policy: Continue, id: "c"#);
+        let e = crate::scene::show::parse_show(&assets, "wall.ron", &continuing, false).err().expect("refused");
+        let e = e.to_string();
+        assert!(e.contains("what can be on screen at once") && e.contains("c7_7"), "{e}");
     }
 
     #[test]

@@ -59,8 +59,9 @@ pub struct Scene {
     pub midi: Vec<(MidiMapping, Target)>,
     /// For a show: its layers, clips, columns and cues over these nodes (`None`: a scene).
     pub show: Option<std::sync::Arc<super::show::Show>>,
-    /// Texture bytes nodes keep beyond their outputs at the scene's size (an ISF node's pass
-    /// targets, as its file declares them), counted in [`Scene::texture_bytes`].
+    /// Texture bytes nodes keep beyond their outputs at the size the scene was loaded to render
+    /// at (an ISF node's pass targets, as its file declares them), counted in
+    /// [`Scene::texture_bytes`].
     pub own_texture_bytes: u64,
 }
 
@@ -186,13 +187,24 @@ impl Scene {
     }
 
     /// An upper estimate of the texture memory the scene takes at `size` with its `msaa`: per
-    /// node, its output and one working texture in HDR (8 bytes a pixel each) and, when
-    /// multisampled, a colour and depth target per sample (12 bytes a pixel-sample). Simulation
-    /// buffers are bounded by each technique's parameter ranges instead.
+    /// node that can draw in one frame, its output and one working texture in HDR (8 bytes a
+    /// pixel each); when multisampled, two sets of a colour and a depth target per sample (12
+    /// bytes a pixel-sample) — a pass resolves its targets and gives them back to the frame's
+    /// pool, so nodes drawing one after another share them; and what nodes keep (see
+    /// [`Scene::own_texture_bytes`]). In a show only the clips that can be on screen at once
+    /// draw ([`super::show::Show::nodes_drawn_at_once`]). Simulation buffers are bounded by each
+    /// technique's parameter ranges instead.
     pub fn texture_bytes(&self, size: (u32, u32)) -> u64 {
+        let drawn = self.show.as_deref().map_or(self.nodes.len(), |show| show.nodes_drawn_at_once(self.nodes.len()));
+        self.texture_bytes_of(drawn, size).saturating_add(self.own_texture_bytes)
+    }
+
+    /// The per-frame texture bytes of `nodes` drawing nodes at `size` (without what nodes keep).
+    pub fn texture_bytes_of(&self, nodes: usize, size: (u32, u32)) -> u64 {
         let pixels = u64::from(size.0) * u64::from(size.1);
         let multisampled = if self.msaa > 1 { 12 * u64::from(self.msaa) } else { 0 };
-        (self.nodes.len() as u64 * pixels * (16 + multisampled)).saturating_add(self.own_texture_bytes)
+        let sets = nodes.min(2) as u64;
+        (nodes as u64).saturating_mul(pixels * 16).saturating_add(sets * pixels * multisampled)
     }
 
     /// Whether the scene fits [`MAX_TEXTURE_BYTES`] at `size`; the error says what to lower.

@@ -151,7 +151,8 @@ impl<'a> Validator<'a> {
         if !self.errors.is_empty() {
             return Err(self.failure());
         }
-        let own_texture_bytes = own_texture_bytes(self.assets, &ordered, file.size);
+        let size = self.assets.output_size().unwrap_or(file.size);
+        let own_texture_bytes = own_texture_bytes(self.assets, &ordered, size);
         let mut scene = Scene {
             origin: self.origin.into(),
             name: file.name,
@@ -181,7 +182,7 @@ impl<'a> Validator<'a> {
         if !self.errors.is_empty() {
             return Err(self.failure());
         }
-        if let Err(message) = scene.check_texture_budget(scene.size) {
+        if let Err(message) = scene.check_texture_budget(size) {
             self.error(&["size"], message);
             return Err(self.failure());
         }

@@ -296,7 +296,8 @@ impl Builder<'_> {
             show.mix_kind = self.transition(&TransitionFile::default(), &["effects"]).and_then(|t| t.kind);
         }
         show.kinds = std::mem::take(&mut self.kinds);
-        let own_texture_bytes = crate::scene::model::own_texture_bytes(self.assets, &nodes, file.size);
+        let size = self.assets.output_size().unwrap_or(file.size);
+        let own_texture_bytes = crate::scene::model::own_texture_bytes(self.assets, &nodes, size);
         let mut scene = Scene {
             origin: self.origin.to_string(),
             name: file.name.clone(),
@@ -323,11 +324,11 @@ impl Builder<'_> {
                 self.error(&["outputs"], e);
             }
         }
-        if let Err(e) = budget(&scene, &show) {
-            self.error(&["size"], e);
-        }
         show.file = Some(Arc::new(ShowSource { file, text: self.source.into() }));
         scene.show = Some(Arc::new(show));
+        if let Err(e) = budget(&scene, size) {
+            self.error(&["size"], e);
+        }
         Some(scene)
     }
 
@@ -558,21 +559,20 @@ fn note_problem(clip: &ClipFile) -> Option<String> {
     None
 }
 
-/// Whether the show's textures fit the scene budget; if not, one sentence on which clips take what.
-fn budget(scene: &Scene, show: &Show) -> Result<(), String> {
-    scene.check_texture_budget(scene.size).map_err(|_| {
-        let per_node = scene.texture_bytes(scene.size) / scene.nodes.len().max(1) as u64;
+/// Whether the show's textures fit the scene budget at `size`; if not, one sentence on which
+/// clips take what.
+fn budget(scene: &Scene, size: (u32, u32)) -> Result<(), String> {
+    scene.check_texture_budget(size).map_err(|_| {
+        let per_node = scene.texture_bytes_of(1, size);
         let gib = |b: u64| b as f64 / f64::from(1u32 << 30);
-        let clips: Vec<String> = show
-            .clips
-            .iter()
-            .map(|c| format!("{} {:.1} GiB", c.id, gib(per_node * c.nodes.len() as u64)))
-            .collect();
+        let show = scene.show.as_deref().expect("a show");
+        let clips: Vec<String> =
+            show.clips.iter().map(|c| format!("{} {:.1} GiB", c.id, gib(per_node * c.nodes.len() as u64))).collect();
         format!(
-            "the show needs about {:.1} GiB of textures at {}x{} with msaa {}, over the {:.0} GiB a show may use: {} (lower the size or the msaa, or move clips to another show)",
-            gib(scene.texture_bytes(scene.size)),
-            scene.size.0,
-            scene.size.1,
+            "the show needs about {:.1} GiB of textures at {}x{} with msaa {} (what can be on screen at once), over the {:.0} GiB a show may use: {} (lower the size or the msaa, or move clips to another show)",
+            gib(scene.texture_bytes(size)),
+            size.0,
+            size.1,
             scene.msaa,
             gib(crate::scene::model::MAX_TEXTURE_BYTES),
             clips.join(", ")

@@ -179,6 +179,22 @@ impl Show {
         self.layers.iter().position(|l| l.node == node)
     }
 
+    /// How many of the flat scene's `total` nodes can draw in one frame: all but those of clips
+    /// that cannot be on screen. A layer shows one clip, two during a transition; its clips that
+    /// restart when triggered draw only then, so all but its two largest are left out. Clips
+    /// that keep running while hidden draw always.
+    pub fn nodes_drawn_at_once(&self, total: usize) -> usize {
+        let mut hidden = 0;
+        for layer in &self.layers {
+            let clips = layer.clips.iter().map(|&c| &self.clips[c]);
+            let mut restarting: Vec<usize> =
+                clips.filter(|c| c.policy == ClipPolicy::Restart).map(|c| c.nodes.len()).collect();
+            restarting.sort_unstable_by(|a, b| b.cmp(a));
+            hidden += restarting.iter().skip(2).sum::<usize>();
+        }
+        total.saturating_sub(hidden)
+    }
+
     /// Clip `clip` of layer `layer` as an index into [`Show::clips`].
     pub fn clip_at(&self, layer: usize, clip: usize) -> Option<usize> {
         self.layers.get(layer)?.clips.get(clip).copied()
