@@ -35,6 +35,11 @@ pub struct Replacement {
     kept: Vec<Option<usize>>,
     /// Per new node: its new instance, where it is not kept.
     fresh: Vec<Option<Box<dyn Technique>>>,
+    /// Per new node: its parameters as the new scene starts them (cloned off the render thread).
+    params: Vec<ParamSet>,
+    /// Per new node: (parameter, the old node's parameter) pairs whose live value carries over
+    /// (same name, type and default), for kept nodes.
+    carried: Vec<Vec<(usize, usize)>>,
     show: Option<ShowRuntime>,
 }
 
@@ -76,8 +81,28 @@ impl Replacement {
                 None => Some(create_node(&scene, i, &n.params, gpu, assets, output_size)?),
             });
         }
+        // What the install does on the render thread is only copying values: the parameter sets
+        // and which values carry over are worked out here.
+        let params: Vec<ParamSet> = scene.nodes.iter().map(|n| n.params.clone()).collect();
+        let carried = scene
+            .nodes
+            .iter()
+            .zip(&kept)
+            .map(|(n, kept)| {
+                let Some(old_node) = kept.map(|o| &old.nodes[o]) else { return Vec::new() };
+                let (old_decls, old_set) = (&old_node.params, &snapshot.params[kept.expect("kept")]);
+                let decls = n.params.decls().iter().enumerate();
+                decls
+                    .filter_map(|(p, decl)| {
+                        let op = old_decls.index(&decl.name)?;
+                        let unchanged = old_decls.decls()[op].default == decl.default;
+                        (unchanged && old_set.decls()[op].ty() == decl.ty()).then_some((p, op))
+                    })
+                    .collect()
+            })
+            .collect();
         let show = ShowRuntime::new(gpu, assets, &scene, output_size)?;
-        Ok(Self { revision: snapshot.revision, scene, kept, fresh, show })
+        Ok(Self { revision: snapshot.revision, scene, kept, fresh, params, carried, show })
     }
 }
 
@@ -137,28 +162,22 @@ impl SceneInstance {
     /// default. Returns where each old parameter is now, for everything that holds parameter
     /// positions across the reload (queued events, scripts, MIDI learn).
     pub fn install(&mut self, replacement: Replacement) -> Result<Remap, Outdated> {
-        let Replacement { revision, scene, kept, mut fresh, mut show } = replacement;
+        let Replacement { revision, scene, kept, mut fresh, mut params, carried, mut show } = replacement;
         if revision != self.revision {
             return Err(Outdated);
         }
         let in_place: Vec<bool> = kept.iter().enumerate().map(|(i, k)| *k == Some(i)).collect();
         let mut old_nodes: Vec<Option<Box<dyn Technique>>> = self.nodes.drain(..).map(Some).collect();
-        let mut params = Vec::with_capacity(scene.nodes.len());
-        for ((n, new), kept) in scene.nodes.iter().zip(fresh.iter_mut()).zip(kept) {
-            let mut set = n.params.clone();
+        // Kept nodes carry their live values (the ones now, not the snapshot's) and instances.
+        for (((set, new), kept), carried) in params.iter_mut().zip(fresh.iter_mut()).zip(kept).zip(&carried) {
             if let Some(old) = kept {
-                let (old_decls, old_set) = (&self.scene.nodes[old].params, &self.params[old]);
-                for (p, decl) in set.decls().to_vec().iter().enumerate() {
-                    let Some(op) = old_decls.index(&decl.name) else { continue };
-                    let unchanged = old_decls.decls()[op].default == decl.default;
-                    if unchanged && old_set.decls()[op].ty() == decl.ty() {
-                        set.set_at(p, old_set.target_at(op));
-                    }
+                let old_set = &self.params[old];
+                for &(p, op) in carried {
+                    set.set_at(p, old_set.target_at(op));
                 }
                 set.snap();
                 *new = old_nodes[old].take();
             }
-            params.push(set);
         }
         let remap = Remap::between(
             self.scene.nodes.iter().map(|n| n.id.as_str()).zip(&self.params),
