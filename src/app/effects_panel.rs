@@ -78,15 +78,9 @@ pub fn effects_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut Cont
 /// What a right-click does.
 const LEARN_HINT: &str = "right-click, then play a note: MIDI learn";
 
-/// `label` with a mark of its MIDI learn state (ASCII: egui's bundled fonts lack dot glyphs).
+/// `label` with the mark of its MIDI learn state.
 fn learn_mark(label: &str, command: ShowCommand, hub: &ControlHub) -> String {
-    if hub.mapper.learning_command == Some(command) {
-        format!("{label} ?")
-    } else if hub.mapper.command_bindings().iter().any(|b| b.command == command) {
-        format!("{label} M")
-    } else {
-        label.to_string()
-    }
+    format!("{label}{}", hub.mapper.learn_mark(command))
 }
 
 /// What effect node `node` plays: its file's name, else its technique's.

@@ -39,19 +39,12 @@ pub fn show_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut Control
                     hint.push_str(" — could not be loaded");
                 }
                 let command = ShowCommand::Trigger { layer: l, clip: Some(c) };
-                let learning = hub.mapper.learning_command == Some(command);
-                let learned = hub.mapper.command_bindings().iter().any(|b| b.command == command);
                 // ASCII marks: egui's bundled fonts lack the usual dot glyphs.
-                let mark = match (broken, learning, learned) {
-                    (true, _, _) => " !",
-                    (_, true, _) => " ?",
-                    (_, _, true) => " M",
-                    _ => "",
-                };
+                let mark = if broken { " !" } else { hub.mapper.learn_mark(command) };
                 hint.push_str(" — right-click, then play a note: MIDI learn");
                 let cell = ui.selectable_label(playing, format!("{}{mark}", info.id)).on_hover_text(hint);
                 if cell.clicked() {
-                    trigger(ShowCommand::Trigger { layer: l, clip: Some(c) });
+                    trigger(command);
                 }
                 if cell.secondary_clicked() {
                     hub.learn_clip(l, c);

@@ -204,6 +204,18 @@ impl MidiMapper {
         &self.commands
     }
 
+    /// The panel's mark of `command`'s note (ASCII: egui's bundled fonts lack dot glyphs): " ?"
+    /// while it waits for one, " M" once it has one.
+    pub fn learn_mark(&self, command: ShowCommand) -> &'static str {
+        if self.learning_command == Some(command) {
+            " ?"
+        } else if self.commands.iter().any(|b| b.command == command) {
+            " M"
+        } else {
+            ""
+        }
+    }
+
     /// The show commands whose note `event` is.
     pub fn note_commands(&self, event: MidiEvent) -> Vec<ShowCommand> {
         let MidiEvent::NoteOn { channel, note, .. } = event else { return Vec::new() };

@@ -73,6 +73,20 @@ impl PresetStore {
             std::fs::read_to_string(&path).map_err(|e| format!("no preset '{name}' ({}: {e})", path.display()))?;
         ron::from_str(&text).map_err(|e| format!("{}:{}", path.display(), e))
     }
+
+    /// Preset names, sorted (MIDI program change n recalls the n-th).
+    pub fn names(&self) -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(&self.dir)
+            .map(|entries| {
+                entries
+                    .flatten()
+                    .filter_map(|e| e.file_name().to_str()?.strip_suffix(".ron").map(str::to_string))
+                    .collect()
+            })
+            .unwrap_or_default();
+        names.sort();
+        names
+    }
 }
 
 impl PresetFile {
@@ -99,9 +113,8 @@ impl PresetFile {
     /// Its values for `scene`. Nodes or parameters the scene does not have, and values that no
     /// longer fit, are skipped and named in the returned warnings.
     pub fn values_for(&self, name: &str, scene: &Scene) -> (NodeValues, Vec<String>) {
-        let file = self;
         let (mut values, mut warnings) = (Vec::new(), Vec::new());
-        for (node_id, params) in &file.values {
+        for (node_id, params) in &self.values {
             let Some(n) = scene.node_index(node_id) else {
                 warnings.push(format!("preset '{name}': no node '{node_id}' in this scene"));
                 continue;
@@ -118,22 +131,6 @@ impl PresetFile {
             }
         }
         (values, warnings)
-    }
-}
-
-impl PresetStore {
-    /// Preset names, sorted (MIDI program change n recalls the n-th).
-    pub fn names(&self) -> Vec<String> {
-        let mut names: Vec<String> = std::fs::read_dir(&self.dir)
-            .map(|entries| {
-                entries
-                    .flatten()
-                    .filter_map(|e| e.file_name().to_str()?.strip_suffix(".ron").map(str::to_string))
-                    .collect()
-            })
-            .unwrap_or_default();
-        names.sort();
-        names
     }
 }
 

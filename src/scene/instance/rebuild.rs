@@ -89,14 +89,14 @@ impl Replacement {
             .iter()
             .zip(&kept)
             .map(|(n, kept)| {
-                let Some(old_node) = kept.map(|o| &old.nodes[o]) else { return Vec::new() };
-                let (old_decls, old_set) = (&old_node.params, &snapshot.params[kept.expect("kept")]);
+                let Some(o) = *kept else { return Vec::new() };
+                let old_decls = &snapshot.params[o];
                 let decls = n.params.decls().iter().enumerate();
                 decls
                     .filter_map(|(p, decl)| {
                         let op = old_decls.index(&decl.name)?;
-                        let unchanged = old_decls.decls()[op].default == decl.default;
-                        (unchanged && old_set.decls()[op].ty() == decl.ty()).then_some((p, op))
+                        let before = &old_decls.decls()[op];
+                        (before.default == decl.default && before.ty() == decl.ty()).then_some((p, op))
                     })
                     .collect()
             })

@@ -62,28 +62,22 @@ pub fn edited_show(
         (n < entries.len()).then_some(()).ok_or_else(|| format!("{chain} has no effect {} to {what}", n + 1))
     };
     match edit {
-        EffectEdit::Add(effect) => {
-            if entries.len() >= MAX_EFFECTS_PER_CHAIN {
-                return Err(format!("{chain} has {MAX_EFFECTS_PER_CHAIN} effects, the most a chain has"));
-            }
-            entries.push(EffectFile {
-                effect: effect.as_str().to_string(),
-                params: Default::default(),
-                mix: 1.0,
-                bypass: false,
-            });
+        EffectEdit::Add(_) if entries.len() >= MAX_EFFECTS_PER_CHAIN => {
+            return Err(format!("{chain} has {MAX_EFFECTS_PER_CHAIN} effects, the most a chain has"));
         }
-        EffectEdit::Remove(n) => {
-            in_range(n, "remove")?;
-            entries.remove(n);
-        }
+        EffectEdit::Add(_) => {}
+        EffectEdit::Remove(n) => in_range(n, "remove")?,
         EffectEdit::Move { from, to } => {
             in_range(from, "move")?;
             in_range(to, "move to")?;
-            let moved = entries.remove(from);
-            entries.insert(to, moved);
         }
     }
+    apply_edit(entries, edit, |effect| EffectFile {
+        effect: effect.as_str().to_string(),
+        params: Default::default(),
+        mix: 1.0,
+        bypass: false,
+    });
     let mut edited = build_show(assets, &scene.origin, &source.text, file, true).map_err(|e| e.to_string())?;
     // Everything but the chain is as it runs, with what the command line changed (`--set`,
     // `--msaa`, `--seed`, `--dt`): an unchanged node keeps its instance and its values.
@@ -98,6 +92,21 @@ pub fn edited_show(
 
 /// The longest effect file name an edit carries.
 pub const MAX_EFFECT_NAME: usize = Text::CAPACITY;
+
+/// Applies `edit` to `chain` (its positions checked by the caller); an added effect is
+/// `added(name)`.
+fn apply_edit<T>(chain: &mut Vec<T>, edit: EffectEdit, added: impl FnOnce(Text) -> T) {
+    match edit {
+        EffectEdit::Add(effect) => chain.push(added(effect)),
+        EffectEdit::Remove(n) => {
+            chain.remove(n);
+        }
+        EffectEdit::Move { from, to } => {
+            let moved = chain.remove(from);
+            chain.insert(to, moved);
+        }
+    }
+}
 
 /// Each layer's chain and the master's as they play now: (owner, effect names in order).
 pub fn chains(show: &Show) -> Vec<(String, Vec<String>)> {
@@ -148,9 +157,9 @@ pub fn edits_between(current: &[String], target: &[String]) -> Result<Vec<Effect
     for (to, wanted) in target.iter().enumerate() {
         let from = (to..chain.len()).find(|&j| chain[j] == *wanted).expect("every wanted effect is in the chain");
         if from != to {
-            let moved = chain.remove(from);
-            chain.insert(to, moved);
-            edits.push(EffectEdit::Move { from, to });
+            let edit = EffectEdit::Move { from, to };
+            apply_edit(&mut chain, edit, |_| unreachable!("a move adds nothing"));
+            edits.push(edit);
         }
     }
     Ok(edits)
@@ -163,17 +172,8 @@ mod tests {
     /// Applies `edits` to `chain` as `edited_show` does.
     fn apply(chain: &[&str], edits: &[EffectEdit]) -> Vec<String> {
         let mut chain: Vec<String> = chain.iter().map(|s| s.to_string()).collect();
-        for edit in edits {
-            match *edit {
-                EffectEdit::Add(name) => chain.push(name.as_str().to_string()),
-                EffectEdit::Remove(n) => {
-                    chain.remove(n);
-                }
-                EffectEdit::Move { from, to } => {
-                    let moved = chain.remove(from);
-                    chain.insert(to, moved);
-                }
-            }
+        for &edit in edits {
+            apply_edit(&mut chain, edit, |name| name.as_str().to_string());
         }
         chain
     }
