@@ -249,7 +249,7 @@ fn replace_word(word: &str, stage: StageKind, cx: &Context<'_>) -> String {
         "vv_FragNormCoord" => return "isf_FragNormCoord".into(),
         "vv_vertShaderInit" => return "isf_vertShaderInit".into(),
         "attribute" => return "in".into(),
-        // GLSL leaves these undefined where GL hosts agree on a value (see GL_AS_HOSTS_DO).
+        // GLSL leaves these undefined where GL hosts agree on a value (see translate.rs, COMMON).
         "pow" => return "_isf_pow".into(),
         "smoothstep" => return "_isf_smoothstep".into(),
         _ => {}

@@ -113,9 +113,7 @@ pub fn translate(header: &Header, fs: &str, vs: Option<&str>) -> Result<Program,
         &[
             "#version 450".into(),
             declarations.clone(),
-            format!(
-                "{COMMON} {GL_AS_HOSTS_DO} layout(location = 0) in vec2 isf_FragNormCoord; layout(location = 0) out vec4 _isf_out;"
-            ),
+            format!("{COMMON} layout(location = 0) in vec2 isf_FragNormCoord; layout(location = 0) out vec4 _isf_out;"),
             "vec4 isf_FragColor; vec4 isf_FragCoord;".into(),
         ],
         &fs_out.text,
@@ -130,7 +128,7 @@ pub fn translate(header: &Header, fs: &str, vs: Option<&str>) -> Result<Program,
         &[
             "#version 450".into(),
             declarations.clone(),
-            format!("{COMMON} {GL_AS_HOSTS_DO} layout(location = 0) out vec2 isf_FragNormCoord; {VERT_INIT}"),
+            format!("{COMMON} layout(location = 0) out vec2 isf_FragNormCoord; {VERT_INIT}"),
         ],
         &vs_out.text,
         &format!(
@@ -152,7 +150,7 @@ pub fn translate(header: &Header, fs: &str, vs: Option<&str>) -> Result<Program,
                     "#version 450".into(),
                     format!("layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in; {declarations}"),
                     format!(
-                        "layout(set = 0, binding = {binding}, {format}) uniform writeonly image2D _isf_dst; {COMMON} {GL_AS_HOSTS_DO} \
+                        "layout(set = 0, binding = {binding}, {format}) uniform writeonly image2D _isf_dst; {COMMON} \
                          vec2 isf_FragNormCoord;"
                     ),
                     "vec4 isf_FragColor; vec4 isf_FragCoord;".into(),
@@ -187,12 +185,21 @@ fn contains_word(text: &str, word: &str) -> bool {
 /// The vertex stage when a shader has no `.vs`.
 const DEFAULT_VS: &str = "void main() { isf_vertShaderInit(); }\n";
 
-/// Built-ins as GL hosts compute them where GLSL leaves the result undefined and shaders rely on
-/// the hosts' answer (the reference renderer's, on SwiftShader, and desktop drivers'): `pow` of
-/// a negative base is `pow(|x|, y)` (Butterfly Wave Scrawler raises a sine to the 5th, which
-/// Vulkan drivers make NaN), and `smoothstep` is the spec's formula whatever its edges, with equal
-/// edges a step at them (RGB Halftone's dots of a channel at 0: GL divides by zero to ±∞).
-const GL_AS_HOSTS_DO: &str = "float _isf_pow(float x, float y) { return pow(abs(x), y); } \
+/// Helpers every stage gets (one line).
+/// `_isf_encode` takes a node's image (linear, premultiplied) to what ISF shaders expect
+/// (display values, straight alpha); `_isf_decode` goes back.
+/// `_isf_pow` and `_isf_smoothstep` are built-ins as GL hosts compute them where GLSL leaves
+/// the result undefined and shaders rely on the hosts' answer (the reference renderer's, on
+/// SwiftShader, and desktop drivers'): `pow` of a negative base is `pow(|x|, y)` (Butterfly Wave
+/// Scrawler raises a sine to the 5th, which Vulkan drivers make NaN), and `smoothstep` is the
+/// spec's formula whatever its edges, with equal edges a step at them (RGB Halftone's dots of a
+/// channel at 0: GL divides by zero to ±∞).
+const COMMON: &str = "vec2 _isf_flip(vec2 c) { return vec2(c.x, 1.0 - c.y); } \
+    vec4 _isf_encode(vec4 c) { float a = clamp(c.a, 0.0, 1.0); vec3 x = max(a > 0.0 ? c.rgb / a : c.rgb, vec3(0.0)); \
+    return vec4(mix(x * 12.92, 1.055 * pow(x, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), x)), a); } \
+    vec4 _isf_decode(vec4 c) { float a = clamp(c.a, 0.0, 1.0); vec3 x = max(c.rgb, vec3(0.0)); \
+    return vec4(mix(x / 12.92, pow((x + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), x)) * a, a); } \
+    float _isf_pow(float x, float y) { return pow(abs(x), y); } \
     vec2 _isf_pow(vec2 x, vec2 y) { return pow(abs(x), y); } vec3 _isf_pow(vec3 x, vec3 y) { return pow(abs(x), y); } \
     vec4 _isf_pow(vec4 x, vec4 y) { return pow(abs(x), y); } \
     float _isf_smoothstep(float a, float b, float x) { if (a == b) { return x > a ? 1.0 : 0.0; } \
@@ -206,15 +213,6 @@ const GL_AS_HOSTS_DO: &str = "float _isf_pow(float x, float y) { return pow(abs(
     vec2 _isf_smoothstep(float a, float b, vec2 x) { return _isf_smoothstep(vec2(a), vec2(b), x); } \
     vec3 _isf_smoothstep(float a, float b, vec3 x) { return _isf_smoothstep(vec3(a), vec3(b), x); } \
     vec4 _isf_smoothstep(float a, float b, vec4 x) { return _isf_smoothstep(vec4(a), vec4(b), x); }";
-
-/// Helpers both stages get (one line).
-/// `_isf_encode` takes a node's image (linear, premultiplied) to what ISF shaders expect
-/// (display values, straight alpha); `_isf_decode` goes back.
-const COMMON: &str = "vec2 _isf_flip(vec2 c) { return vec2(c.x, 1.0 - c.y); } \
-    vec4 _isf_encode(vec4 c) { float a = clamp(c.a, 0.0, 1.0); vec3 x = max(a > 0.0 ? c.rgb / a : c.rgb, vec3(0.0)); \
-    return vec4(mix(x * 12.92, 1.055 * pow(x, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), x)), a); } \
-    vec4 _isf_decode(vec4 c) { float a = clamp(c.a, 0.0, 1.0); vec3 x = max(c.rgb, vec3(0.0)); \
-    return vec4(mix(x / 12.92, pow((x + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), x)) * a, a); }";
 
 /// `isf_vertShaderInit`: the quad (two triangles over the whole target, from the vertex index)
 /// and the normalised coordinate, y up.
