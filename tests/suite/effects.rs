@@ -258,6 +258,36 @@ fn effects_added_moved_and_removed_live_give_the_chain_the_file_would() {
 }
 
 #[test]
+fn an_edit_leaves_a_waiting_trigger_and_a_running_fade_where_they_were() {
+    // A beat every 9 frames: the trigger at frame 1 waits for frame 9, then fades over 9.
+    let text = r#"(
+    name: "fading",
+    size: (64, 36),
+    seed: 1,
+    bpm: 400.0,
+    transition: (kind: "crossfade", beats: 1.0, quantize: Beat),
+    layers: [(clips: [(scene: "kleinian_classic"), (scene: "kleinian")])],
+)"#;
+    let play = |edits: &[(u64, EffectEdit)]| {
+        let mut r = OffscreenRenderer::new(gpu(), &assets(), show_from(text), Some(SIZE), None, None).unwrap();
+        r.schedule(1, vec![ControlEvent::Show(ShowCommand::Trigger { layer: 0, clip: Some(1) })]);
+        for &(frame, e) in edits {
+            r.schedule(frame, vec![edit(Some(0), e)]);
+        }
+        (0..20).map(|_| r.render_next().unwrap().rgba).collect::<Vec<_>>()
+    };
+    let plain = play(&[]);
+    let add = EffectEdit::Add(Text::new("shaders/isf/Kaleidoscope.fs"));
+    // Added and removed while the trigger waits, and again halfway through the fade.
+    let edited = play(&[(3, add), (4, EffectEdit::Remove(0)), (12, add), (13, EffectEdit::Remove(0))]);
+    assert!(plain[12] != plain[8] && plain[12] != plain[19], "frame 12 is not inside the fade");
+    assert!(edited[3] != plain[3] && edited[12] != plain[12], "the added effect did not show");
+    for frame in (4..12).chain(13..20) {
+        assert!(edited[frame] == plain[frame], "frame {frame}: the edit moved the trigger or the fade");
+    }
+}
+
+#[test]
 fn frame_n_is_the_same_played_or_sought_across_adds_moves_and_bypasses() {
     let pulse = Text::new("shaders/isf/Shockwave Pulse.fs");
     let scene = show_from(&limit_set_show("", KALEIDOSCOPE, ""));

@@ -184,9 +184,13 @@ impl SceneInstance {
             scene.nodes.iter().map(|n| n.id.as_str()).zip(&params),
         );
         self.nodes = fresh.into_iter().map(|n| n.expect("every node kept or created")).collect();
-        self.params = params;
-        crate::gpu::drop_later(std::mem::replace(&mut self.scene, scene));
-        if let (Some(show), Some(old)) = (&mut show, &self.show) {
+        // The old scene and parameter sets are many small allocations: freed off the render thread.
+        crate::gpu::drop_later((
+            std::mem::replace(&mut self.scene, scene),
+            std::mem::replace(&mut self.params, params),
+        ));
+        if let (Some(show), Some(old)) = (&mut show, &mut self.show) {
+            show.adopt_gpu_objects(old);
             let messages = show.carry_over(old, &self.scene, &self.params, &mut self.nodes, &|n| in_place[n]);
             self.messages.extend(messages);
         }

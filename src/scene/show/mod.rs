@@ -144,7 +144,7 @@ pub enum Length {
 }
 
 /// One cue, resolved.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Cue {
     /// Its name.
     pub name: String,

@@ -73,24 +73,26 @@ impl ShowRuntime {
 
     /// Takes over the play state of the show this one replaces (a hot reload, a chain edit);
     /// clips whose nodes ran before are no longer fresh, and hidden ones get fresh copies — but a
-    /// clip whose nodes were all kept in place (`kept_in_place`, by node) and are still fresh
-    /// stays fresh: an effect added to a layer rebuilds no clip.
+    /// clip whose nodes were all kept in place (`kept_in_place`, by node) keeps its slot (fresh,
+    /// or a copy on its way): an effect added to a layer rebuilds no clip.
     pub fn carry_over(
         &mut self,
-        old: &ShowRuntime,
+        old: &mut ShowRuntime,
         scene: &Scene,
         params: &[ParamSet],
         nodes: &mut [Box<dyn Technique>],
         kept_in_place: &dyn Fn(usize) -> bool,
     ) -> Vec<String> {
         self.state = old.state.carried(&old.plan, &self.plan);
+        self.spares.continue_from(&old.spares);
         let mut messages = Vec::new();
         for c in 0..self.plan.clips.len() {
             let clip = &self.plan.clips[c];
             let untouched = old.plan.clips.get(c).is_some_and(|o| o.id == clip.id && o.nodes == clip.nodes)
-                && clip.nodes.clone().all(kept_in_place)
-                && old.spares.is_fresh(c);
-            if untouched {
+                && clip.nodes.clone().all(kept_in_place);
+            // A copy on its way stays on its way: building it again would clone the clip's nodes
+            // on the render thread and throw a build away.
+            if untouched && self.spares.take_slot(&mut old.spares, c) {
                 continue;
             }
             self.spares.mark_stale(c);
@@ -99,6 +101,14 @@ impl ShowRuntime {
             }
         }
         messages
+    }
+
+    /// Takes `old`'s transitions and shared images where this show plays the same transitions
+    /// on the same layers (see [`Mixer::adopt`]); `old` is left with this one's, to be dropped.
+    pub fn adopt_gpu_objects(&mut self, old: &mut ShowRuntime) {
+        if self.plan.kinds == old.plan.kinds && self.mixer.adopt(&mut old.mixer) {
+            std::mem::swap(&mut self.black, &mut old.black);
+        }
     }
 
     /// After every node was rebuilt on a new device: the play state stays; clips on screen run

@@ -118,6 +118,24 @@ impl Spares {
         None
     }
 
+    /// Counts its builds with `old`'s (the spares of the show this one replaces): the threads
+    /// `old` started still run, and still hold their places among [`MAX_BUILDS_IN_FLIGHT`].
+    pub fn continue_from(&mut self, old: &Spares) {
+        self.in_flight = old.in_flight.clone();
+    }
+
+    /// Takes `clip`'s slot from `old` (the clip's nodes carried over unchanged) unless it is
+    /// stale: fresh nodes stay fresh, and a copy on its way keeps coming instead of being built
+    /// again. Returns whether it took it.
+    pub fn take_slot(&mut self, old: &mut Spares, clip: usize) -> bool {
+        let (Some(slot), Some(before)) = (self.slots.get_mut(clip), old.slots.get_mut(clip)) else { return false };
+        if matches!(before, Slot::Stale) {
+            return false;
+        }
+        *slot = std::mem::replace(before, Slot::Stale);
+        true
+    }
+
     /// Marks `clip`'s nodes as fresh (a copy was just swapped in).
     pub fn mark_fresh(&mut self, clip: usize) {
         if let Some(slot) = self.slots.get_mut(clip) {
@@ -234,4 +252,21 @@ fn release_free_memory() {
 
 fn failure(message: &str) -> ShaderError {
     ShaderError { origin: "show".into(), line: 1, column: 1, message: message.into() }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_replacing_show_takes_the_slots_that_are_not_stale() {
+        let mut old = Spares::new(3);
+        old.mark_stale(0);
+        let mut new = Spares::new(3);
+        new.continue_from(&old);
+        assert!(!new.take_slot(&mut old, 0), "a stale slot was taken");
+        assert!(new.take_slot(&mut old, 1) && new.is_fresh(1) && !old.is_fresh(1));
+        assert!(!new.take_slot(&mut old, 7), "a clip the show lacks");
+        assert!(Arc::ptr_eq(&new.in_flight, &old.in_flight), "the builds in flight are counted apart");
+    }
 }

@@ -255,6 +255,12 @@ impl ShowState {
     /// layer keeps playing the clip of the same id, the cue list stays where it is; running
     /// transitions and waiting triggers end.
     pub fn carried(&self, old: &Show, show: &Show) -> ShowState {
+        // A chain edit (or a reload that touched only effects or values) plays the same clips
+        // on the same layers with the same transitions and cues: everything carries, so a fade
+        // runs on and a trigger waiting for its bar still fires.
+        if same_playlist(old, show) {
+            return self.clone();
+        }
         let mut next = ShowState::new(show);
         next.started_once = self.started_once;
         next.last = self.last;
@@ -400,6 +406,17 @@ fn elapsed(length: Length, since: Clock, now: Clock) -> f64 {
 
 fn progress(fade: &Fade, now: Clock) -> f32 {
     elapsed(fade.transition.length, fade.since, now).clamp(0.0, 1.0) as f32
+}
+
+/// Whether shows `a` and `b` have the same clips (by id, in order), layers (by their clips),
+/// transition kinds and cues: indices into any of them mean the same in both.
+fn same_playlist(a: &Show, b: &Show) -> bool {
+    a.kinds == b.kinds
+        && a.clips.len() == b.clips.len()
+        && a.clips.iter().zip(&b.clips).all(|(x, y)| x.id == y.id && x.layer == y.layer && x.transition == y.transition)
+        && a.layers.len() == b.layers.len()
+        && a.layers.iter().zip(&b.layers).all(|(x, y)| x.clips == y.clips && x.start == y.start)
+        && a.cues == b.cues
 }
 
 #[cfg(test)]
