@@ -10,7 +10,7 @@ use super::watcher::read_stable;
 use crate::assets::{Asset, AssetKind, Assets};
 use crate::gpu::{Gpu, validate_as_used};
 use crate::scene::show::{build_show, parse_show};
-use crate::scene::{NodeRebuild, Replacement, SceneNode, SceneSnapshot, load_scene, parse_scene_with};
+use crate::scene::{NodeRebuild, Replacement, SceneNode, SceneSnapshot, Transitions, load_scene, parse_scene_with};
 
 /// Everything one file's reload needs, owned (it may travel to a worker thread).
 pub(super) struct Job {
@@ -106,8 +106,15 @@ impl Job {
                 parse_scene_with(&self.running, &origin, &source).map_err(|e| e.to_string())?
             }
         };
-        let replacement = Replacement::prepare(&self.snapshot, scene, &self.gpu, &self.running, self.size, &|_| false)
-            .map_err(|e| e.to_string())?;
+        let replacement = Replacement::prepare(
+            &self.snapshot,
+            scene,
+            &self.gpu,
+            &self.running,
+            self.size,
+            (&|_| false, Transitions::Compile),
+        )
+        .map_err(|e| e.to_string())?;
         Ok(Prepared::Scene(replacement))
     }
 
@@ -152,5 +159,7 @@ pub(super) fn rebuild_reading(
     // A built-in scene reloads by its name; one from disk (or a bare .fs) by its path.
     let name = origin.strip_prefix("<embedded>/scenes/").unwrap_or(origin);
     let scene = load_scene(assets, name).map_err(|e| e.to_string())?;
-    Replacement::prepare(snapshot, scene, gpu, assets, size, &reads_it).map(Some).map_err(|e| e.to_string())
+    Replacement::prepare(snapshot, scene, gpu, assets, size, (&reads_it, Transitions::Compile))
+        .map(Some)
+        .map_err(|e| e.to_string())
 }

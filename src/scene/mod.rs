@@ -13,7 +13,7 @@ mod validate;
 
 pub use edit::parse_value_override;
 pub use error::{SceneError, SceneErrors};
-pub use instance::{NodeRebuild, Outdated, Replacement, SceneInstance, SceneSnapshot, SceneView};
+pub use instance::{NodeRebuild, Outdated, Replacement, SceneInstance, SceneSnapshot, SceneView, Transitions};
 pub use load::{load_scene, names_a_show, parse_scene, parse_scene_with};
 pub use model::{AudioMapping, BoundTrack, MAX_NAME_CHARS, Scene, SceneNode, SceneOutput, check_audio, resolve_target};
 pub use player::{Player, SeekError};

@@ -258,6 +258,19 @@ fn effects_added_moved_and_removed_live_give_the_chain_the_file_would() {
 }
 
 #[test]
+fn the_first_effect_added_to_a_show_mixes_dry_and_wet_as_the_file_would() {
+    // A show without effects has no dry/wet mix: the first edit's build must compile it.
+    let plain = show_from(&limit_set_show("", "", ""));
+    let mut r = OffscreenRenderer::new(gpu(), &assets(), plain, Some(SIZE), None, None).unwrap();
+    r.schedule(1, vec![edit(Some(0), EffectEdit::Add(Text::new("shaders/isf/Kaleidoscope.fs")))]);
+    let edited = show_from(&limit_set_show("", r#"(effect: "shaders/isf/Kaleidoscope.fs")"#, ""));
+    r.schedule(2, vec![write(&edited, "layer/1/fx/1", "mix", ParamValue::Float(0.5))]);
+    let frames: Vec<Vec<u8>> = (0..4).map(|_| r.render_next().unwrap().rgba).collect();
+    let half = r#"(effect: "shaders/isf/Kaleidoscope.fs", mix: 0.5)"#;
+    assert!(frames[3] == frame_of(&limit_set_show("", half, ""), 3), "the live half mix differs from the file's");
+}
+
+#[test]
 fn an_edit_leaves_a_waiting_trigger_and_a_running_fade_where_they_were() {
     // A beat every 9 frames: the trigger at frame 1 waits for frame 9, then fades over 9.
     let text = r#"(

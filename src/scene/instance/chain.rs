@@ -7,7 +7,7 @@
 use std::sync::mpsc::Receiver;
 
 use super::SceneInstance;
-use super::rebuild::{Replacement, SceneSnapshot};
+use super::rebuild::{Replacement, SceneSnapshot, Transitions};
 use crate::assets::Assets;
 use crate::gpu::Gpu;
 use crate::params::{EffectEdit, Remap, ShowCommand};
@@ -25,8 +25,19 @@ impl SceneInstance {
     ) -> Result<Replacement, String> {
         let scene = edited_show(assets, &snapshot.scene, &snapshot.params, layer, edit)?;
         let owner = chain_owner(layer);
+        // Its transitions are the running show's, unless the edit added the show's first effect
+        // or removed its last (the dry/wet mix is a transition the show has only with effects).
+        let transitions = match (&scene.show, &snapshot.scene.show) {
+            (Some(new), Some(old))
+                if new.kinds == old.kinds && new.mix_kind == old.mix_kind && new.layers.len() == old.layers.len() =>
+            {
+                Transitions::TakeRunning
+            }
+            _ => Transitions::Compile,
+        };
         // The chain's effects are built anew: an effect moved to another place is another node.
-        Replacement::prepare(snapshot, scene, gpu, assets, output_size, &|n| in_chain(&n.id, &owner))
+        let rebuild = |n: &crate::scene::SceneNode| in_chain(&n.id, &owner);
+        Replacement::prepare(snapshot, scene, gpu, assets, output_size, (&rebuild, transitions))
             .map_err(|e| e.to_string())
     }
 

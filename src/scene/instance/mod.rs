@@ -22,7 +22,7 @@ use crate::params::{
 };
 use crate::techniques::{NodeSetup, Technique};
 use crate::time::FrameTime;
-pub use rebuild::{NodeRebuild, Outdated, Replacement, SceneSnapshot};
+pub use rebuild::{NodeRebuild, Outdated, Replacement, SceneSnapshot, Transitions};
 
 /// What the control layer reads of a running show: the scene, every node's parameters and the
 /// tempo clock — not its GPU nodes, so protocol code (and its tests) needs no device.
@@ -355,7 +355,8 @@ impl SceneInstance {
         output_size: (u32, u32),
         rebuild: &dyn Fn(&super::SceneNode) -> bool,
     ) -> Result<Remap, ShaderError> {
-        let replacement = Replacement::prepare(&self.snapshot(), scene, gpu, assets, output_size, rebuild)?;
+        let replacement =
+            Replacement::prepare(&self.snapshot(), scene, gpu, assets, output_size, (rebuild, Transitions::Compile))?;
         Ok(self.install(replacement).expect("built from this revision"))
     }
 

@@ -27,6 +27,15 @@ pub struct SceneSnapshot {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Outdated;
 
+/// Where a replacement's show gets its transitions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Transitions {
+    /// Compiled for it (a reload: the show file may name others).
+    Compile,
+    /// Taken from the running show at the install (a chain edit: they do not change).
+    TakeRunning,
+}
+
 /// A switch to an edited scene, built ahead (see [`SceneInstance::install`]).
 pub struct Replacement {
     revision: u64,
@@ -54,7 +63,7 @@ impl Replacement {
         gpu: &Gpu,
         assets: &Assets,
         output_size: (u32, u32),
-        rebuild: &dyn Fn(&SceneNode) -> bool,
+        (rebuild, transitions): (&dyn Fn(&SceneNode) -> bool, Transitions),
     ) -> Result<Self, ShaderError> {
         let old = &snapshot.scene;
         let same_msaa = old.msaa == scene.msaa;
@@ -101,7 +110,10 @@ impl Replacement {
                     .collect()
             })
             .collect();
-        let show = ShowRuntime::new(gpu, assets, &scene, output_size)?;
+        let show = match transitions {
+            Transitions::Compile => ShowRuntime::new(gpu, assets, &scene, output_size)?,
+            Transitions::TakeRunning => ShowRuntime::taking_transitions(gpu, assets, &scene, output_size),
+        };
         Ok(Self { revision: snapshot.revision, scene, kept, fresh, params, carried, show })
     }
 }

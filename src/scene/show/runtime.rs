@@ -43,7 +43,26 @@ impl ShowRuntime {
     ) -> Result<Option<Self>, ShaderError> {
         let Some(plan) = scene.show.clone() else { return Ok(None) };
         let mixer = Mixer::new(gpu, assets, &plan)?;
-        Ok(Some(Self {
+        Ok(Some(Self::with_mixer(gpu, assets, scene, output_size, plan, mixer)))
+    }
+
+    /// The runtime of `scene`'s show with no transitions of its own: it takes the running
+    /// show's in [`ShowRuntime::adopt_gpu_objects`], which must play the same transition kinds
+    /// on as many layers (a chain edit's).
+    pub fn taking_transitions(gpu: &Gpu, assets: &Assets, scene: &Scene, output_size: (u32, u32)) -> Option<Self> {
+        let plan = scene.show.clone()?;
+        Some(Self::with_mixer(gpu, assets, scene, output_size, plan, Mixer::to_take_over()))
+    }
+
+    fn with_mixer(
+        gpu: &Gpu,
+        assets: &Assets,
+        scene: &Scene,
+        output_size: (u32, u32),
+        plan: Arc<Show>,
+        mixer: Mixer,
+    ) -> Self {
+        Self {
             node_clip: (0..scene.nodes.len()).map(|n| plan.clip_of(n)).collect(),
             state: ShowState::new(&plan),
             spares: Spares::new(plan.clips.len()),
@@ -53,7 +72,7 @@ impl ShowRuntime {
             gpu: gpu.clone(),
             assets: assets.clone(),
             output_size,
-        }))
+        }
     }
 
     /// The plan.
@@ -106,9 +125,14 @@ impl ShowRuntime {
     /// Takes `old`'s transitions and shared images where this show plays the same transitions
     /// on the same layers (see [`Mixer::adopt`]); `old` is left with this one's, to be dropped.
     pub fn adopt_gpu_objects(&mut self, old: &mut ShowRuntime) {
-        if self.plan.kinds == old.plan.kinds && self.mixer.adopt(&mut old.mixer) {
+        let same = self.plan.kinds == old.plan.kinds
+            && self.plan.mix_kind == old.plan.mix_kind
+            && self.plan.layers.len() == old.plan.layers.len();
+        let taken = same && self.mixer.adopt(&mut old.mixer, &self.gpu.device, self.plan.effects.len());
+        if taken {
             std::mem::swap(&mut self.black, &mut old.black);
         }
+        debug_assert!(taken || !self.mixer.is_taking_over(), "a chain edit's show changed its transitions");
     }
 
     /// After every node was rebuilt on a new device: the play state stays; clips on screen run
