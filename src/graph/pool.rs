@@ -127,7 +127,11 @@ impl TexturePool {
     pub fn bytes(&self) -> u64 {
         self.entries
             .iter()
-            .map(|e| texture_bytes(e.key.size, e.key.format) * u64::from(e.key.layers.unwrap_or(1)))
+            .map(|e| {
+                texture_bytes(e.key.size, e.key.format)
+                    * u64::from(e.key.layers.unwrap_or(1))
+                    * u64::from(e.key.samples)
+            })
             .sum()
     }
 }

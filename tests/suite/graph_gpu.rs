@@ -79,6 +79,7 @@ fn transients_are_reused_within_and_across_frames() {
     let (second, _) = chain_frame(&mut runtime, &gpu);
     assert_eq!(second.stats.textures_created, 0, "a steady-state frame creates no textures");
     assert_eq!(runtime.pool().len(), 3);
+    assert_eq!(runtime.pool().bytes(), 3 * texture);
 }
 
 #[test]
