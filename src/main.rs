@@ -100,8 +100,9 @@ fn main() -> ExitCode {
         Some(Command::Bench(args)) => cli::bench(&assets, &gpu, &args),
         Some(Command::Triangulate(args)) => cli::triangulate(&args),
     };
-    // GPU objects let go of off the render thread are released before the driver unloads.
-    indra::gpu::wait_for_drops(std::time::Duration::from_secs(5));
+    // Worker threads end, and GPU objects let go of off the render thread are released, before
+    // the driver unloads (a clip still building at exit is a few seconds at most).
+    indra::gpu::wait_for_drops(std::time::Duration::from_secs(20));
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {

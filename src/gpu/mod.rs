@@ -26,7 +26,7 @@ pub use context::{BackendChoice, Gpu, GpuError, GpuOptions, instance_descriptor}
 pub use prefix_sum::{PrefixSum, SCAN_BINDINGS, SCAN_BLOCK, ScanTarget};
 pub use raster::{GrowableBuffer, RasterDesc, UniformBlock, raster_pipeline};
 pub use readback::{ReadbackError, read_buffer, read_texture_bytes, read_texture_rgba8};
-pub use reaper::{drop_later, wait_for_drops};
+pub use reaper::{drop_later, spawn_worker, wait_for_drops};
 pub use shader::{
     JoinedSource, ShaderError, compile_wgsl, validate_as_used, validate_module, validate_wgsl, validated,
 };

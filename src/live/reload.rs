@@ -243,7 +243,7 @@ impl LiveReload {
     fn start(&mut self, path: PathBuf, player: &Player, gpu: &Gpu, size: (u32, u32)) {
         let job = self.job(path.clone(), player, gpu, size);
         let (sender, receiver) = std::sync::mpsc::channel();
-        let spawned = std::thread::Builder::new().name("indra-reload".into()).spawn(move || {
+        let spawned = crate::gpu::spawn_worker("indra-reload", move || {
             let _ = sender.send(job.run());
         });
         let receiver = match spawned {

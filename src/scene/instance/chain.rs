@@ -51,12 +51,10 @@ impl SceneInstance {
             self.show_context().ok_or_else(|| format!("{command:?}: '{}' is a scene, not a show", self.scene.name))?;
         let snapshot = self.snapshot();
         let (sender, receiver) = std::sync::mpsc::channel();
-        std::thread::Builder::new()
-            .name("indra-chain-edit".into())
-            .spawn(move || {
-                let _ = sender.send(Self::prepare_chain_edit(&snapshot, &gpu, &assets, size, (layer, edit)));
-            })
-            .map_err(|e| format!("no thread to build the edit on: {e}"))?;
+        crate::gpu::spawn_worker("indra-chain-edit", move || {
+            let _ = sender.send(Self::prepare_chain_edit(&snapshot, &gpu, &assets, size, (layer, edit)));
+        })
+        .map_err(|e| format!("no thread to build the edit on: {e}"))?;
         Ok(receiver)
     }
 

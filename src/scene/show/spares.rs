@@ -219,7 +219,7 @@ impl Spares {
             let (send, receive) = mpsc::channel();
             let in_flight = self.in_flight.clone();
             in_flight.fetch_add(1, Ordering::Relaxed);
-            let spawned = std::thread::Builder::new().name("indra-clip-prepare".into()).spawn(move || {
+            let spawned = crate::gpu::spawn_worker("indra-clip-prepare", move || {
                 let _ = send.send(build.run());
                 in_flight.fetch_sub(1, Ordering::Relaxed);
                 release_free_memory();
