@@ -28,11 +28,7 @@ impl SceneInstance {
         // Its transitions are the running show's, unless the edit added the show's first effect
         // or removed its last (the dry/wet mix is a transition the show has only with effects).
         let transitions = match (&scene.show, &snapshot.scene.show) {
-            (Some(new), Some(old))
-                if new.kinds == old.kinds && new.mix_kind == old.mix_kind && new.layers.len() == old.layers.len() =>
-            {
-                Transitions::TakeRunning
-            }
+            (Some(new), Some(old)) if new.plays_same_transitions(old) => Transitions::TakeRunning,
             _ => Transitions::Compile,
         };
         // The chain's effects are built anew: an effect moved to another place is another node.

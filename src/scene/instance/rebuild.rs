@@ -50,6 +50,7 @@ pub struct Replacement {
     /// (same name, type and default), for kept nodes.
     carried: Vec<Vec<(usize, usize)>>,
     show: Option<ShowRuntime>,
+    transitions: Transitions,
 }
 
 impl Replacement {
@@ -114,7 +115,7 @@ impl Replacement {
             Transitions::Compile => ShowRuntime::new(gpu, assets, &scene, output_size)?,
             Transitions::TakeRunning => ShowRuntime::taking_transitions(gpu, assets, &scene, output_size),
         };
-        Ok(Self { revision: snapshot.revision, scene, kept, fresh, params, carried, show })
+        Ok(Self { revision: snapshot.revision, scene, kept, fresh, params, carried, show, transitions })
     }
 }
 
@@ -174,7 +175,7 @@ impl SceneInstance {
     /// default. Returns where each old parameter is now, for everything that holds parameter
     /// positions across the reload (queued events, scripts, MIDI learn).
     pub fn install(&mut self, replacement: Replacement) -> Result<Remap, Outdated> {
-        let Replacement { revision, scene, kept, mut fresh, mut params, carried, mut show } = replacement;
+        let Replacement { revision, scene, kept, mut fresh, mut params, carried, mut show, transitions } = replacement;
         if revision != self.revision {
             return Err(Outdated);
         }
@@ -202,7 +203,9 @@ impl SceneInstance {
             std::mem::replace(&mut self.params, params),
         ));
         if let (Some(show), Some(old)) = (&mut show, &mut self.show) {
-            show.adopt_gpu_objects(old);
+            if transitions == Transitions::TakeRunning {
+                show.take_transitions(old);
+            }
             let messages = show.carry_over(old, &self.scene, &self.params, &mut self.nodes, &|n| in_place[n]);
             self.messages.extend(messages);
         }

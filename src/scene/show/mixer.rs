@@ -62,8 +62,6 @@ pub struct Mixer {
     /// The kind that mixes an effect's dry and wet images, and one pass per effect.
     mix_kind: Option<usize>,
     fx: Vec<ImagePass>,
-    /// Made empty to take the running show's transitions (see [`Mixer::to_take_over`]).
-    taking_over: bool,
 }
 
 impl Mixer {
@@ -100,21 +98,14 @@ impl Mixer {
             Some(k) => show.effects.iter().map(|_| ImagePass::new(device, k)).collect(),
             None => Vec::new(),
         };
-        Ok(Self { kernels, passes, isf, mix_kind, fx, taking_over: false })
+        Ok(Self { kernels, passes, isf, mix_kind, fx })
     }
 
-    /// An empty mixer that takes everything from the running show's in [`Mixer::adopt`]: a
-    /// chain edit's, whose show plays the same transitions. Compiling them again cost the
-    /// edit's build the time and the driver's memory, and the running show the drop of them.
+    /// An empty mixer, to take the running show's with [`Mixer::take_from`]: a chain edit's,
+    /// whose show plays the same transitions. Compiling them again cost the edit's build the
+    /// time and the driver's memory, and the running show the drop of them.
     pub fn to_take_over() -> Self {
-        Self {
-            kernels: Vec::new(),
-            passes: Vec::new(),
-            isf: Vec::new(),
-            mix_kind: None,
-            fx: Vec::new(),
-            taking_over: true,
-        }
+        Self { kernels: Vec::new(), passes: Vec::new(), isf: Vec::new(), mix_kind: None, fx: Vec::new() }
     }
 
     /// The shader files a mixer for `show` is built from (an edit of one rebuilds it).
@@ -124,46 +115,21 @@ impl Mixer {
         files
     }
 
-    /// Whether it waits to take the running show's transitions (see [`Mixer::to_take_over`]).
-    pub fn is_taking_over(&self) -> bool {
-        self.taking_over
-    }
-
-    /// Takes `old`'s pipelines, passes and ISF transition nodes in place of this mixer's where
-    /// both were built for the same kinds and layers (a chain edit or a reload that left the
-    /// transitions alone), and gives `old` these in exchange; one made by
-    /// [`Mixer::to_take_over`] takes them whatever they are (its show has `old`'s kinds and
-    /// layers) and makes or drops dry/wet passes to have one for each of `effects`. The objects
-    /// that drew the frame before draw the next one with their bind groups and buffers in place;
-    /// with fresh ones the edit frame's submit took 0.09–0.16 ms more than its neighbours' on an
-    /// H100 host (median of 11–14 edits), 0.01–0.02 ms with these. Returns whether it took them.
-    pub fn adopt(&mut self, old: &mut Mixer, device: &wgpu::Device, effects: usize) -> bool {
-        let same = self.kernels.len() == old.kernels.len()
-            && self.passes.len() == old.passes.len()
-            && self.mix_kind == old.mix_kind
-            && self.isf.iter().zip(&old.isf).all(|(a, b)| a.len() == b.len());
-        if !same && !self.taking_over {
-            return false;
-        }
-        std::mem::swap(&mut self.kernels, &mut old.kernels);
-        std::mem::swap(&mut self.passes, &mut old.passes);
-        std::mem::swap(&mut self.isf, &mut old.isf);
-        if std::mem::take(&mut self.taking_over) {
-            self.mix_kind = old.mix_kind;
-            self.fx = std::mem::take(&mut old.fx);
-            self.fx.truncate(effects);
-            if let Some(kernel) = self.mix_kind.and_then(|k| self.kernels[k].as_ref()) {
-                while self.fx.len() < effects {
-                    self.fx.push(ImagePass::new(device, kernel));
-                }
-            }
-            return true;
-        }
+    /// Takes `old`'s pipelines, passes and ISF transition nodes (it was built for the same
+    /// transition kinds on as many layers), and makes or drops dry/wet passes to have one for
+    /// each of `effects`. The objects that drew the frame before draw the next one with their
+    /// bind groups and buffers in place; with fresh ones the edit frame's submit took 0.09–0.16
+    /// ms more than its neighbours' on an H100 host (median of 11–14 edits), 0.01–0.02 ms with
+    /// these.
+    pub fn take_from(&mut self, old: &mut Mixer, device: &wgpu::Device, effects: usize) {
+        *self = std::mem::replace(old, Self::to_take_over());
         // Dry/wet passes are alike: the effects there were keep theirs, a new one takes a new one.
-        for (new, before) in self.fx.iter_mut().zip(old.fx.iter_mut()) {
-            std::mem::swap(new, before);
+        self.fx.truncate(effects);
+        if let Some(kernel) = self.mix_kind.and_then(|k| self.kernels[k].as_ref()) {
+            while self.fx.len() < effects {
+                self.fx.push(ImagePass::new(device, kernel));
+            }
         }
-        true
     }
 
     /// This frame's use of the mixer: each layer's pass lent out once.

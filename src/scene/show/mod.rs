@@ -164,6 +164,12 @@ impl Show {
         self.clips.iter().position(|c| c.nodes.contains(&node))
     }
 
+    /// Whether `other` plays the same transitions: the same kinds, dry/wet mix and number of
+    /// layers (a mixer built for one serves the other).
+    pub fn plays_same_transitions(&self, other: &Show) -> bool {
+        self.kinds == other.kinds && self.mix_kind == other.mix_kind && self.layers.len() == other.layers.len()
+    }
+
     /// Effect node `node`'s place among [`Show::effects`] (its dry/wet pass), if it is one.
     pub fn effect_slot(&self, node: usize) -> Option<usize> {
         self.effects.binary_search(&node).ok()

@@ -47,8 +47,8 @@ impl ShowRuntime {
     }
 
     /// The runtime of `scene`'s show with no transitions of its own: it takes the running
-    /// show's in [`ShowRuntime::adopt_gpu_objects`], which must play the same transition kinds
-    /// on as many layers (a chain edit's).
+    /// show's in [`ShowRuntime::take_transitions`], which must play the same transitions (see
+    /// [`Show::plays_same_transitions`]; a chain edit's).
     pub fn taking_transitions(gpu: &Gpu, assets: &Assets, scene: &Scene, output_size: (u32, u32)) -> Option<Self> {
         let plan = scene.show.clone()?;
         Some(Self::with_mixer(gpu, assets, scene, output_size, plan, Mixer::to_take_over()))
@@ -122,17 +122,12 @@ impl ShowRuntime {
         messages
     }
 
-    /// Takes `old`'s transitions and shared images where this show plays the same transitions
-    /// on the same layers (see [`Mixer::adopt`]); `old` is left with this one's, to be dropped.
-    pub fn adopt_gpu_objects(&mut self, old: &mut ShowRuntime) {
-        let same = self.plan.kinds == old.plan.kinds
-            && self.plan.mix_kind == old.plan.mix_kind
-            && self.plan.layers.len() == old.plan.layers.len();
-        let taken = same && self.mixer.adopt(&mut old.mixer, &self.gpu.device, self.plan.effects.len());
-        if taken {
-            std::mem::swap(&mut self.black, &mut old.black);
-        }
-        debug_assert!(taken || !self.mixer.is_taking_over(), "a chain edit's show changed its transitions");
+    /// Takes `old`'s transitions and shared image (see [`Mixer::take_from`]): this runtime was
+    /// made by [`ShowRuntime::taking_transitions`] for a show that plays the same ones.
+    pub fn take_transitions(&mut self, old: &mut ShowRuntime) {
+        debug_assert!(self.plan.plays_same_transitions(&old.plan), "a chain edit's show changed its transitions");
+        self.mixer.take_from(&mut old.mixer, &self.gpu.device, self.plan.effects.len());
+        std::mem::swap(&mut self.black, &mut old.black);
     }
 
     /// After every node was rebuilt on a new device: the play state stays; clips on screen run
