@@ -3,7 +3,7 @@
 //!
 //! Layers, from the bottom (a module imports only lower layers; `docs/architecture.md` is the
 //! map, and a test holds it to this crate): [`time`], [`files`], [`atomic_file`] → [`assets`],
-//! [`geometry`], [`gpu`], [`graph`] → [`params`] → [`techniques`] → [`scene`] → [`control`],
+//! [`geometry`], [`gpu`], [`graph`] → [`params`], [`dmx`] → [`techniques`] → [`scene`] → [`control`],
 //! [`live`] → [`offscreen`] → [`app`]; `main.rs` is the command line only.
 
 #![warn(missing_docs)]
@@ -12,6 +12,7 @@ pub mod app;
 pub mod assets;
 pub mod atomic_file;
 pub mod control;
+pub mod dmx;
 pub mod files;
 pub mod geometry;
 pub mod gpu;

@@ -37,6 +37,8 @@ pub struct WindowOptions {
     pub ndi_out: Option<String>,
     /// Offer the output as this PipeWire video source from the start (see `run --pipewire-out`).
     pub pipewire_out: Option<String>,
+    /// Send the fixtures of this DMX patch the output's pixels (see `run --dmx-out`).
+    pub dmx_out: Option<std::path::PathBuf>,
 }
 
 /// A window title showing `scene` (cut to a scene name's greatest length: the display server

@@ -65,6 +65,8 @@ pub(super) struct Running {
     pub(super) video_base: std::path::PathBuf,
     /// The windows of the scene's other outputs (projectors).
     pub(super) outputs: Vec<OutputWindow>,
+    /// The DMX patch the output's pixels go to (`--dmx-out`).
+    pub(super) lights: Option<crate::dmx::LiveLights>,
 }
 
 /// The most takes started in a minute.
@@ -152,8 +154,17 @@ impl Running {
         let mut projected = Vec::new();
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("window_frame") });
-        match self.player.encode(&self.gpu, &mut self.runtime, &mut encoder, size, |_| {}) {
+        let lights = self.lights.as_ref();
+        let drawn = self.player.encode(&self.gpu, &mut self.runtime, &mut encoder, size, |graph| {
+            if let Some(lights) = lights {
+                lights.add_pass(graph);
+            }
+        });
+        match drawn {
             Ok(output) => {
+                if let Some(lights) = self.lights.as_mut() {
+                    lights.after_encode(&mut encoder, self.player.last_step().frame);
+                }
                 self.blit.record(
                     &self.gpu.device,
                     &self.gpu.queue,
@@ -198,6 +209,10 @@ impl Running {
             self.overlay.recording = Some(recording_status(video, self.player.last_step().dt));
         }
         self.overlay.sending.clear();
+        if let Some(lights) = self.lights.as_mut() {
+            lights.after_submit(&self.gpu.device);
+            self.overlay.sending.push(lights.status());
+        }
         for (_, send) in &mut self.sends {
             send.after_submit();
             send.poll(&self.gpu.device);
@@ -275,6 +290,12 @@ impl Running {
                 }
                 self.runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
                 self.blit = Blit::new(&gpu.device);
+                if let Some(lights) = self.lights.as_mut()
+                    && let Err(e) = lights.move_to(&gpu.device)
+                {
+                    self.overlay.report(format!("DMX out stopped on the new device: {e}"));
+                    self.lights = None;
+                }
                 (self.egui_state, self.egui_renderer) = egui_parts(&self.window, &gpu, self.config.format);
                 self.gpu = gpu;
                 self.guard.reset();

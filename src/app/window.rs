@@ -185,7 +185,19 @@ impl WindowApp {
                 );
             }
         }
+        let lights =
+            self.options.dmx_out.as_ref().and_then(|patch| match crate::dmx::LiveLights::start(&gpu.device, patch) {
+                Ok(lights) => {
+                    log::info!("sending DMX as {} says", patch.display());
+                    Some(lights)
+                }
+                Err(e) => {
+                    overlay.report(format!("no DMX out: {e}"));
+                    None
+                }
+            });
         Ok(Running {
+            lights,
             window,
             surface,
             config,

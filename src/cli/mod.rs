@@ -20,6 +20,7 @@ mod bench_record;
 mod check;
 mod list;
 mod render;
+mod render_dmx;
 mod run;
 mod triangulate;
 
@@ -27,6 +28,7 @@ pub use bench::{BenchArgs, bench};
 pub use check::check;
 pub use list::{list, list_cameras, list_ndi};
 pub use render::{RenderArgs, render};
+use render_dmx::RenderDmx;
 pub use run::{RunArgs, run};
 
 pub use triangulate::{TriangulateArgs, triangulate};

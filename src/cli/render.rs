@@ -71,6 +71,14 @@ pub struct RenderArgs {
     /// is also the video's sound track.
     #[arg(long, value_name = "FILE")]
     pub audio: Option<PathBuf>,
+    /// Send the fixtures of this DMX patch file (Art-Net or sACN, see docs/lights.md) the
+    /// pixels of each frame, in real time (each frame waits until it is due at 1/dt).
+    #[arg(long, value_name = "PATCH")]
+    pub dmx_out: Option<PathBuf>,
+    /// Also write every frame's universes to this file (per universe: the frame as u64, the
+    /// universe as u16, little-endian, then its 512 channels).
+    #[arg(long, value_name = "FILE", requires = "dmx_out")]
+    pub dmx_record: Option<PathBuf>,
 }
 
 /// Renders a PNG sequence.
@@ -147,6 +155,10 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
         eprintln!("seeking to frame {} (every step runs; nothing before it is drawn)", args.start);
     }
     renderer.seek(args.start).map_err(|e| e.to_string())?;
+    let mut lights = match &args.dmx_out {
+        Some(patch) => Some(super::RenderDmx::start(patch, args.dmx_record.as_deref(), &mut renderer, dt)?),
+        None => None,
+    };
     let bar = indicatif::ProgressBar::new(args.frames);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}")
@@ -157,6 +169,9 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
         sink.write(&frame)?;
         for send in &mut sends {
             send.take(&frame.rgba, 1, frame.time.frame).map_err(|e| e.to_string())?;
+        }
+        if let Some(lights) = lights.as_mut() {
+            lights.frame(&renderer, frame.time.frame)?;
         }
         // What a node tells the performer (a clip that cannot play, a bad image path) is said
         // once, as the window's overlay says it; the render goes on.
@@ -179,6 +194,9 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     };
     for send in sends {
         send.close().map_err(|e| e.to_string())?;
+    }
+    if let Some(lights) = lights {
+        eprintln!("sent {} DMX packet(s)", lights.finish()?);
     }
     eprintln!("wrote {} frame(s) to {place}", args.frames);
     Ok(())

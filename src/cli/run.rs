@@ -117,6 +117,14 @@ pub struct RunArgs {
     /// show never waits: frames the source cannot take are dropped and counted.
     #[arg(long, value_name = "NAME")]
     pub pipewire_out: Option<String>,
+    /// Send the fixtures of this DMX patch file the pixels they sit on, over Art-Net or sACN
+    /// (see docs/lights.md), from a thread of its own at the patch's rate.
+    #[arg(long, value_name = "PATCH")]
+    pub dmx_out: Option<PathBuf>,
+    /// Take DMX in from a lighting desk as this file says: where to listen, and which channels
+    /// drive which parameters (see docs/lights.md).
+    #[arg(long, value_name = "FILE")]
+    pub dmx_in: Option<PathBuf>,
 }
 
 /// Where OSC listens unless told otherwise: loopback, so nothing on the network can reach it.
@@ -171,6 +179,7 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         stream: args.stream.clone(),
         ndi_out: args.ndi_out.clone(),
         pipewire_out: args.pipewire_out.clone(),
+        dmx_out: args.dmx_out.clone(),
     };
     let web = match &args.web {
         Some(addr) => {
@@ -197,6 +206,7 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         audio_learn_file: args.audio_learn.clone().unwrap_or_else(|| indra::files::user_data("audio-learn.ron")),
         link: args.link,
         sites: indra::control::site::SiteRules { hosts: args.web_hosts.clone(), cors: args.oscquery_cors.clone() },
+        dmx_in: args.dmx_in.clone(),
     };
     indra::app::run(assets.clone(), gpu.clone(), scene, options, control, notices)
 }

@@ -50,6 +50,8 @@ pub struct ControlOptions {
     pub link: bool,
     /// Host names and third-party origins the OSCQuery server answers beyond its own.
     pub sites: SiteRules,
+    /// DMX in from a lighting desk, as this file says (`None`: no DMX in).
+    pub dmx_in: Option<PathBuf>,
 }
 
 impl Default for ControlOptions {
@@ -68,6 +70,7 @@ impl Default for ControlOptions {
             audio_in: Some(None),
             link: false,
             sites: SiteRules::default(),
+            dmx_in: None,
         }
     }
 }
@@ -118,6 +121,8 @@ pub struct ControlHub {
     preset_names: Vec<String>,
     /// A recall waiting for its effect chain edits: name, preset, morph seconds.
     pending_recall: Option<(String, PresetFile, f64)>,
+    /// DMX in, when a file asks for it.
+    pub dmx: Option<super::dmx_in::DmxControl>,
 }
 
 /// Frames between re-reads of the preset folder (files may be copied in by hand).
@@ -168,6 +173,11 @@ impl ControlHub {
         notices.extend(problem);
         let audio_mapper = AudioMapper::with_learned(scene, audio_learn.bound(scene));
         let audio = open_audio(options.audio_in.as_ref(), !audio_mapper.is_empty(), &mut notices);
+        let dmx = options.dmx_in.as_deref().and_then(|path| {
+            let started = super::dmx_in::DmxInFile::load(path)
+                .and_then(|file| super::dmx_in::DmxControl::start(file, scene, &mut notices));
+            started.map_err(|e| notices.push(format!("no DMX in: {e}"))).ok()
+        });
         #[cfg(feature = "link")]
         let link = options.link.then(|| super::link::LinkInput::join(scene.bpm));
         #[cfg(not(feature = "link"))]
@@ -202,6 +212,7 @@ impl ControlHub {
             frame_count: 0,
             preset_names,
             pending_recall: None,
+            dmx,
         }
     }
 
@@ -211,6 +222,9 @@ impl ControlHub {
     pub fn set_scene(&mut self, scene: &Scene, remap: Option<&Remap>) {
         self.router = OscRouter::new(scene);
         self.rebuild_audio(scene);
+        if let Some(dmx) = self.dmx.as_mut() {
+            dmx.set_scene(scene, &mut self.notices);
+        }
         let learning = self.mapper.learning.take();
         self.mapper = MidiMapper::new(scene, &self.learn.load());
         self.mapper.learning = learning.and_then(|t| match remap {
@@ -255,6 +269,9 @@ impl ControlHub {
         {
             events.extend(self.audio_mapper.events(&frame, dt, scene));
             self.audio_frame = Some(frame);
+        }
+        if let Some(dmx) = self.dmx.as_mut() {
+            events.extend(dmx.events(scene));
         }
         // A running MIDI clock sets the show's tempo.
         if self.mapper.clock.playing {

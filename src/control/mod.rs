@@ -8,6 +8,7 @@
 pub mod address;
 pub mod audio;
 pub mod discovery;
+pub mod dmx_in;
 pub mod feedback;
 pub mod http;
 pub mod hub;

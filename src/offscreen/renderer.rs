@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use crate::assets::Assets;
+use crate::dmx::PixelMap;
 use crate::gpu::DEFAULT_STALL_TIMEOUT;
 use crate::gpu::{Blit, Gpu, read_texture_rgba8};
 use crate::graph::{FrameStats, GraphRuntime, PersistentTexture};
@@ -37,6 +38,8 @@ pub struct OffscreenRenderer {
     submitted: Option<wgpu::SubmissionIndex>,
     /// Which output is read back: 0 the scene's output, n its n-th extra output.
     shown: usize,
+    /// A DMX patch's pixel map and the output it samples.
+    pixel_map: Option<(PixelMap, usize)>,
 }
 
 impl OffscreenRenderer {
@@ -73,6 +76,7 @@ impl OffscreenRenderer {
             guard,
             submitted: None,
             shown: 0,
+            pixel_map: None,
         })
     }
 
@@ -163,8 +167,15 @@ impl OffscreenRenderer {
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("offscreen_frame") });
         let (blit, target, shown, size) = (&mut self.blit, &self.target, self.shown, self.size);
+        let pixel_map = self.pixel_map.as_ref();
         let mut encoded = false;
         let output = self.player.encode(&self.gpu, &mut self.runtime, &mut encoder, self.size, |graph| {
+            if let Some((map, image)) = pixel_map {
+                let source = if *image == 0 { graph.output() } else { graph.extra_output(image - 1) };
+                if let Some(source) = source {
+                    map.add_pass(graph, source);
+                }
+            }
             // The display encode is a pass of the frame: timed with the others, after them.
             let source = if shown == 0 { graph.output() } else { graph.extra_output(shown - 1) };
             let Some(source) = source else { return };
@@ -184,6 +195,23 @@ impl OffscreenRenderer {
         self.guard.submitted(index);
         self.runtime.after_submit();
         Ok((time, output.stats))
+    }
+
+    /// Samples a DMX patch's fixtures on `image` (0 the output, n the n-th extra output) in
+    /// every frame from now on; [`OffscreenRenderer::read_pixel_map`] reads them.
+    pub fn set_pixel_map(&mut self, map: PixelMap, image: usize) -> Result<(), String> {
+        let count = self.player.instance().scene().outputs.len();
+        if image > count {
+            return Err(format!("the patch samples image {image}, but the scene has outputs 0 to {count}"));
+        }
+        self.pixel_map = Some((map, image));
+        Ok(())
+    }
+
+    /// The newest frame's sampled fixture pixels (waits for the GPU).
+    pub fn read_pixel_map(&self) -> Option<Result<Vec<[u16; 3]>, crate::gpu::ReadbackError>> {
+        let (map, _) = self.pixel_map.as_ref()?;
+        Some(map.read_now(&self.gpu.device, &self.gpu.queue))
     }
 
     /// The submission of the newest frame `render_only` recorded.

@@ -17,6 +17,8 @@ pub enum Source {
     Replay,
     /// Audio analysis (a band, the level, an onset) through the scene's audio mappings.
     Audio,
+    /// A DMX channel from a lighting desk (Art-Net or sACN in).
+    Dmx,
 }
 
 /// Set parameter `param` (or one `component` of it) of node `node` to `value`.

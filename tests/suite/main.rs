@@ -18,6 +18,7 @@ mod flood;
 mod gl_transitions;
 mod graph_gpu;
 mod isf_reference;
+mod lights;
 mod live;
 #[path = "../support/live_show.rs"]
 mod live_show;

@@ -195,7 +195,8 @@ impl SceneInstance {
             }
             return;
         }
-        let live = matches!(w.source, Source::Ui | Source::Osc | Source::Midi | Source::Replay | Source::Audio);
+        let live =
+            matches!(w.source, Source::Ui | Source::Osc | Source::Midi | Source::Replay | Source::Audio | Source::Dmx);
         if live && self.has_track(w.node, w.param) {
             self.overridden.insert((w.node, w.param));
         }
