@@ -54,6 +54,10 @@ pub struct BenchArgs {
     /// full latency.
     #[arg(long)]
     pub pipelined: bool,
+    /// Sample this DMX patch's fixtures in every frame (its pass is timed as `dmx/pixel_map`;
+    /// nothing is sent).
+    #[arg(long, value_name = "PATCH")]
+    pub dmx_patch: Option<std::path::PathBuf>,
 }
 
 /// Renders `frames` frames and prints per-pass GPU medians and frame time.
@@ -94,6 +98,13 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     let mut renderer =
         OffscreenRenderer::new(device, assets, scene, Some(args.size), None, None).map_err(|e| e.to_string())?;
     renderer.instance_mut().animate = !args.no_animation;
+    let mut dmx_line = None;
+    if let Some(path) = &args.dmx_patch {
+        let layout = indra::dmx::Layout::new(indra::dmx::Patch::load(path)?)?;
+        let map = indra::dmx::PixelMap::new(&renderer.gpu().device, &layout.boxes).map_err(|e| e.to_string())?;
+        renderer.set_pixel_map(map, layout.patch.image)?;
+        dmx_line = Some(format!("dmx        {} LEDs in {} universes", layout.boxes.len(), layout.universes().len()));
+    }
     renderer.seek(args.start).map_err(|e| e.to_string())?;
     for _ in 0..args.warmup {
         renderer.render_only().map_err(|e| e.to_string())?;
@@ -150,6 +161,9 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     );
     for s in &args.edits.sets {
         say!("set        {s}");
+    }
+    if let Some(line) = dmx_line {
+        say!("{line}");
     }
     if timestamps {
         say!("{:<28} {:>12} {:>8}", "pass", "GPU median", "samples");

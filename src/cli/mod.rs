@@ -109,6 +109,22 @@ impl SceneEdits {
     }
 }
 
+/// The DMX patch a command sends to: `--dmx-out`, else the file the scene names (`dmx:`), found
+/// as the scene's other files are (beside it, or under the project's folders).
+fn dmx_patch(
+    assets: &Assets,
+    flag: Option<&std::path::Path>,
+    scene: &Scene,
+) -> Result<Option<std::path::PathBuf>, String> {
+    match (flag, &scene.dmx) {
+        (Some(path), _) => Ok(Some(path.to_path_buf())),
+        (None, Some(name)) => {
+            assets.locate_file(name).map(Some).map_err(|e| format!("'{}' names the DMX patch {name}: {e}", scene.name))
+        }
+        (None, None) => Ok(None),
+    }
+}
+
 /// Loads a scene and applies the command line's edits to it.
 fn scene_with_edits(assets: &Assets, name: &str, edits: &SceneEdits) -> Result<Scene, String> {
     edits.apply(load_scene(assets, name).map_err(|e| e.to_string())?)

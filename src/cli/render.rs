@@ -72,12 +72,13 @@ pub struct RenderArgs {
     #[arg(long, value_name = "FILE")]
     pub audio: Option<PathBuf>,
     /// Send the fixtures of this DMX patch file (Art-Net or sACN, see docs/lights.md) the
-    /// pixels of each frame, in real time (each frame waits until it is due at 1/dt).
+    /// pixels of each frame, in real time (each frame waits until it is due at 1/dt); default:
+    /// the patch the scene or show names (`dmx:`).
     #[arg(long, value_name = "PATCH")]
     pub dmx_out: Option<PathBuf>,
     /// Also write every frame's universes to this file (per universe: the frame as u64, the
     /// universe as u16, little-endian, then its 512 channels).
-    #[arg(long, value_name = "FILE", requires = "dmx_out")]
+    #[arg(long, value_name = "FILE")]
     pub dmx_record: Option<PathBuf>,
 }
 
@@ -102,6 +103,14 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
         }
     }
     scene.check_texture_budget(args.size.unwrap_or(scene.size))?;
+    // A patch the scene names but that cannot be found costs the lights, not the frames.
+    let patch = super::dmx_patch(assets, args.dmx_out.as_deref(), &scene).unwrap_or_else(|e| {
+        eprintln!("warning: no DMX out: {e}");
+        None
+    });
+    if args.dmx_record.is_some() && patch.is_none() {
+        return Err(format!("--dmx-record needs a patch: '{}' names none; give --dmx-out", scene.name));
+    }
     let stem = Path::new(&args.scene).file_stem().map_or("frame".into(), |s| s.to_string_lossy().into_owned());
     let size = args.size.unwrap_or(scene.size);
     let fps = 1.0 / dt;
@@ -155,8 +164,8 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
         eprintln!("seeking to frame {} (every step runs; nothing before it is drawn)", args.start);
     }
     renderer.seek(args.start).map_err(|e| e.to_string())?;
-    let mut lights = match &args.dmx_out {
-        Some(patch) => Some(super::RenderDmx::start(patch, args.dmx_record.as_deref(), &mut renderer, dt)?),
+    let mut lights = match patch {
+        Some(patch) => Some(super::RenderDmx::start(&patch, args.dmx_record.as_deref(), &mut renderer, dt)?),
         None => None,
     };
     let bar = indicatif::ProgressBar::new(args.frames);

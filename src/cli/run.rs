@@ -118,7 +118,8 @@ pub struct RunArgs {
     #[arg(long, value_name = "NAME")]
     pub pipewire_out: Option<String>,
     /// Send the fixtures of this DMX patch file the pixels they sit on, over Art-Net or sACN
-    /// (see docs/lights.md), from a thread of its own at the patch's rate.
+    /// (see docs/lights.md), from a thread of its own at the patch's rate; default: the patch
+    /// the scene or show names (`dmx:`).
     #[arg(long, value_name = "PATCH")]
     pub dmx_out: Option<PathBuf>,
     /// Take DMX in from a lighting desk as this file says: where to listen, and which channels
@@ -179,7 +180,13 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         stream: args.stream.clone(),
         ndi_out: args.ndi_out.clone(),
         pipewire_out: args.pipewire_out.clone(),
-        dmx_out: args.dmx_out.clone(),
+        dmx_out: match super::dmx_patch(assets, args.dmx_out.as_deref(), &scene) {
+            Ok(patch) => patch,
+            Err(e) => {
+                notices.push(format!("no DMX out: {e}"));
+                None
+            }
+        },
     };
     let web = match &args.web {
         Some(addr) => {

@@ -6,8 +6,9 @@ use serde::Deserialize;
 
 /// The largest patch file read (a patch of thousands of fixtures is a few hundred kB).
 pub const MAX_PATCH_BYTES: u64 = 4 << 20;
-/// The most pixels one patch maps (a few LED walls; each costs 8 bytes of readback a frame).
-pub const MAX_PIXELS: usize = 65_536;
+/// The most pixels one patch maps (a few LED walls; each costs 8 bytes of readback a frame and
+/// one workgroup of the pixel-map pass, whose count a dispatch holds to 65 535).
+pub const MAX_PIXELS: usize = 65_535;
 /// The most universes one patch sends.
 pub const MAX_UNIVERSES: usize = 1024;
 

@@ -107,7 +107,8 @@ impl PixelMap {
             let mut pass = ctx
                 .encoder
                 .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("pixel_map"), timestamp_writes: None });
-            self.kernel.dispatch(&mut pass, &[&group], [self.count, 1, 1]);
+            // One workgroup of 64 per LED (the shader's layout).
+            self.kernel.dispatch(&mut pass, &[&group], [self.count * 64, 1, 1]);
         });
     }
 

@@ -53,6 +53,8 @@ pub struct Scene {
     pub tracks: Vec<BoundTrack>,
     /// More outputs (windows; `render --output N`), numbered from 1.
     pub outputs: Vec<SceneOutput>,
+    /// The DMX patch file the scene names (`dmx:`), as written; `--dmx-out` overrides it.
+    pub dmx: Option<String>,
     /// OSC addresses declared in the scene's `controls`, besides `/indra/<node>/<param>`.
     pub osc_aliases: Vec<(String, Target)>,
     /// MIDI mappings declared in the scene's `controls`.

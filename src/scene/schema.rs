@@ -65,6 +65,9 @@ pub struct SceneFile {
     /// Animation tracks.
     #[serde(default)]
     pub tracks: Vec<TrackFile>,
+    /// A DMX patch file (docs/lights.md) whose fixtures the show's pixels light.
+    #[serde(default)]
+    pub dmx: Option<String>,
 }
 
 /// One more output: a node's texture, optionally through a warp (projection mapping).

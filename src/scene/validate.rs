@@ -167,6 +167,7 @@ impl<'a> Validator<'a> {
             nodes: ordered,
             output,
             outputs: Vec::new(),
+            dmx: file.dmx.clone(),
             tracks,
             osc_aliases,
             midi,

@@ -79,6 +79,9 @@ pub struct ShowFile {
     /// Output windows of the composition (sources default to the master).
     #[serde(default)]
     pub outputs: Vec<OutputFile>,
+    /// A DMX patch file (docs/lights.md) whose fixtures the show's pixels light.
+    #[serde(default)]
+    pub dmx: Option<String>,
     /// OSC aliases and MIDI mappings; targets as `layer/1.opacity`, `master.level` or
     /// `<clip>/<node>.<param>`.
     #[serde(default)]

@@ -313,6 +313,7 @@ impl Builder<'_> {
             output: master,
             tracks,
             outputs: Vec::new(),
+            dmx: file.dmx.clone(),
             osc_aliases: vec![("/indra/master".into(), Target { node: master, param: 0, component: None })],
             midi: Vec::new(),
             show: None,
