@@ -6,6 +6,7 @@
 mod chain_edits;
 mod effects_panel;
 mod input;
+mod lights_panel;
 mod outputs;
 mod panel;
 mod param_widget;

@@ -156,8 +156,12 @@ pub fn draw_ui(
     overlay: &mut Overlay,
     hub: &mut ControlHub,
     time: FrameTime,
+    mut lights: Option<(&mut crate::dmx::LiveLights, &wgpu::Queue)>,
 ) -> Vec<ControlEvent> {
     let mut events = Vec::new();
+    if let Some((lights, queue)) = lights.as_mut() {
+        super::lights_panel::fixture_overlay(ui.ctx(), lights, queue);
+    }
     if overlay.panel_visible {
         egui::Panel::left("indra_params").resizable(true).default_size(300.0).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
@@ -189,6 +193,11 @@ pub fn draw_ui(
                 super::web_panel::web_panel(ui, &hub.web_urls);
                 events.extend(super::show_panel::show_panel(ui, instance, hub));
                 events.extend(super::effects_panel::effects_panel(ui, instance, hub));
+                if let Some((lights, _)) = lights.as_mut()
+                    && let Some(message) = super::lights_panel::lights_panel(ui, lights)
+                {
+                    overlay.report(message);
+                }
                 events.extend(param_panel(ui, instance, hub).into_iter().map(ControlEvent::Write));
                 ui.separator();
                 events.extend(preset_panel(ui, instance, overlay, hub));

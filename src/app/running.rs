@@ -495,7 +495,11 @@ impl Running {
         let (instance, overlay) = (self.player.instance_mut(), &mut self.overlay);
         let mut events = Vec::new();
         let hub = &mut self.hub;
-        let mut output = ctx.run_ui(input, |ui| events = draw_ui(ui, instance, overlay, hub, now));
+        let (mut lights, queue) = (self.lights.as_mut(), &self.gpu.queue);
+        let mut output = ctx.run_ui(input, |ui| {
+            let lights = lights.as_mut().map(|l| (&mut **l, queue));
+            events = draw_ui(ui, instance, overlay, hub, now, lights);
+        });
         self.ui_events.extend(events);
         self.egui_state.handle_platform_output(&self.window, output.platform_output);
         let primitives = ctx.tessellate(output.shapes, output.pixels_per_point);

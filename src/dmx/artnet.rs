@@ -211,6 +211,11 @@ mod tests {
             }
             other => panic!("not ArtPollReply: {other:?}"),
         }
+        // The responder counts after it has sent.
+        let deadline = std::time::Instant::now() + Duration::from_secs(5);
+        while sender.polls_answered() == 0 && std::time::Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(10));
+        }
         assert_eq!(sender.polls_answered(), 1);
     }
 }

@@ -93,6 +93,13 @@ impl Layout {
         Ok(Self { patch, boxes, slots })
     }
 
+    /// Moves fixture `index` by (`dx`, `dy`) of the picture; its channels stay.
+    pub fn move_fixture(&mut self, index: usize, dx: f32, dy: f32) {
+        let Some(fixture) = self.patch.fixtures.get_mut(index) else { return };
+        fixture.shape.translate(dx, dy);
+        self.boxes = self.patch.fixtures.iter().flat_map(|f| pixel_boxes(&f.shape)).collect();
+    }
+
     /// The universes the patch fills, in order.
     pub fn universes(&self) -> Vec<u16> {
         let mut list: Vec<u16> = self.slots.iter().map(|s| s.universe).collect();
@@ -253,6 +260,23 @@ mod tests {
                 .unwrap();
         let u = layout.encode(&[[32768, 65535, 0]])[&1];
         assert_eq!(&u[0..3], &[32, 128, 0]);
+    }
+
+    #[test]
+    fn a_moved_fixture_keeps_its_channels_and_a_saved_patch_reads_back_the_same() {
+        let mut layout = Layout::new(patch(
+            "(name: \"a\", shape: Strip(from: (0.1, 0.5), to: (0.3, 0.5), pixels: 3), universe: 1), \
+             (name: \"b\", shape: Matrix(at: (0.5, 0.5), size: (0.2, 0.2), columns: 2, rows: 2), universe: 2, bits: 16)",
+        ))
+        .unwrap();
+        let (slots, first) = (layout.slots.clone(), layout.boxes[3]);
+        layout.move_fixture(1, 0.25, -0.5);
+        assert_eq!(layout.slots, slots);
+        assert!((layout.boxes[3].min[0] - first.min[0] - 0.25).abs() < 1e-6);
+        assert!((layout.boxes[3].min[1] - first.min[1] + 0.5).abs() < 1e-6);
+        assert_eq!(layout.patch.fixtures[1].shape.handle(), (0.85, 0.1));
+        let again = Patch::parse(&layout.patch.to_ron(), "saved").unwrap();
+        assert_eq!(again, layout.patch);
     }
 
     #[test]

@@ -7,12 +7,19 @@ use super::{DmxOut, Layout, Patch, PixelMap};
 
 /// A patch playing in the window.
 pub struct LiveLights {
-    boxes: Vec<super::PixelBox>,
+    layout: Layout,
+    path: std::path::PathBuf,
     map: PixelMap,
     out: DmxOut,
     image: usize,
     /// The patch file, for messages.
     pub origin: String,
+    /// The panel draws the fixtures over the output.
+    pub show_fixtures: bool,
+    /// The panel lets the performer drag the fixtures.
+    pub editing: bool,
+    /// Fixtures moved since the patch was loaded or saved.
+    pub moved: bool,
 }
 
 impl LiveLights {
@@ -22,14 +29,37 @@ impl LiveLights {
         let layout = Layout::new(Patch::load(path)?).map_err(|e| format!("{origin}: {e}"))?;
         let map = PixelMap::new(device, &layout.boxes).map_err(|e| e.to_string())?;
         let image = layout.patch.image;
-        let boxes = layout.boxes.clone();
-        Ok(Self { boxes, map, out: DmxOut::start(layout)?, image, origin })
+        let out = DmxOut::start(layout.clone())?;
+        let path = path.to_path_buf();
+        Ok(Self { layout, path, map, out, image, origin, show_fixtures: false, editing: false, moved: false })
+    }
+
+    /// The patch as it is now (fixtures moved by the panel included).
+    pub fn patch(&self) -> &Patch {
+        &self.layout.patch
+    }
+
+    /// Moves fixture `index` by (`dx`, `dy`) of the picture: the next frame samples it there.
+    /// Its channels stay, so the sender needs nothing new.
+    pub fn move_fixture(&mut self, queue: &wgpu::Queue, index: usize, dx: f32, dy: f32) {
+        self.layout.move_fixture(index, dx, dy);
+        self.map.set_boxes(queue, &self.layout.boxes);
+        self.moved = true;
+    }
+
+    /// Saves the patch with the fixtures where they are now (atomically, over the file it came
+    /// from; the file's comments are not kept). Returns the message for the performer.
+    pub fn save(&mut self) -> Result<String, String> {
+        crate::atomic_file::write(&self.path, self.layout.patch.to_ron().as_bytes())
+            .map_err(|e| format!("cannot save {}: {e}", self.origin))?;
+        self.moved = false;
+        Ok(format!("saved the fixtures' places to {}", self.origin))
     }
 
     /// Builds the pixel map again on a new device (after the old one was lost); the sender
     /// goes on.
     pub fn move_to(&mut self, device: &wgpu::Device) -> Result<(), String> {
-        self.map = PixelMap::new(device, &self.boxes).map_err(|e| e.to_string())?;
+        self.map = PixelMap::new(device, &self.layout.boxes).map_err(|e| e.to_string())?;
         Ok(())
     }
 

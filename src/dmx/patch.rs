@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// The largest patch file read (a patch of thousands of fixtures is a few hundred kB).
 pub const MAX_PATCH_BYTES: u64 = 4 << 20;
@@ -13,7 +13,7 @@ pub const MAX_PIXELS: usize = 65_535;
 pub const MAX_UNIVERSES: usize = 1024;
 
 /// A patch: fixtures placed on one of the show's images, and where their bytes go.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Patch {
     /// The image the fixtures sample: 0 the output, n the scene's n-th extra output.
@@ -44,7 +44,7 @@ fn yes() -> bool {
 }
 
 /// Art-Net out: unicast to the nodes named (never broadcast unless a broadcast address is named).
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ArtNetOut {
     /// Nodes to send to: "IP" or "IP:PORT" (port 6454 by default).
@@ -59,7 +59,7 @@ pub struct ArtNetOut {
 }
 
 /// sACN out: multicast per universe, or unicast to the receivers named.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SacnOut {
     /// Receivers to send to ("IP" or "IP:PORT"); empty: each universe's multicast group.
@@ -88,7 +88,7 @@ fn default_source_name() -> String {
 }
 
 /// What the lights get when indra stops.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 pub enum OnStop {
     /// Every channel 0, then the streams end.
     #[default]
@@ -98,7 +98,7 @@ pub enum OnStop {
 }
 
 /// One fixture: a shape on the image, its pixels' format and its first channel.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Fixture {
     /// Its name in messages and the panel.
@@ -139,7 +139,7 @@ fn one() -> f32 {
 
 /// Where a fixture's pixels sit, in image coordinates: (0, 0) the top left corner, (1, 1) the
 /// bottom right.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub enum Shape {
     /// A line of `pixels` LEDs, the first at `from` and the last at `to`; each averages the
@@ -180,7 +180,7 @@ pub enum Shape {
 }
 
 /// The order a matrix's LEDs are wired in, starting at the top left.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 pub enum MatrixOrder {
     /// Row by row, each left to right.
     #[default]
@@ -194,7 +194,7 @@ pub enum MatrixOrder {
 }
 
 /// The bytes of one pixel, in the order the LED chip reads them.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 #[allow(missing_docs)]
 pub enum PixelFormat {
     #[default]
@@ -208,6 +208,29 @@ pub enum PixelFormat {
     Rgbw,
     /// Green, red, blue, white (SK6812 RGBW tape).
     Grbw,
+}
+
+impl Shape {
+    /// Where the panel shows the shape's handle: a strip's middle, a matrix's centre, a point.
+    pub fn handle(&self) -> (f32, f32) {
+        match *self {
+            Self::Strip { from, to, .. } => ((from.0 + to.0) / 2.0, (from.1 + to.1) / 2.0),
+            Self::Matrix { at, size, .. } => (at.0 + size.0 / 2.0, at.1 + size.1 / 2.0),
+            Self::Point { at, .. } => at,
+        }
+    }
+
+    /// Moves the whole shape by (`dx`, `dy`) of the picture.
+    pub fn translate(&mut self, dx: f32, dy: f32) {
+        let by = |p: &mut (f32, f32)| *p = (p.0 + dx, p.1 + dy);
+        match self {
+            Self::Strip { from, to, .. } => {
+                by(from);
+                by(to);
+            }
+            Self::Matrix { at, .. } | Self::Point { at, .. } => by(at),
+        }
+    }
 }
 
 impl PixelFormat {
@@ -232,6 +255,13 @@ impl Patch {
         let bytes = crate::files::read_limited(path, MAX_PATCH_BYTES).map_err(|e| e.to_string())?;
         let text = String::from_utf8(bytes).map_err(|_| format!("{}: not UTF-8 text", path.display()))?;
         Self::parse(&text, &path.display().to_string())
+    }
+
+    /// The patch as RON text (what the panel saves; comments of the file it came from are not
+    /// kept).
+    pub fn to_ron(&self) -> String {
+        let config = ron::ser::PrettyConfig::default().struct_names(false);
+        ron::ser::to_string_pretty(self, config).unwrap_or_default()
     }
 
     /// Parses and checks a patch's text; `origin` names it in messages.

@@ -112,6 +112,12 @@ impl PixelMap {
         });
     }
 
+    /// Moves the LEDs' boxes (the panel dragged a fixture); as many boxes as before.
+    pub fn set_boxes(&self, queue: &wgpu::Queue, boxes: &[PixelBox]) {
+        debug_assert_eq!(boxes.len(), self.count as usize);
+        queue.write_buffer(&self.boxes, 0, bytemuck::cast_slice(boxes));
+    }
+
     /// Reads this frame's values now, waiting for the GPU (renders).
     pub fn read_now(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<[u16; 3]>, ReadbackError> {
         let bytes = read_buffer(device, queue, &self.pixels, 0, self.pixels.size())?;
