@@ -259,7 +259,7 @@ fn preset_panel(
 /// The parameter panel; returns the writes the performer made this frame. Each parameter has a
 /// MIDI learn button: click it, move a control; right-click unlearns. Numbers, bools and triggers
 /// also have an audio button: click it, pick a source (shown with its live value); right-click
-/// unlearns.
+/// unlearns. With DMX in, a DMX learn button: click it, move a channel on the desk.
 fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub) -> Vec<ParamWrite> {
     let mut writes = Vec::new();
     for node in 0..instance.scene().nodes.len() {
@@ -299,6 +299,18 @@ fn param_panel(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut ControlHub
                         }
                         if decl.ty().is_scalar() {
                             audio_learn_button(ui, instance, hub, target);
+                        }
+                        if let Some(dmx) = hub.dmx.as_mut() {
+                            let mark = match (dmx.learning() == Some(target), dmx.maps(target)) {
+                                (true, _) => "?",
+                                (false, true) => "D",
+                                (false, false) => "d",
+                            };
+                            let hint = "DMX learn: click, then move a channel on the desk";
+                            if ui.small_button(mark).on_hover_text(hint).clicked() {
+                                let id = &instance.scene().nodes[node].id;
+                                dmx.learn(target, format!("{id}.{}", decl.name));
+                            }
                         }
                         let label = ui.label(&decl.name).on_hover_text(&decl.doc);
                         if animated {

@@ -109,17 +109,20 @@ impl SceneEdits {
     }
 }
 
-/// The DMX patch a command sends to: `--dmx-out`, else the file the scene names (`dmx:`), found
-/// as the scene's other files are (beside it, or under the project's folders).
-fn dmx_patch(
+/// A DMX file a command uses: `flag` (`--dmx-out`, `--dmx-in`), else the file `named` in scene
+/// `scene` (`dmx:`, `dmx_in:`), found as the scene's other files are (beside it, or under the
+/// project's folders); `what` names it in the message.
+fn dmx_file(
     assets: &Assets,
     flag: Option<&std::path::Path>,
-    scene: &Scene,
+    named: Option<&str>,
+    scene: &str,
+    what: &str,
 ) -> Result<Option<std::path::PathBuf>, String> {
-    match (flag, &scene.dmx) {
+    match (flag, named) {
         (Some(path), _) => Ok(Some(path.to_path_buf())),
         (None, Some(name)) => {
-            assets.locate_file(name).map(Some).map_err(|e| format!("'{}' names the DMX patch {name}: {e}", scene.name))
+            assets.locate_file(name).map(Some).map_err(|e| format!("'{scene}' names the {what} {name}: {e}"))
         }
         (None, None) => Ok(None),
     }

@@ -104,10 +104,11 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     }
     scene.check_texture_budget(args.size.unwrap_or(scene.size))?;
     // A patch the scene names but that cannot be found costs the lights, not the frames.
-    let patch = super::dmx_patch(assets, args.dmx_out.as_deref(), &scene).unwrap_or_else(|e| {
-        eprintln!("warning: no DMX out: {e}");
-        None
-    });
+    let patch = super::dmx_file(assets, args.dmx_out.as_deref(), scene.dmx.as_deref(), &scene.name, "DMX patch")
+        .unwrap_or_else(|e| {
+            eprintln!("warning: no DMX out: {e}");
+            None
+        });
     if args.dmx_record.is_some() && patch.is_none() {
         return Err(format!("--dmx-record needs a patch: '{}' names none; give --dmx-out", scene.name));
     }

@@ -123,7 +123,8 @@ pub struct RunArgs {
     #[arg(long, value_name = "PATCH")]
     pub dmx_out: Option<PathBuf>,
     /// Take DMX in from a lighting desk as this file says: where to listen, and which channels
-    /// drive which parameters (see docs/lights.md).
+    /// drive which parameters (see docs/lights.md); default: the file the scene or show names
+    /// (`dmx_in:`).
     #[arg(long, value_name = "FILE")]
     pub dmx_in: Option<PathBuf>,
 }
@@ -180,7 +181,8 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         stream: args.stream.clone(),
         ndi_out: args.ndi_out.clone(),
         pipewire_out: args.pipewire_out.clone(),
-        dmx_out: match super::dmx_patch(assets, args.dmx_out.as_deref(), &scene) {
+        dmx_out: match super::dmx_file(assets, args.dmx_out.as_deref(), scene.dmx.as_deref(), &scene.name, "DMX patch")
+        {
             Ok(patch) => patch,
             Err(e) => {
                 notices.push(format!("no DMX out: {e}"));
@@ -213,7 +215,19 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         audio_learn_file: args.audio_learn.clone().unwrap_or_else(|| indra::files::user_data("audio-learn.ron")),
         link: args.link,
         sites: indra::control::site::SiteRules { hosts: args.web_hosts.clone(), cors: args.oscquery_cors.clone() },
-        dmx_in: args.dmx_in.clone(),
+        dmx_in: match super::dmx_file(
+            assets,
+            args.dmx_in.as_deref(),
+            scene.dmx_in.as_deref(),
+            &scene.name,
+            "DMX-in file",
+        ) {
+            Ok(file) => file,
+            Err(e) => {
+                notices.push(format!("no DMX in: {e}"));
+                None
+            }
+        },
     };
     indra::app::run(assets.clone(), gpu.clone(), scene, options, control, notices)
 }

@@ -14,6 +14,8 @@ use crate::scene::Scene;
 
 /// The largest DMX-in file read.
 const MAX_FILE_BYTES: u64 = 1 << 20;
+/// Universes 1 to this are listened to for learning, beside those the file maps.
+const LEARN_UNIVERSES: u16 = 16;
 
 /// A DMX-in file: where to listen and what each channel does.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -30,7 +32,7 @@ pub struct DmxInFile {
 }
 
 /// One channel (or a coarse/fine pair) → one parameter.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, serde::Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ChannelMap {
     /// The universe (Art-Net port-address, sACN universe).
@@ -98,16 +100,106 @@ pub struct DmxControl {
     targets: Vec<Option<Target>>,
     /// The last value each mapping and clip channel acted on.
     last: BTreeMap<(u16, u16), u16>,
+    /// Mappings learned from the panel, applied after the file's (so a learned one wins).
+    learned: Vec<ChannelMap>,
+    /// Where learned mappings are kept.
+    learn_file: Option<std::path::PathBuf>,
+    /// The parameter waiting for a channel to move, and its name.
+    learning: Option<(Target, String)>,
+    /// The universes as the last frame saw them (learn binds the first channel that moves).
+    previous: Option<Universes>,
 }
 
 impl DmxControl {
     /// Starts receiving as `file` says; its mappings are resolved against `scene` (a target
     /// the scene lacks is one notice, the rest work).
-    pub fn start(file: DmxInFile, scene: &Scene, notices: &mut Vec<String>) -> Result<Self, String> {
-        let input = DmxIn::start(&file.listen, &file.universes())?;
-        let mut control = Self { input, file, targets: Vec::new(), last: BTreeMap::new() };
+    /// Mappings learned before are read from `learn_file` (where new ones are kept) and come
+    /// after the file's.
+    pub fn start(
+        file: DmxInFile,
+        learn_file: Option<std::path::PathBuf>,
+        scene: &Scene,
+        notices: &mut Vec<String>,
+    ) -> Result<Self, String> {
+        let mut learned = Vec::new();
+        if let Some(path) = learn_file.as_deref().filter(|p| p.exists()) {
+            let read = crate::files::read_limited(path, MAX_FILE_BYTES).map_err(|e| e.to_string()).and_then(|b| {
+                crate::dmx::ron_options()
+                    .from_bytes::<Vec<ChannelMap>>(&b)
+                    .map_err(|e| format!("{}: {e}", path.display()))
+            });
+            match read {
+                Ok(list) => learned = list,
+                Err(e) => notices.push(format!("DMX learn: {e} (learning afresh)")),
+            }
+        }
+        // Learning listens to every universe the desk might use; mapping needs only the file's.
+        let mut universes = file.universes();
+        universes.extend(learned.iter().map(|m| m.universe));
+        universes.extend(1..=LEARN_UNIVERSES);
+        universes.sort_unstable();
+        universes.dedup();
+        let input = DmxIn::start(&file.listen, &universes)?;
+        // Every channel starts at 0, as the receiver's state does.
+        let previous = Some(universes.iter().map(|u| (*u, [0; crate::dmx::UNIVERSE_CHANNELS])).collect());
+        let mut control = Self {
+            input,
+            file,
+            targets: Vec::new(),
+            last: BTreeMap::new(),
+            learned,
+            learn_file,
+            learning: None,
+            previous,
+        };
         control.set_scene(scene, notices);
         Ok(control)
+    }
+
+    /// Waits for a channel to move and binds it to `target` (named `name`, `node.param`).
+    pub fn learn(&mut self, target: Target, name: String) {
+        self.learning = Some((target, name));
+    }
+
+    /// The parameter waiting for a channel, if any.
+    pub fn learning(&self) -> Option<Target> {
+        self.learning.as_ref().map(|(t, _)| *t)
+    }
+
+    /// Whether a channel drives `target`.
+    pub fn maps(&self, target: Target) -> bool {
+        self.targets.contains(&Some(target))
+    }
+
+    /// Binds the first channel that moved since the last frame to the parameter learning.
+    fn bind_moved(&mut self, universes: &Universes, notices: &mut Vec<String>) {
+        let Some(previous) = self.previous.replace(universes.clone()) else { return };
+        if self.learning.is_none() {
+            return;
+        }
+        let moved = universes.iter().find_map(|(u, channels)| {
+            let before = previous.get(u)?;
+            let i = channels.iter().zip(before).position(|(a, b)| a != b)?;
+            Some((*u, i as u16 + 1))
+        });
+        let (Some((universe, channel)), Some((_, name))) = (moved, self.learning.take()) else { return };
+        self.learned.retain(|m| m.target != name);
+        self.learned.push(ChannelMap { universe, channel, fine: false, target: name.clone(), range: None });
+        // Resolved again before the events.
+        self.targets = Vec::new();
+        let message = format!("DMX learn: universe {universe} channel {channel} → {name}");
+        log::info!("{message}");
+        notices.push(message);
+        if let Err(e) = self.save_learned() {
+            notices.push(e);
+        }
+    }
+
+    /// Writes the learned mappings to the learn file.
+    fn save_learned(&self) -> Result<(), String> {
+        let Some(path) = &self.learn_file else { return Ok(()) };
+        let text = ron::ser::to_string_pretty(&self.learned, Default::default()).map_err(|e| e.to_string())?;
+        crate::atomic_file::write(path, text.as_bytes()).map_err(|e| format!("cannot write {}: {e}", path.display()))
     }
 
     /// Resolves the mappings against a new scene.
@@ -116,6 +208,7 @@ impl DmxControl {
             .file
             .map
             .iter()
+            .chain(&self.learned)
             .map(|m| {
                 crate::scene::resolve_target(&scene.nodes, &m.target)
                     .map_err(|e| notices.push(format!("DMX in: {e}")))
@@ -124,11 +217,16 @@ impl DmxControl {
             .collect();
     }
 
-    /// The events of every mapped channel whose value changed since the last frame.
-    pub fn events(&mut self, scene: &Scene) -> Vec<ControlEvent> {
+    /// The events of every mapped channel whose value changed since the last frame (a channel
+    /// that moves while a parameter learns is bound to it first).
+    pub fn events(&mut self, scene: &Scene, notices: &mut Vec<String>) -> Vec<ControlEvent> {
         let Some(universes) = self.input.changed() else { return Vec::new() };
+        self.bind_moved(&universes, notices);
+        if self.targets.len() != self.file.map.len() + self.learned.len() {
+            self.set_scene(scene, notices);
+        }
         let mut events = Vec::new();
-        for (m, target) in self.file.map.iter().zip(&self.targets) {
+        for (m, target) in self.file.map.iter().chain(&self.learned).zip(&self.targets) {
             let Some(target) = target else { continue };
             let Some(raw) = channel_value(&universes, m.universe, m.channel, m.fine) else { continue };
             let before = self.last.insert((m.universe, m.channel), raw);

@@ -174,8 +174,10 @@ impl ControlHub {
         let audio_mapper = AudioMapper::with_learned(scene, audio_learn.bound(scene));
         let audio = open_audio(options.audio_in.as_ref(), !audio_mapper.is_empty(), &mut notices);
         let dmx = options.dmx_in.as_deref().and_then(|path| {
-            let started = super::dmx_in::DmxInFile::load(path)
-                .and_then(|file| super::dmx_in::DmxControl::start(file, scene, &mut notices));
+            let started = super::dmx_in::DmxInFile::load(path).and_then(|file| {
+                let learned = options.learn_file.with_file_name("dmx-learn.ron");
+                super::dmx_in::DmxControl::start(file, Some(learned), scene, &mut notices)
+            });
             started.map_err(|e| notices.push(format!("no DMX in: {e}"))).ok()
         });
         #[cfg(feature = "link")]
@@ -271,7 +273,7 @@ impl ControlHub {
             self.audio_frame = Some(frame);
         }
         if let Some(dmx) = self.dmx.as_mut() {
-            events.extend(dmx.events(scene));
+            events.extend(dmx.events(scene, &mut self.notices));
         }
         // A running MIDI clock sets the show's tempo.
         if self.mapper.clock.playing {

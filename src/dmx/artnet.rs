@@ -29,12 +29,7 @@ impl ArtNetSender {
     /// Opens the socket (bound where the patch says, else any address) and, when bound, the
     /// thread that answers ArtPoll for `universes`.
     pub fn open(config: &ArtNetOut, universes: &[u16]) -> Result<Self, String> {
-        let targets = config
-            .to
-            .iter()
-            .map(|t| super::socket_address(t, ARTNET_PORT))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| format!("artnet.to: {e}"))?;
+        let targets = super::socket_addresses(&config.to, ARTNET_PORT).map_err(|e| format!("artnet.to: {e}"))?;
         let (socket, poll) = match &config.bind {
             Some(bind) => {
                 let at = super::socket_address(bind, ARTNET_PORT).map_err(|e| format!("artnet.bind: {e}"))?;

@@ -34,6 +34,11 @@ fn socket_address(text: &str, port: u16) -> Result<SocketAddr, String> {
         .ok_or_else(|| format!("'{text}' is not an address (IP or IP:PORT)"))
 }
 
+/// Each of `texts` as a socket address ([`socket_address`]).
+fn socket_addresses(texts: &[String], port: u16) -> Result<Vec<SocketAddr>, String> {
+    texts.iter().map(|t| socket_address(t, port)).collect()
+}
+
 /// A UDP socket bound to `at` that shares its port with other programs on the machine (a desk
 /// tool or OLA listening on the same port at another address).
 fn bind_udp(at: SocketAddr) -> std::io::Result<UdpSocket> {

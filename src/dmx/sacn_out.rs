@@ -23,12 +23,7 @@ pub struct SacnSender {
 impl SacnSender {
     /// Opens the source and registers `universes` (and the sync universe).
     pub fn open(config: &SacnOut, universes: &[u16]) -> Result<Self, String> {
-        let targets = config
-            .to
-            .iter()
-            .map(|t| super::socket_address(t, SACN_PORT))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| format!("sacn.to: {e}"))?;
+        let targets = super::socket_addresses(&config.to, SACN_PORT).map_err(|e| format!("sacn.to: {e}"))?;
         let bind = match &config.bind {
             Some(bind) => super::socket_address(bind, 0).map_err(|e| format!("sacn.bind: {e}"))?,
             None => SocketAddr::from(([0, 0, 0, 0], 0)),

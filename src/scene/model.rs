@@ -55,6 +55,8 @@ pub struct Scene {
     pub outputs: Vec<SceneOutput>,
     /// The DMX patch file the scene names (`dmx:`), as written; `--dmx-out` overrides it.
     pub dmx: Option<String>,
+    /// The DMX-in file the scene names (`dmx_in:`), as written; `--dmx-in` overrides it.
+    pub dmx_in: Option<String>,
     /// OSC addresses declared in the scene's `controls`, besides `/indra/<node>/<param>`.
     pub osc_aliases: Vec<(String, Target)>,
     /// MIDI mappings declared in the scene's `controls`.

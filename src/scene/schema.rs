@@ -68,6 +68,9 @@ pub struct SceneFile {
     /// A DMX patch file (docs/lights.md) whose fixtures the show's pixels light.
     #[serde(default)]
     pub dmx: Option<String>,
+    /// A DMX-in file (docs/lights.md): which desk channels drive which parameters.
+    #[serde(default)]
+    pub dmx_in: Option<String>,
 }
 
 /// One more output: a node's texture, optionally through a warp (projection mapping).

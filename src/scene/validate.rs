@@ -168,6 +168,7 @@ impl<'a> Validator<'a> {
             output,
             outputs: Vec::new(),
             dmx: file.dmx.clone(),
+            dmx_in: file.dmx_in.clone(),
             tracks,
             osc_aliases,
             midi,

@@ -263,6 +263,15 @@ fn olad_receives_the_pixel_map_of_the_rendered_frame_over_artnet() {
     assert!(got.len() >= 205, "olad holds {} channels of universe 1", got.len());
     assert!(want[..48].iter().any(|v| *v > 0), "the strip sees a black frame: a test of nothing");
     assert_close(&got[..205], &want[..205], 2);
+
+    // A patch that blacks out on stop leaves every channel at 0.
+    std::fs::write(&patch_file, patch("artnet: Some((to: [\"127.0.0.1\"]))").replace("Hold", "Blackout")).unwrap();
+    render(&dir, &patch_file, &[]);
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while olad.dmx(1).iter().any(|v| *v != 0) {
+        assert!(Instant::now() < deadline, "no blackout after the render: {:?}", olad.dmx(1));
+        std::thread::sleep(Duration::from_millis(100));
+    }
 }
 
 #[test]
@@ -377,4 +386,72 @@ fn a_desk_drives_a_live_parameter_through_sacn_in_with_16_bits_and_a_flood_chang
     assert!((intensity() - want).abs() < 1e-4, "the flood moved the parameter");
     let grown = show.resident().saturating_sub(before);
     assert!(grown < 64 << 20, "the flood grew the show by {:.0} MiB", mib(grown));
+}
+
+#[test]
+fn dmx_learn_binds_the_channel_that_moves_and_keeps_it_for_the_next_start() {
+    use indra::control::dmx_in::{DmxControl, DmxInFile};
+    use indra::params::{ControlEvent, ParamValue, Target};
+    let scene = indra::scene::parse_scene(
+        "t.ron",
+        r#"(name: "t", size: (8, 8), dt: 0.1, nodes: [(id: "fluid", technique: "grid_fluid")], output: "fluid")"#,
+    )
+    .unwrap();
+    let param = scene.nodes[0].params.decls().iter().position(|d| d.name == "velocity_coef").unwrap();
+    let target = Target { node: 0, param, component: None };
+    let range = scene.nodes[0].params.decls()[param].range.unwrap();
+    let dir = scratch_dir("dmx-learn");
+    let port = UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let text = format!("(listen: (artnet: \"127.0.0.1:{port}\"))");
+    let path = dir.join("desk.ron");
+    std::fs::write(&path, text).unwrap();
+    let learn_file = dir.join("dmx-learn.ron");
+    let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let send = |universe: u8, channel: usize, value: u8| {
+        let mut packet = b"Art-Net\0\x00\x50\x00\x0e\x00\x00".to_vec();
+        packet.extend_from_slice(&[universe, 0, 2, 0]);
+        let mut channels = [0u8; 512];
+        channels[channel - 1] = value;
+        packet.extend_from_slice(&channels);
+        socket.send_to(&packet, ("127.0.0.1", port)).unwrap();
+    };
+    // Frames until `done` says yes (the receiver is a thread of its own).
+    let frames = |control: &mut DmxControl, notices: &mut Vec<String>, done: &dyn Fn(&[ControlEvent]) -> bool| {
+        let deadline = Instant::now() + Duration::from_secs(10);
+        loop {
+            let events = control.events(&scene, notices);
+            if done(&events) {
+                return events;
+            }
+            assert!(Instant::now() < deadline, "nothing came: {notices:?}");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    };
+    let mut notices = Vec::new();
+    let mut control =
+        DmxControl::start(DmxInFile::load(&path).unwrap(), Some(learn_file.clone()), &scene, &mut notices).unwrap();
+    send(2, 7, 0);
+    frames(&mut control, &mut notices, &|_| true);
+    control.learn(target, "fluid.velocity_coef".into());
+    send(2, 7, 40);
+    let bound = |n: &Vec<String>| n.iter().any(|m| m.contains("universe 2 channel 7"));
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while !bound(&notices) {
+        assert!(Instant::now() < deadline, "no channel was learned: {notices:?}");
+        control.events(&scene, &mut notices);
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(control.maps(target) && control.learning().is_none());
+    drop(control);
+
+    // A new start reads what was learned: the channel at full drives the top of the range.
+    let mut control =
+        DmxControl::start(DmxInFile::load(&path).unwrap(), Some(learn_file), &scene, &mut notices).unwrap();
+    send(2, 7, 255);
+    let wrote_top = |events: &[ControlEvent]| {
+        events
+            .iter()
+            .any(|e| matches!(e, ControlEvent::Write(w) if w.param == param && w.value == ParamValue::Float(range.1)))
+    };
+    frames(&mut control, &mut notices, &wrote_top);
 }

@@ -82,6 +82,9 @@ pub struct ShowFile {
     /// A DMX patch file (docs/lights.md) whose fixtures the show's pixels light.
     #[serde(default)]
     pub dmx: Option<String>,
+    /// A DMX-in file (docs/lights.md): which desk channels drive which parameters.
+    #[serde(default)]
+    pub dmx_in: Option<String>,
     /// OSC aliases and MIDI mappings; targets as `layer/1.opacity`, `master.level` or
     /// `<clip>/<node>.<param>`.
     #[serde(default)]

@@ -314,6 +314,7 @@ impl Builder<'_> {
             tracks,
             outputs: Vec::new(),
             dmx: file.dmx.clone(),
+            dmx_in: file.dmx_in.clone(),
             osc_aliases: vec![("/indra/master".into(), Target { node: master, param: 0, component: None })],
             midi: Vec::new(),
             show: None,
