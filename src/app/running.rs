@@ -138,6 +138,11 @@ impl Running {
         for _ in 0..steps {
             self.player.step();
         }
+        if let Some(lights) = self.lights.as_mut() {
+            let instance = self.player.instance();
+            let positions = lights.lamp_targets().iter().map(|t| instance.position_of(t)).collect();
+            lights.set_lamps(positions);
+        }
         let frame = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(f) | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {

@@ -101,8 +101,10 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     let mut dmx_line = None;
     if let Some(path) = &args.dmx_patch {
         let layout = indra::dmx::Layout::new(indra::dmx::Patch::load(path)?)?;
-        let map = indra::dmx::PixelMap::new(&renderer.gpu().device, &layout.boxes).map_err(|e| e.to_string())?;
-        renderer.set_pixel_map(map, layout.patch.image)?;
+        if !layout.boxes.is_empty() {
+            let map = indra::dmx::PixelMap::new(&renderer.gpu().device, &layout.boxes).map_err(|e| e.to_string())?;
+            renderer.set_pixel_map(map, layout.patch.image)?;
+        }
         dmx_line = Some(format!("dmx        {} LEDs in {} universes", layout.boxes.len(), layout.universes().len()));
     }
     renderer.seek(args.start).map_err(|e| e.to_string())?;

@@ -181,7 +181,7 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
             send.take(&frame.rgba, 1, frame.time.frame).map_err(|e| e.to_string())?;
         }
         if let Some(lights) = lights.as_mut() {
-            lights.frame(&renderer, frame.time.frame)?;
+            lights.frame(&mut renderer, frame.time.frame)?;
         }
         // What a node tells the performer (a clip that cannot play, a bad image path) is said
         // once, as the window's overlay says it; the render goes on.

@@ -28,8 +28,10 @@ impl RenderDmx {
         dt: f64,
     ) -> Result<Self, String> {
         let layout = Layout::new(Patch::load(patch)?).map_err(|e| format!("{}: {e}", patch.display()))?;
-        let map = PixelMap::new(&renderer.gpu().device, &layout.boxes).map_err(|e| e.to_string())?;
-        renderer.set_pixel_map(map, layout.patch.image)?;
+        if !layout.boxes.is_empty() {
+            let map = PixelMap::new(&renderer.gpu().device, &layout.boxes).map_err(|e| e.to_string())?;
+            renderer.set_pixel_map(map, layout.patch.image)?;
+        }
         let record = record
             .map(|path| {
                 std::fs::File::create(path)
@@ -43,12 +45,13 @@ impl RenderDmx {
 
     /// After each rendered frame: reads its pixels, records them, waits until the frame is
     /// due in real time and hands them to the sender.
-    pub fn frame(&mut self, renderer: &OffscreenRenderer, frame: u64) -> Result<(), String> {
-        let Some(pixels) = renderer.read_pixel_map() else { return Ok(()) };
-        let pixels = pixels.map_err(|e| e.to_string())?;
+    pub fn frame(&mut self, renderer: &mut OffscreenRenderer, frame: u64) -> Result<(), String> {
+        let pixels = renderer.read_pixel_map().transpose().map_err(|e| e.to_string())?.unwrap_or_default();
+        let instance = renderer.instance_mut();
+        let lamps: Vec<Option<f32>> = self.layout.lamp_targets().iter().map(|t| instance.position_of(t)).collect();
         if let Some(file) = self.record.as_mut() {
             // Each universe: the frame (u64), the universe (u16), 512 channels; little-endian.
-            for (universe, channels) in self.layout.encode(&pixels) {
+            for (universe, channels) in self.layout.encode(&pixels, &lamps) {
                 let written = file
                     .write_all(&frame.to_le_bytes())
                     .and_then(|()| file.write_all(&universe.to_le_bytes()))
@@ -60,7 +63,7 @@ impl RenderDmx {
         if let Some(wait) = due.checked_duration_since(Instant::now()) {
             std::thread::sleep(wait);
         }
-        self.out.offer(pixels);
+        self.out.offer(pixels, lamps);
         self.sent += 1;
         Ok(())
     }

@@ -3,6 +3,7 @@
 
 use std::collections::BTreeMap;
 
+use super::ofl::Slot;
 use super::patch::{Fixture, MatrixOrder, Patch, Shape};
 
 /// Channels in a DMX universe.
@@ -83,7 +84,35 @@ impl Layout {
                 offset += width;
             }
         }
-        let universes: std::collections::BTreeSet<u16> = slots.iter().map(|s| s.universe).collect();
+        if patch.lamp_modes.len() != patch.lamps.len() {
+            return Err("the lamps' profiles were not read (load the patch from its file)".into());
+        }
+        for (lamp, mode) in patch.lamps.iter().zip(&patch.lamp_modes) {
+            let offset = usize::from(lamp.address) - 1;
+            if offset + mode.slots.len() > UNIVERSE_CHANNELS {
+                return Err(format!(
+                    "lamp '{}': {} channels from {} run past channel 512",
+                    lamp.name,
+                    mode.slots.len(),
+                    lamp.address
+                ));
+            }
+            if let Some(channel) = lamp.drive.keys().find(|c| !mode.slots.contains(&Slot::Coarse((*c).clone()))) {
+                return Err(format!("lamp '{}': {} has no channel '{channel}'", lamp.name, mode.name));
+            }
+            for channel in offset..offset + mode.slots.len() {
+                if owner.insert((lamp.universe, channel), usize::MAX).is_some() {
+                    return Err(format!(
+                        "lamp '{}' uses universe {} channel {}, which another fixture uses",
+                        lamp.name,
+                        lamp.universe,
+                        channel + 1
+                    ));
+                }
+            }
+        }
+        let universes: std::collections::BTreeSet<u16> =
+            slots.iter().map(|s| s.universe).chain(patch.lamps.iter().map(|l| l.universe)).collect();
         if universes.len() > super::patch::MAX_UNIVERSES {
             return Err(format!("more than {} universes in one patch", super::patch::MAX_UNIVERSES));
         }
@@ -100,9 +129,16 @@ impl Layout {
         self.boxes = self.patch.fixtures.iter().flat_map(|f| pixel_boxes(&f.shape)).collect();
     }
 
+    /// The parameters the lamps' channels follow, in the order [`Layout::encode`] takes their
+    /// positions: lamp by lamp, each lamp's channels by name.
+    pub fn lamp_targets(&self) -> Vec<&str> {
+        self.patch.lamps.iter().flat_map(|l| l.drive.values().map(String::as_str)).collect()
+    }
+
     /// The universes the patch fills, in order.
     pub fn universes(&self) -> Vec<u16> {
-        let mut list: Vec<u16> = self.slots.iter().map(|s| s.universe).collect();
+        let mut list: Vec<u16> =
+            self.slots.iter().map(|s| s.universe).chain(self.patch.lamps.iter().map(|l| l.universe)).collect();
         list.dedup();
         list.sort_unstable();
         list.dedup();
@@ -115,13 +151,36 @@ impl Layout {
     }
 
     /// Encodes each pixel's sampled screen value (0–65535 per colour, as the GPU packs them)
-    /// into the universes: gamma, brightness, white extraction, byte order and bit depth.
-    pub fn encode(&self, screen: &[[u16; 3]]) -> Universes {
+    /// into the universes: gamma, brightness, white extraction, byte order and bit depth; and
+    /// each lamp channel: the position (0–1) of the parameter driving it, in the order of
+    /// [`Layout::lamp_targets`] (`None`, or none given: the profile's default).
+    pub fn encode(&self, screen: &[[u16; 3]], lamps: &[Option<f32>]) -> Universes {
         let mut out = self.blackout();
         for (slot, value) in self.slots.iter().zip(screen) {
             let fixture = &self.patch.fixtures[slot.fixture];
             let channels = out.get_mut(&slot.universe).expect("every slot's universe is listed");
             write_pixel(fixture, *value, &mut channels[slot.offset..slot.offset + fixture.pixel_bytes()]);
+        }
+        let mut positions = lamps.iter();
+        for (lamp, mode) in self.patch.lamps.iter().zip(&self.patch.lamp_modes) {
+            let driven: BTreeMap<&str, f32> = lamp
+                .drive
+                .keys()
+                .filter_map(|c| positions.next().copied().flatten().map(|p| (c.as_str(), p)))
+                .collect();
+            let channels = out.get_mut(&lamp.universe).expect("every lamp's universe is listed");
+            let base = usize::from(lamp.address) - 1;
+            let level =
+                |name: &str| driven.get(name).or(mode.defaults.get(name)).copied().unwrap_or(0.0).clamp(0.0, 1.0);
+            for (k, slot) in mode.slots.iter().enumerate() {
+                let has_fine = |name: &String| mode.slots.contains(&Slot::Fine(name.clone()));
+                channels[base + k] = match slot {
+                    Slot::Coarse(name) if has_fine(name) => ((level(name) * 65535.0).round() as u16 >> 8) as u8,
+                    Slot::Coarse(name) => (level(name) * 255.0).round() as u8,
+                    Slot::Fine(name) => ((level(name) * 65535.0).round() as u16 & 0xff) as u8,
+                    Slot::Unused => 0,
+                };
+            }
         }
         out
     }
@@ -246,7 +305,7 @@ mod tests {
              (name: \"fine\", shape: Point(at: (0.5, 0.5)), universe: 1, address: 10, bits: 16)",
         ))
         .unwrap();
-        let universes = layout.encode(&[[65535, 32768, 32768], [65535, 0x1234, 0]]);
+        let universes = layout.encode(&[[65535, 32768, 32768], [65535, 0x1234, 0]], &[]);
         let u = &universes[&1];
         // G R B W: white takes the shared half, red keeps the rest.
         assert_eq!(&u[0..4], &[0, 127, 0, 128]);
@@ -258,7 +317,7 @@ mod tests {
         let layout =
             Layout::new(patch("(name: \"g\", shape: Point(at: (0.5, 0.5)), universe: 1, gamma: 2.0, brightness: 0.5)"))
                 .unwrap();
-        let u = layout.encode(&[[32768, 65535, 0]])[&1];
+        let u = layout.encode(&[[32768, 65535, 0]], &[])[&1];
         assert_eq!(&u[0..3], &[32, 128, 0]);
     }
 

@@ -6,6 +6,7 @@
 mod artnet;
 mod layout;
 mod live;
+mod ofl;
 mod patch;
 mod pixel_map;
 mod receive;
@@ -15,7 +16,8 @@ mod sender;
 pub use artnet::{ARTNET_PORT, ArtNetSender};
 pub use layout::{Layout, PixelBox, PixelSlot, UNIVERSE_CHANNELS, Universes};
 pub use live::LiveLights;
-pub use patch::{ArtNetOut, Fixture, MatrixOrder, OnStop, Patch, PixelFormat, SacnOut, Shape, ron_options};
+pub use ofl::{LampMode, Slot};
+pub use patch::{ArtNetOut, Fixture, Lamp, MatrixOrder, OnStop, Patch, PixelFormat, SacnOut, Shape, ron_options};
 pub use pixel_map::PixelMap;
 pub use receive::{DmxIn, DmxInCounts, ListenConfig, Merge};
 pub use sacn_out::{SACN_PORT, SacnSender};

@@ -16,11 +16,15 @@ use super::sacn_out::SacnSender;
 /// A universe that did not change is sent again after this long.
 pub const REFRESH: Duration = Duration::from_millis(1000);
 
+/// One frame's sampled pixels and lamp positions.
+type Offered = (Vec<[u16; 3]>, Vec<Option<f32>>);
+
 /// What the render thread and the sender share.
 #[derive(Default)]
 struct Shared {
-    /// The newest frame's sampled pixels, replaced by each offer (latest wins).
-    latest: Mutex<Option<Vec<[u16; 3]>>>,
+    /// The newest frame's sampled pixels and lamp positions, replaced by each offer (latest
+    /// wins).
+    latest: Mutex<Option<Offered>>,
     stop: AtomicBool,
     /// Packets sent (each universe to each protocol counts one).
     packets: AtomicU64,
@@ -81,11 +85,12 @@ impl DmxOut {
         Ok(Self { shared, thread: Some(thread), polls })
     }
 
-    /// Hands over a frame's sampled pixels; never waits (a frame offered while the sender is
-    /// taking the previous one is dropped and counted).
-    pub fn offer(&self, pixels: Vec<[u16; 3]>) {
+    /// Hands over a frame's sampled pixels and the positions of the parameters its lamps follow
+    /// ([`Layout::lamp_targets`]); never waits (a frame offered while the sender is taking the
+    /// previous one is dropped and counted).
+    pub fn offer(&self, pixels: Vec<[u16; 3]>, lamps: Vec<Option<f32>>) {
         match self.shared.latest.try_lock() {
-            Ok(mut slot) => *slot = Some(pixels),
+            Ok(mut slot) => *slot = Some((pixels, lamps)),
             Err(_) => {
                 self.shared.missed.fetch_add(1, Ordering::Relaxed);
             }
@@ -120,9 +125,9 @@ fn run(layout: Layout, mut wire: Wire, shared: &Shared, polls: &AtomicU64) {
         layout.universes().into_iter().map(|u| (u, None, [0; 512])).collect();
     let mut next = Instant::now();
     while !shared.stop.load(Ordering::Relaxed) {
-        let pixels = shared.latest.lock().map(|mut slot| slot.take()).unwrap_or(None);
-        if let Some(pixels) = pixels {
-            current = Some(layout.encode(&pixels));
+        let frame = shared.latest.lock().map(|mut slot| slot.take()).unwrap_or(None);
+        if let Some((pixels, lamps)) = frame {
+            current = Some(layout.encode(&pixels, &lamps));
         }
         if let Some(universes) = &current {
             let now = Instant::now();

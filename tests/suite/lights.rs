@@ -455,3 +455,38 @@ fn dmx_learn_binds_the_channel_that_moves_and_keeps_it_for_the_next_start() {
     };
     frames(&mut control, &mut notices, &wrote_top);
 }
+
+#[test]
+fn an_ofl_moving_head_follows_its_parameters_and_keeps_its_profile_defaults() {
+    let dir = scratch_dir("dmx-lamp");
+    let profile = Path::new(env!("CARGO_MANIFEST_DIR")).join("patches/fixtures/generic-spot.json");
+    let patch_file = dir.join("lamp.ron");
+    let patch = format!(
+        "(artnet: (to: [\"127.0.0.1:9\"]), lamps: [(name: \"spot\", profile: {:?}, mode: \"9-channel\", \
+         universe: 7, address: 100, drive: {{\"Dimmer\": \"glow.intensity\", \"Pan\": \"glow.intensity\"}})])",
+        profile.display().to_string()
+    );
+    std::fs::write(&patch_file, patch).unwrap();
+    let channels = |intensity: &str| {
+        let record = dir.join(format!("{intensity}.dmx"));
+        let o = indra()
+            .args(["render", "star_glow", "--size", "64x36", "--frames", "2", "--set"])
+            .arg(format!("glow.intensity={intensity}"))
+            .arg("--out")
+            .arg(dir.join("frames"))
+            .arg("--dmx-out")
+            .arg(&patch_file)
+            .arg("--dmx-record")
+            .arg(&record)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", text(&o));
+        let bytes = std::fs::read(record).unwrap();
+        assert_eq!(u16::from_le_bytes([bytes[8], bytes[9]]), 7, "one universe: the lamp's");
+        bytes[10 + 99..10 + 108].to_vec()
+    };
+    // glow.intensity's range is 0–10: 2.5 is a quarter. Pan has a fine channel (16 bits),
+    // Dimmer has none; Tilt stays at its 50 % default, Shutter at 255, the colours at 0.
+    assert_eq!(channels("2.5"), vec![0x40, 0x00, 0x80, 0x00, 64, 0, 0, 0, 255]);
+    assert_eq!(channels("10")[..5], [0xff, 0xff, 0x80, 0x00, 255]);
+}

@@ -121,6 +121,16 @@ impl SceneInstance {
         &self.params[node]
     }
 
+    /// Where parameter `target` (`node.param` or `node.param.x`) stands in its range, 0–1 (what
+    /// a DMX lamp channel follows); `None` for a parameter the scene lacks.
+    pub fn position_of(&self, target: &str) -> Option<f32> {
+        let t = crate::scene::resolve_target(&self.scene.nodes, target).ok()?;
+        let value = self.params[t.node].value_at(t.param).components();
+        let x = *value.get(t.component.unwrap_or(0))?;
+        let (lo, hi) = self.scene.nodes[t.node].params.decls()[t.param].range.unwrap_or((0.0, 1.0));
+        Some(if hi > lo { ((x - lo) / (hi - lo)).clamp(0.0, 1.0) } else { 0.0 })
+    }
+
     /// Every node's parameters.
     pub fn all_params(&self) -> &[ParamSet] {
         &self.params
