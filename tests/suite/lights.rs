@@ -490,3 +490,46 @@ fn an_ofl_moving_head_follows_its_parameters_and_keeps_its_profile_defaults() {
     assert_eq!(channels("2.5"), vec![0x40, 0x00, 0x80, 0x00, 64, 0, 0, 0, 255]);
     assert_eq!(channels("10")[..5], [0xff, 0xff, 0x80, 0x00, 255]);
 }
+
+#[test]
+fn two_desks_merge_highest_takes_precedence_and_a_channel_picks_a_layers_clip() {
+    use indra::control::dmx_in::{DmxControl, DmxInFile};
+    use indra::params::{ControlEvent, ShowCommand};
+    let dir = scratch_dir("dmx-merge");
+    let port = UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let path = dir.join("desk.ron");
+    let file =
+        format!("(listen: (artnet: \"127.0.0.1:{port}\", merge: Htp), clips: [(universe: 1, channel: 5, layer: 2)])");
+    std::fs::write(&path, file).unwrap();
+    let scene = indra::scene::show::load_show(&crate::common::assets(), "shows/set.ron", true).unwrap();
+    let mut notices = Vec::new();
+    let mut control = DmxControl::start(DmxInFile::load(&path).unwrap(), None, &scene, &mut notices).unwrap();
+    // Two sources (two loopback addresses), each with channels of its own set.
+    let desk = |from: &str, values: &[(usize, u8)]| {
+        let socket = UdpSocket::bind((from, 0)).unwrap();
+        let mut packet = b"Art-Net\0\x00\x50\x00\x0e\x00\x00\x01\x00\x02\x00".to_vec();
+        let mut channels = [0u8; 512];
+        for &(c, v) in values {
+            channels[c - 1] = v;
+        }
+        packet.extend_from_slice(&channels);
+        socket.send_to(&packet, ("127.0.0.1", port)).unwrap();
+    };
+    // The higher value first, then the lower from another desk: HTP keeps 2 (layer 2 plays its
+    // second clip and nothing else); LTP would end on 1 and trigger the first clip.
+    desk("127.0.0.1", &[(5, 2)]);
+    std::thread::sleep(Duration::from_millis(100));
+    desk("127.0.0.2", &[(5, 1)]);
+    let trigger = |clip| ControlEvent::Show(ShowCommand::Trigger { layer: 1, clip: Some(clip) });
+    let deadline = Instant::now() + Duration::from_secs(10);
+    let mut seen = Vec::new();
+    while !seen.contains(&trigger(1)) || control.counts().packets < 2 {
+        assert!(Instant::now() < deadline, "no trigger of clip 2: {seen:?} {notices:?}");
+        seen.extend(control.events(&scene, &mut notices));
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    seen.extend(control.events(&scene, &mut notices));
+    assert!(!seen.contains(&trigger(0)), "the lower desk's value took over: {seen:?}");
+    assert_eq!(control.counts().malformed, 0);
+}
