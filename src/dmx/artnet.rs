@@ -15,6 +15,9 @@ use super::patch::ArtNetOut;
 
 /// Art-Net's UDP port.
 pub const ARTNET_PORT: u16 = 6454;
+/// ArtPolls answered in one second at most: a reply is larger than a poll, so a flood of
+/// (spoofed) polls must not turn indra into an amplifier. Desks poll every few seconds.
+const MAX_REPLIES_PER_SECOND: u32 = 20;
 
 /// Sends one patch's universes over Art-Net.
 pub struct ArtNetSender {
@@ -100,10 +103,18 @@ impl PollResponder {
             .name("artnet-poll".into())
             .spawn(move || {
                 let mut buffer = [0u8; 1024];
+                let (mut second, mut replies) = (std::time::Instant::now(), 0u32);
                 while !stopping.load(Ordering::Relaxed) {
                     let Ok((n, from)) = socket.recv_from(&mut buffer) else { continue };
-                    // Anything but a well-formed ArtPoll is ignored.
+                    if second.elapsed() >= Duration::from_secs(1) {
+                        (second, replies) = (std::time::Instant::now(), 0);
+                    }
+                    // Anything but a well-formed ArtPoll is ignored, and polls past the rate.
+                    if replies >= MAX_REPLIES_PER_SECOND {
+                        continue;
+                    }
                     if let Ok(ArtCommand::Poll(_)) = ArtCommand::from_buffer(&buffer[..n]) {
+                        replies += 1;
                         let to = SocketAddr::new(from.ip(), ARTNET_PORT);
                         let _ = socket.send_to(&reply, to);
                         if to != from {
@@ -212,5 +223,25 @@ mod tests {
             std::thread::sleep(Duration::from_millis(10));
         }
         assert_eq!(sender.polls_answered(), 1);
+    }
+
+    #[test]
+    fn a_flood_of_polls_gets_twenty_replies_a_second_at_most() {
+        let config = ArtNetOut { to: vec!["127.0.0.1:9".into()], bind: Some("127.0.0.5:6454".into()), sync: false };
+        let sender = ArtNetSender::open(&config, &[1]).unwrap();
+        let desk = super::super::bind_udp("127.0.0.6:6454".parse().unwrap()).unwrap();
+        desk.set_read_timeout(Some(Duration::from_millis(300))).unwrap();
+        let poll = ArtCommand::Poll(Default::default()).write_to_buffer().unwrap();
+        for _ in 0..200 {
+            desk.send_to(&poll, "127.0.0.5:6454").unwrap();
+        }
+        let mut buffer = [0u8; 1024];
+        let mut replies = 0;
+        while desk.recv(&mut buffer).is_ok() {
+            replies += 1;
+        }
+        // The burst may straddle the start of a second: two seconds' worth at the most.
+        assert!((1..=2 * MAX_REPLIES_PER_SECOND).contains(&replies), "{replies} replies to 200 polls");
+        assert!(sender.polls_answered() <= u64::from(2 * MAX_REPLIES_PER_SECOND));
     }
 }
