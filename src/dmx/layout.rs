@@ -111,15 +111,15 @@ impl Layout {
                 }
             }
         }
-        let universes: std::collections::BTreeSet<u16> =
-            slots.iter().map(|s| s.universe).chain(patch.lamps.iter().map(|l| l.universe)).collect();
+        let layout = Self { patch, boxes, slots };
+        let universes = layout.universes();
         if universes.len() > super::patch::MAX_UNIVERSES {
             return Err(format!("more than {} universes in one patch", super::patch::MAX_UNIVERSES));
         }
-        if patch.sacn.is_some() && universes.contains(&0) {
+        if layout.patch.sacn.is_some() && universes.first() == Some(&0) {
             return Err("sACN has no universe 0: start the fixtures at universe 1".into());
         }
-        Ok(Self { patch, boxes, slots })
+        Ok(layout)
     }
 
     /// Moves fixture `index` by (`dx`, `dy`) of the picture; its channels stay.
@@ -139,7 +139,6 @@ impl Layout {
     pub fn universes(&self) -> Vec<u16> {
         let mut list: Vec<u16> =
             self.slots.iter().map(|s| s.universe).chain(self.patch.lamps.iter().map(|l| l.universe)).collect();
-        list.dedup();
         list.sort_unstable();
         list.dedup();
         list
