@@ -61,7 +61,7 @@ struct GpuArgs {
 #[derive(Subcommand)]
 enum Command {
     /// Open a scene in a window with live controls (default: the kleinian scene).
-    Run(cli::RunArgs),
+    Run(Box<cli::RunArgs>),
     /// Render frames off-screen to a PNG sequence.
     Render(cli::RenderArgs),
     /// Validate every scene and shader (or the given files); non-zero exit on any error.

@@ -65,6 +65,11 @@ pub struct RunArgs {
     /// No MIDI input.
     #[arg(long)]
     pub no_midi: bool,
+    /// The pad controller's profile: apc40-mk2, apc-mini-mk2, launchpad-x, launchpad-mini-mk3,
+    /// generic-grid, or a profile file [default: picked by port name, from those and the user's
+    /// controllers/ folder].
+    #[arg(long, value_name = "PROFILE")]
+    pub controller: Option<String>,
     /// Audio input device: the first whose name contains this (default: the default device,
     /// opened when the scene maps audio).
     #[arg(long, value_name = "NAME")]
@@ -209,6 +214,8 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         midi: !args.no_midi,
         audio_in: (!args.no_audio).then(|| args.audio_in.clone()),
         midi_filter: args.midi.clone(),
+        controller: args.controller.clone(),
+        controllers_dir: indra::files::user_data("controllers"),
         record: args.record_controls.clone(),
         presets_dir: args.presets.clone().unwrap_or_else(|| indra::files::user_data("presets")),
         learn_file: args.midi_learn.clone().unwrap_or_else(|| indra::files::user_data("midi-learn.ron")),

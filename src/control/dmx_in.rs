@@ -65,12 +65,9 @@ pub struct ClipChannel {
 impl DmxInFile {
     /// Reads and checks a DMX-in file: one sentence with its place for what is wrong.
     pub fn load(path: &Path) -> Result<Self, String> {
-        let bytes = crate::files::read_limited(path, MAX_FILE_BYTES).map_err(|e| e.to_string())?;
-        let text = String::from_utf8(bytes).map_err(|_| format!("{}: not UTF-8 text", path.display()))?;
+        let text = crate::files::read_text(path, MAX_FILE_BYTES)?;
         let origin = path.display();
-        let file: Self = crate::dmx::ron_options()
-            .from_str(&text)
-            .map_err(|e| format!("{origin}:{}:{}: {}", e.span.start.line, e.span.start.col, e.code))?;
+        let file: Self = crate::files::parse_ron(&text, &origin.to_string())?;
         let last = |fine: bool| if fine { 511 } else { 512 };
         for m in &file.map {
             if !(1..=last(m.fine)).contains(&m.channel) {

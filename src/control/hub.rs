@@ -5,9 +5,11 @@
 use std::path::PathBuf;
 use std::time::SystemTime;
 
+use super::audio::sound::{LiveSound, open_audio};
 use super::audio::{AudioFrame, AudioLearn, AudioMapper};
+use super::controller::Controllers;
 use super::feedback::{OscFeedback, ParamChanges};
-use super::midi::{LearnStore, MidiInput, MidiMapper, MidiParser};
+use super::midi::{LearnStore, MidiEvent, MidiInput, MidiMapper, MidiParser};
 use super::osc::OscReceiver;
 use super::osc_route::{OscRouter, RecordRequest, Routed};
 use super::oscquery::OscQueryServer;
@@ -35,6 +37,11 @@ pub struct ControlOptions {
     pub midi: bool,
     /// Only MIDI ports whose name contains this.
     pub midi_filter: Option<String>,
+    /// The controller profile to use (a bundled one's name, or a file); `None`: every bundled
+    /// profile and the user's, picked by port name.
+    pub controller: Option<String>,
+    /// The user's folder of controller profiles.
+    pub controllers_dir: PathBuf,
     /// Record the control stream to this file.
     pub record: Option<PathBuf>,
     /// Folder of presets.
@@ -63,6 +70,8 @@ impl Default for ControlOptions {
             web: None,
             midi: true,
             midi_filter: None,
+            controller: None,
+            controllers_dir: "controllers".into(),
             record: None,
             presets_dir: "presets".into(),
             learn_file: "midi-learn.ron".into(),
@@ -89,6 +98,8 @@ pub struct ControlHub {
     pub web_urls: Vec<String>,
     midi: Option<MidiInput>,
     parser: MidiParser,
+    /// Pad controllers with profiles, when MIDI is on.
+    controllers: Option<Controllers>,
     /// MIDI mappings, learn state and clock.
     pub mapper: MidiMapper,
     learn: LearnStore,
@@ -159,8 +170,19 @@ impl ControlHub {
             }
             _ => Vec::new(),
         };
+        let controllers =
+            options.midi.then(|| Controllers::start(options.controller.as_deref(), &options.controllers_dir));
+        let controllers = controllers.and_then(|c| {
+            // A profile named on the command line that cannot be read is the performer's to know.
+            c.map_err(|e| if options.controller.is_some() { report(Err(e)) } else { log::info!("{e}") }).ok()
+        });
         let midi = if options.midi {
-            MidiInput::open(options.midi_filter.as_deref()).map_err(|e| log::info!("{e}")).ok()
+            // Ports a controller profile serves are the controller thread's; the lights it sends
+            // (its own client's ports) are not input.
+            let exclude = |name: &str| {
+                name.contains(super::controller::port::CLIENT) || controllers.as_ref().is_some_and(|c| c.serves(name))
+            };
+            MidiInput::open(options.midi_filter.as_deref(), &exclude).map_err(|e| log::info!("{e}")).ok()
         } else {
             None
         };
@@ -197,6 +219,7 @@ impl ControlHub {
             web_urls,
             midi,
             parser: MidiParser::default(),
+            controllers,
             mapper,
             learn,
             presets,
@@ -266,6 +289,13 @@ impl ControlHub {
         for bytes in messages {
             events.extend(self.midi_bytes(&bytes, scene, seconds));
         }
+        if let Some(polled) = self.controllers.as_mut().map(|c| c.poll(&instance)) {
+            events.extend(polled.events);
+            events.extend((0..polled.taps).filter_map(|_| self.tempo.tap()));
+            for e in polled.unused {
+                events.extend(self.midi_event(e, scene, seconds));
+            }
+        }
         if let Some(sound) = self.audio.as_mut()
             && let Some((frame, dt)) = sound.analyse()
         {
@@ -326,21 +356,25 @@ impl ControlHub {
 
     /// Feeds raw MIDI bytes (from a port, or a test) through the parser and mappings.
     pub fn midi_bytes(&mut self, bytes: &[u8], scene: &Scene, seconds: f64) -> Vec<ControlEvent> {
+        let parsed = self.parser.feed(bytes);
+        parsed.into_iter().flat_map(|e| self.midi_event(e, scene, seconds)).collect()
+    }
+
+    /// One MIDI event through the mappings, learn and program changes.
+    fn midi_event(&mut self, e: MidiEvent, scene: &Scene, seconds: f64) -> Vec<ControlEvent> {
         let mut events = Vec::new();
         let was_learning = self.mapper.is_learning();
-        for e in self.parser.feed(bytes) {
-            // The note that is being learned only binds; it triggers from then on.
-            if !self.mapper.is_learning() {
-                let commands = super::midi::cue_commands(e, scene).into_iter().chain(self.mapper.note_commands(e));
-                events.extend(commands.map(ControlEvent::Show));
-            }
-            let (writes, program) = self.mapper.handle(e, scene, seconds);
-            events.extend(writes.into_iter().map(ControlEvent::Write));
-            if let Some(p) = program
-                && let Some(name) = self.preset_names.get(usize::from(p)).cloned()
-            {
-                events.extend(self.recall(&name, 0.0, scene));
-            }
+        // The note that is being learned only binds; it triggers from then on.
+        if !was_learning {
+            let commands = super::midi::cue_commands(e, scene).into_iter().chain(self.mapper.note_commands(e));
+            events.extend(commands.map(ControlEvent::Show));
+        }
+        let (writes, program) = self.mapper.handle(e, scene, seconds);
+        events.extend(writes.into_iter().map(ControlEvent::Write));
+        if let Some(p) = program
+            && let Some(name) = self.preset_names.get(usize::from(p)).cloned()
+        {
+            events.extend(self.recall(&name, 0.0, scene));
         }
         if was_learning && !self.mapper.is_learning() {
             self.persist_learned(scene);
@@ -466,6 +500,9 @@ impl ControlHub {
         if let Some(q) = self.oscquery.as_mut() {
             q.after_frame(instance, self.frame_count.is_multiple_of(6), &changes);
         }
+        if let Some(c) = self.controllers.as_ref() {
+            c.show(&instance);
+        }
         self.frame_count += 1;
     }
 
@@ -484,6 +521,7 @@ impl ControlHub {
             _ if !super::midi::BUILT_IN => parts.push("MIDI: not built in (--no-default-features)".into()),
             _ => parts.push("MIDI: none".into()),
         }
+        parts.extend(self.controllers.as_ref().and_then(Controllers::status));
         if let Some(dropped) = self.oscquery.as_ref().map(OscQueryServer::dropped).filter(|&d| d > 0) {
             parts.push(format!("OSCQuery LISTEN: {dropped} changes dropped (a controller fell behind)"));
         }
@@ -513,67 +551,5 @@ fn announce_surface(urls: &[String], read_only: bool, networked: bool) {
     let Some(first) = urls.first().filter(|_| networked) else { return };
     if let Some(code) = super::web::qr::terminal(first) {
         log::info!("scan to open the control surface:\n{code}");
-    }
-}
-
-/// A live input with its analyzer and the time of its last frame.
-struct LiveSound {
-    #[cfg(feature = "audio")]
-    input: super::audio::live::LiveAudio,
-    analyzer: super::audio::Analyzer,
-    started: std::time::Instant,
-    last: f64,
-}
-
-impl LiveSound {
-    /// Analyses what arrived since the last frame; with the real seconds it covered.
-    fn analyse(&mut self) -> Option<(AudioFrame, f64)> {
-        #[cfg(feature = "audio")]
-        let samples = self.input.drain();
-        #[cfg(not(feature = "audio"))]
-        let samples: Vec<f32> = Vec::new();
-        if samples.is_empty() {
-            return None;
-        }
-        let now = self.started.elapsed().as_secs_f64();
-        let dt = (now - self.last).max(1e-3);
-        self.last = now;
-        Some((self.analyzer.frame(&samples, now), dt))
-    }
-}
-
-/// Opens the audio input `wanted` asks for (see [`ControlOptions::audio_in`]; the default device
-/// only when `mapped`: some mapping listens). No device, or a build without the `audio` feature,
-/// is a logged fact (a notice when a device was named).
-fn open_audio(wanted: Option<&Option<String>>, mapped: bool, notices: &mut Vec<String>) -> Option<LiveSound> {
-    let filter = match wanted {
-        None => return None,
-        Some(None) if !mapped => return None,
-        Some(filter) => filter.as_deref(),
-    };
-    #[cfg(feature = "audio")]
-    {
-        match super::audio::live::LiveAudio::open(filter) {
-            Ok(input) => {
-                let analyzer = super::audio::Analyzer::new(input.rate);
-                Some(LiveSound { input, analyzer, started: std::time::Instant::now(), last: 0.0 })
-            }
-            Err(e) => {
-                log::info!("{e}; the scene's audio mappings stay still");
-                if filter.is_some() {
-                    notices.push(e);
-                }
-                None
-            }
-        }
-    }
-    #[cfg(not(feature = "audio"))]
-    {
-        let message = "this build has no live audio input (built without the `audio` feature)";
-        log::info!("{message}");
-        if filter.is_some() {
-            notices.push(message.into());
-        }
-        None
     }
 }

@@ -439,7 +439,10 @@ pub use port::MidiInput;
 /// MIDI ports through midir (ALSA on Linux, CoreMIDI, WinMM).
 #[cfg(feature = "midi")]
 mod port {
-    use std::sync::mpsc::{Receiver, channel};
+    use std::sync::mpsc::{Receiver, sync_channel};
+
+    /// Messages held for the render thread at most; a flood past that is dropped.
+    const QUEUE: usize = 4096;
 
     /// Connections to MIDI input ports; bytes arrive on a channel drained by the render loop.
     pub struct MidiInput {
@@ -450,22 +453,23 @@ mod port {
     }
 
     impl MidiInput {
-        /// Connects to every input port (or those whose name contains `filter`). Without a MIDI
-        /// system this returns why, to be logged once; the show goes on.
-        pub fn open(filter: Option<&str>) -> Result<Self, String> {
+        /// Connects to every input port (or those whose name contains `filter`) but those
+        /// `exclude` names. Without a MIDI system this returns why, to be logged once; the show
+        /// goes on.
+        pub fn open(filter: Option<&str>, exclude: &dyn Fn(&str) -> bool) -> Result<Self, String> {
             let probe = midir::MidiInput::new("indra")
                 .map_err(|e| format!("MIDI is not available ({e}); continuing without it"))?;
-            let (tx, bytes) = channel();
+            let (tx, bytes) = sync_channel(QUEUE);
             let mut connections = Vec::new();
             let mut ports = Vec::new();
             for port in probe.ports() {
                 let name = probe.port_name(&port).unwrap_or_default();
-                if filter.is_some_and(|f| !name.to_lowercase().contains(&f.to_lowercase())) {
+                if filter.is_some_and(|f| !name.to_lowercase().contains(&f.to_lowercase())) || exclude(&name) {
                     continue;
                 }
                 let input = midir::MidiInput::new("indra").map_err(|e| e.to_string())?;
                 let tx = tx.clone();
-                match input.connect(&port, "indra-in", move |_, message, _| drop(tx.send(message.to_vec())), ()) {
+                match input.connect(&port, "indra-in", move |_, message, _| drop(tx.try_send(message.to_vec())), ()) {
                     Ok(c) => {
                         ports.push(name);
                         connections.push(c);
@@ -498,7 +502,7 @@ mod port {
 
     impl MidiInput {
         /// Says that this binary has no MIDI.
-        pub fn open(_filter: Option<&str>) -> Result<Self, String> {
+        pub fn open(_filter: Option<&str>, _exclude: &dyn Fn(&str) -> bool) -> Result<Self, String> {
             Err(super::NOT_BUILT_IN.into())
         }
 

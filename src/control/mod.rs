@@ -1,5 +1,5 @@
 //! Live control: OSC in and out (with OSCQuery discovery and the browser surface), MIDI with
-//! learn, presets, and the
+//! learn and controllers that light up, presets, and the
 //! recording and replay of control streams. Everything becomes [`ControlEvent`]s that the
 //! running scene applies before its next fixed step. Knows nothing of rendering.
 //!
@@ -7,6 +7,7 @@
 
 pub mod address;
 pub mod audio;
+pub mod controller;
 pub mod discovery;
 pub mod dmx_in;
 pub mod feedback;

@@ -121,7 +121,7 @@ pub fn tree(instance: SceneView<'_>, presets: &[String]) -> Value {
         container.insert("DESCRIPTION".into(), json!(node.technique.summary));
         contents_of(container).extend(contents);
     }
-    if let Some((show, _)) = instance.show {
+    if let Some((show, state)) = instance.show {
         let trigger = |path: String, description: String| json!({ "FULL_PATH": format!("/indra/{path}"), "TYPE": "I", "ACCESS": 2, "DESCRIPTION": description });
         let mut put = |path: String, leaf: Value| {
             let (parent, name) = path.rsplit_once('/').unwrap_or(("", &path));
@@ -137,6 +137,14 @@ pub fn tree(instance: SceneView<'_>, presets: &[String]) -> Value {
             }
             let path = format!("layer/{}/clear", l + 1);
             put(path.clone(), trigger(path, format!("empty {}", layer.name)));
+            // Read-only: the clip the layer plays, from 1 (0: none), for controllers to show.
+            let playing = state.playing(l).and_then(|c| layer.clips.iter().position(|&k| k == c)).map_or(0, |c| c + 1);
+            let path = format!("layer/{}/playing", l + 1);
+            let description = format!("the clip {} plays, from 1 (0: none)", layer.name);
+            put(
+                path.clone(),
+                json!({ "FULL_PATH": format!("/indra/{path}"), "TYPE": "i", "ACCESS": 1, "VALUE": [playing], "DESCRIPTION": description }),
+            );
         }
         // Each chain's edits (a bypass is each effect's own `bypass` parameter in the tree).
         let chains = show.layers.iter().enumerate().map(|(l, layer)| (format!("layer/{}", l + 1), layer.effects.len()));

@@ -282,8 +282,7 @@ impl PixelFormat {
 impl Patch {
     /// Reads and checks a patch file: one sentence with file:line:column for what is wrong.
     pub fn load(path: &Path) -> Result<Self, String> {
-        let bytes = crate::files::read_limited(path, MAX_PATCH_BYTES).map_err(|e| e.to_string())?;
-        let text = String::from_utf8(bytes).map_err(|_| format!("{}: not UTF-8 text", path.display()))?;
+        let text = crate::files::read_text(path, MAX_PATCH_BYTES)?;
         let mut patch = Self::parse(&text, &path.display().to_string())?;
         let folder = path.parent().unwrap_or(Path::new("."));
         for lamp in &patch.lamps {
@@ -304,10 +303,7 @@ impl Patch {
 
     /// Parses and checks a patch's text; `origin` names it in messages.
     pub fn parse(text: &str, origin: &str) -> Result<Self, String> {
-        let patch: Self = ron_options().from_str(text).map_err(|e| {
-            let at = e.span.start;
-            format!("{origin}:{}:{}: {}", at.line, at.col, e.code)
-        })?;
+        let patch: Self = crate::files::parse_ron(text, origin)?;
         patch.check().map_err(|message| format!("{origin}: {message}"))?;
         Ok(patch)
     }

@@ -219,6 +219,19 @@ fn open_nonblocking(path: &Path) -> std::io::Result<std::fs::File> {
     std::fs::File::open(path)
 }
 
+/// Parses a settings file's RON text (an optional field may be written without `Some(…)`);
+/// an error is one sentence placed at `origin:line:column`.
+pub fn parse_ron<T: serde::de::DeserializeOwned>(text: &str, origin: &str) -> Result<T, String> {
+    let options = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+    options.from_str(text).map_err(|e| format!("{origin}:{}:{}: {}", e.span.start.line, e.span.start.col, e.code))
+}
+
+/// Reads a settings file of at most `limit` bytes as UTF-8 text.
+pub fn read_text(path: &Path, limit: u64) -> Result<String, String> {
+    let bytes = read_limited(path, limit).map_err(|e| e.to_string())?;
+    String::from_utf8(bytes).map_err(|_| format!("{}: not UTF-8 text", path.display()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -11,6 +11,7 @@ mod chromium;
 #[path = "../common/mod.rs"]
 mod common;
 mod control;
+mod controllers;
 mod effects;
 mod errors;
 mod file_imports;

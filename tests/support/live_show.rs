@@ -85,10 +85,21 @@ impl Show {
         args: &[&std::ffi::OsStr],
         env: &[(&str, &std::ffi::OsStr)],
     ) -> (Self, u16) {
+        Self::start_with_midi(display, dir, scene, [&["--no-midi".as_ref()], args].concat().as_slice(), env)
+    }
+
+    /// [`Show::start_with_env`] with MIDI on (controllers and ports from `env`'s MIDI system).
+    pub(crate) fn start_with_midi(
+        display: &VirtualDisplay,
+        dir: &Path,
+        scene: &str,
+        args: &[&std::ffi::OsStr],
+        env: &[(&str, &std::ffi::OsStr)],
+    ) -> (Self, u16) {
         let port = UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
         let log = dir.join("show.log");
         let child = Command::new(env!("CARGO_BIN_EXE_indra"))
-            .args(["--backend", "vulkan", "run", scene, "--no-midi", "--no-watch"])
+            .args(["--backend", "vulkan", "run", scene, "--no-watch"])
             .args(["--osc", &format!("127.0.0.1:{port}")])
             .args(args)
             .arg("--presets")

@@ -8,6 +8,7 @@ pub mod learn;
 #[cfg(feature = "audio")]
 pub mod live;
 pub mod mapping;
+pub mod sound;
 
 pub use analysis::{Analyzer, AudioFrame};
 pub use file::AudioFile;

@@ -169,6 +169,17 @@ impl ShowState {
         self.pending.iter().any(|p| p.layer == layer)
     }
 
+    /// The beat position of the last step (what its triggers were due against).
+    pub fn beats(&self) -> f64 {
+        self.last.beats
+    }
+
+    /// The clip a trigger waiting on layer `layer` will start (`Some(None)`: it stops the
+    /// layer), the last one if several wait.
+    pub fn queued(&self, layer: usize) -> Option<Option<usize>> {
+        self.pending.iter().rev().find(|p| p.layer == layer).map(|p| p.clip)
+    }
+
     /// The frame clip `clip`'s own clock started at (0 for a clip that continues).
     pub fn started(&self, clip: usize) -> u64 {
         self.started.get(clip).copied().unwrap_or(0)

@@ -1,0 +1,105 @@
+"""Simulated pad controllers on real JACK MIDI ports, for indra's tests.
+
+Each device named on the command line (NAME=OUT_PORT,IN_PORT) is a JACK client with a MIDI
+output (what its pads and faders send) and input (the lights it is sent). Commands on stdin,
+one per line; each answers one line of JSON on stdout:
+  send NAME HEX       send the bytes (one or more messages) from NAME's output
+  take NAME           every message NAME received since the last take: [[seconds, hex], ...]
+  unplug NAME         close NAME's client (its ports vanish, as a USB device's do)
+  plug NAME           open it again
+  quit
+"""
+
+import json
+import queue
+import sys
+import time
+
+import jack
+
+
+class Device:
+    def __init__(self, name, out_port, in_port):
+        self.name, self.out_port, self.in_port = name, out_port, in_port
+        self.client = None
+        self.outgoing = queue.Queue()
+        self.received = queue.Queue()
+
+    def plug(self):
+        client = jack.Client(self.name, no_start_server=True)
+        output = client.midi_outports.register(self.out_port)
+        inport = client.midi_inports.register(self.in_port)
+
+        def process(frames):
+            output.clear_buffer()
+            while True:
+                try:
+                    data = self.outgoing.get_nowait()
+                except queue.Empty:
+                    break
+                output.write_midi_event(0, data)
+            for _, data in inport.incoming_midi_events():
+                self.received.put((time.monotonic(), bytes(data).hex()))
+
+        client.set_process_callback(process)
+        client.activate()
+        self.client = client
+
+    def unplug(self):
+        self.client.deactivate()
+        self.client.close()
+        self.client = None
+
+    def send(self, hex_bytes):
+        data = bytes.fromhex(hex_bytes)
+        # One JACK event per channel message (3 bytes) or SysEx.
+        i = 0
+        while i < len(data):
+            if data[i] == 0xF0:
+                end = data.index(0xF7, i) + 1
+            else:
+                end = i + (2 if data[i] & 0xF0 in (0xC0, 0xD0) else 3)
+            self.outgoing.put(data[i:end])
+            i = end
+
+    def take(self):
+        out = []
+        while True:
+            try:
+                out.append(self.received.get_nowait())
+            except queue.Empty:
+                return out
+
+
+def main():
+    devices = {}
+    for spec in sys.argv[1:]:
+        name, ports = spec.split("=", 1)
+        out_port, in_port = ports.split(",", 1)
+        devices[name] = Device(name, out_port, in_port)
+        devices[name].plug()
+    print(json.dumps("ready"), flush=True)
+    for line in sys.stdin:
+        words = line.strip().split(" ")
+        command, name = words[0], " ".join(words[1:2])
+        if command == "quit":
+            break
+        device = devices[name.replace("_", " ")]
+        if command == "send":
+            device.send(words[2])
+            answer = "sent"
+        elif command == "take":
+            answer = device.take()
+        elif command == "unplug":
+            device.unplug()
+            answer = "unplugged"
+        elif command == "plug":
+            device.plug()
+            answer = "plugged"
+        else:
+            answer = "unknown command"
+        print(json.dumps(answer), flush=True)
+
+
+if __name__ == "__main__":
+    main()
