@@ -70,6 +70,13 @@ pub struct RunArgs {
     /// controllers/ folder].
     #[arg(long, value_name = "PROFILE")]
     pub controller: Option<String>,
+    /// Send MIDI to the first output port whose name contains this: every MIDI-mapped parameter
+    /// as its control change or note when it changes (motor faders, LED rings, other gear).
+    #[arg(long, value_name = "PORT")]
+    pub midi_out: Option<String>,
+    /// Send MIDI clock at the show's tempo on the --midi-out port.
+    #[arg(long, requires = "midi_out")]
+    pub midi_clock: bool,
     /// Audio input device: the first whose name contains this (default: the default device,
     /// opened when the scene maps audio).
     #[arg(long, value_name = "NAME")]
@@ -216,6 +223,8 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         midi_filter: args.midi.clone(),
         controller: args.controller.clone(),
         controllers_dir: indra::files::user_data("controllers"),
+        midi_out: args.midi_out.clone(),
+        midi_clock: args.midi_clock,
         record: args.record_controls.clone(),
         presets_dir: args.presets.clone().unwrap_or_else(|| indra::files::user_data("presets")),
         learn_file: args.midi_learn.clone().unwrap_or_else(|| indra::files::user_data("midi-learn.ron")),

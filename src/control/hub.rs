@@ -10,6 +10,7 @@ use super::audio::{AudioFrame, AudioLearn, AudioMapper};
 use super::controller::Controllers;
 use super::feedback::{OscFeedback, ParamChanges};
 use super::midi::{LearnStore, MidiEvent, MidiInput, MidiMapper, MidiParser};
+use super::midi_out::MidiOut;
 use super::osc::OscReceiver;
 use super::osc_route::{OscRouter, RecordRequest, Routed};
 use super::oscquery::OscQueryServer;
@@ -42,6 +43,10 @@ pub struct ControlOptions {
     pub controller: Option<String>,
     /// The user's folder of controller profiles.
     pub controllers_dir: PathBuf,
+    /// MIDI out to the first port whose name contains this: mapped parameters mirrored.
+    pub midi_out: Option<String>,
+    /// MIDI clock out (on the `midi_out` port) at the show's tempo.
+    pub midi_clock: bool,
     /// Record the control stream to this file.
     pub record: Option<PathBuf>,
     /// Folder of presets.
@@ -72,6 +77,8 @@ impl Default for ControlOptions {
             midi_filter: None,
             controller: None,
             controllers_dir: "controllers".into(),
+            midi_out: None,
+            midi_clock: false,
             record: None,
             presets_dir: "presets".into(),
             learn_file: "midi-learn.ron".into(),
@@ -100,6 +107,8 @@ pub struct ControlHub {
     parser: MidiParser,
     /// Pad controllers with profiles, when MIDI is on.
     controllers: Option<Controllers>,
+    /// MIDI out (mirrored mappings, clock), when asked for.
+    midi_out: Option<MidiOut>,
     /// MIDI mappings, learn state and clock.
     pub mapper: MidiMapper,
     learn: LearnStore,
@@ -186,6 +195,10 @@ impl ControlHub {
         } else {
             None
         };
+        let midi_out = options
+            .midi_out
+            .as_deref()
+            .and_then(|port| MidiOut::start(port, options.midi_clock).map_err(|e| report(Err(e))).ok());
         let recorder = options.record.as_deref().and_then(|p| Recorder::create(p).map_err(|e| report(Err(e))).ok());
         let learn = LearnStore { path: options.learn_file.clone() };
         let mapper = MidiMapper::new(scene, &learn.load());
@@ -220,6 +233,7 @@ impl ControlHub {
             midi,
             parser: MidiParser::default(),
             controllers,
+            midi_out,
             mapper,
             learn,
             presets,
@@ -258,6 +272,9 @@ impl ControlHub {
         });
         // Everything counts as changed: controllers get the new scene's values.
         self.changes.reset();
+        if let Some(out) = self.midi_out.as_mut() {
+            out.reset();
+        }
         if let Some(q) = self.oscquery.as_mut() {
             q.scene_changed();
         }
@@ -503,6 +520,9 @@ impl ControlHub {
         if let Some(c) = self.controllers.as_ref() {
             c.show(&instance);
         }
+        if let Some(out) = self.midi_out.as_mut() {
+            out.after_frame(self.mapper.bindings(), &instance);
+        }
         self.frame_count += 1;
     }
 
@@ -522,6 +542,7 @@ impl ControlHub {
             _ => parts.push("MIDI: none".into()),
         }
         parts.extend(self.controllers.as_ref().and_then(Controllers::status));
+        parts.extend(self.midi_out.as_ref().map(MidiOut::status));
         if let Some(dropped) = self.oscquery.as_ref().map(OscQueryServer::dropped).filter(|&d| d > 0) {
             parts.push(format!("OSCQuery LISTEN: {dropped} changes dropped (a controller fell behind)"));
         }

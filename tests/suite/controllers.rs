@@ -21,21 +21,33 @@ fn skip(problem: &str) {
 }
 
 /// A JACK server of its own name on the dummy driver; killed when dropped.
-struct Jack {
+pub(crate) struct Jack {
     child: Child,
-    name: String,
+    pub(crate) name: String,
+    /// One JACK test at a time: their timings are measured, and two shows at once on a
+    /// two-core machine starve both.
+    _turn: std::sync::MutexGuard<'static, ()>,
 }
 
+static TURN: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 impl Jack {
-    fn start() -> Option<Self> {
+    pub(crate) fn start() -> Option<Self> {
         if !cfg!(feature = "midi-jack") {
             skip("this test build has no JACK MIDI (tools/test builds with --features midi-jack)");
             return None;
         }
-        let name = format!("indra-test-{}", std::process::id());
+        // A server per test: tests run in parallel, and one show's controllers must not see
+        // another's devices.
+        static SERVERS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+        let n = SERVERS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        let name = format!("indra-test-{}-{n}", std::process::id());
+        let turn = TURN.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         let log = std::env::temp_dir().join(format!("{name}.log"));
         let spawned = Command::new("jackd")
-            .args(["--no-realtime", "-n", &name, "-d", "dummy", "-r", "48000", "-p", "256"])
+            // A slow client (a busy test machine) is waited for 2 s before JACK gives up on it (and a
+            // killed one, at the end, as long).
+            .args(["--no-realtime", "-t", "2000", "-n", &name, "-d", "dummy", "-r", "48000", "-p", "256"])
             .env("JACK_NO_AUDIO_RESERVATION", "1")
             .stdout(Stdio::null())
             .stderr(std::fs::File::create(&log).unwrap())
@@ -44,7 +56,7 @@ impl Jack {
             skip("no jackd (tools/setup-system test installs jackd2)");
             return None;
         };
-        let jack = Self { child, name };
+        let jack = Self { child, name, _turn: turn };
         let deadline = Instant::now() + Duration::from_secs(10);
         while !Command::new("jack_lsp")
             .env("JACK_DEFAULT_SERVER", &jack.name)
@@ -64,7 +76,7 @@ impl Drop for Jack {
         // Asked to stop, jackd takes its server out of JACK's registry (a killed one is left
         // there, and the registry holds a few).
         let _ = Command::new("kill").args(["-TERM", &self.child.id().to_string()]).status();
-        let deadline = Instant::now() + Duration::from_secs(5);
+        let deadline = Instant::now() + Duration::from_secs(15);
         while Instant::now() < deadline && matches!(self.child.try_wait(), Ok(None)) {
             std::thread::sleep(Duration::from_millis(50));
         }
@@ -74,14 +86,14 @@ impl Drop for Jack {
 }
 
 /// The simulated controllers: one Python process, one JACK client per device.
-struct Devices {
+pub(crate) struct Devices {
     child: Child,
     input: ChildStdin,
     output: BufReader<ChildStdout>,
 }
 
 impl Devices {
-    fn start(jack: &Jack, specs: &[&str]) -> Option<Self> {
+    pub(crate) fn start(jack: &Jack, specs: &[&str]) -> Option<Self> {
         let python = std::env::var("INDRA_MIDI_PYTHON").unwrap_or_else(|_| "python3".into());
         if !Command::new(&python).args(["-c", "import jack"]).output().is_ok_and(|o| o.status.success()) {
             skip(&format!("{python} has no JACK-Client (tools/test installs it in target/midi-peer)"));
@@ -108,25 +120,25 @@ impl Devices {
         serde_json::from_str(&line).unwrap_or_else(|e| panic!("the peer said {line:?}: {e}"))
     }
 
-    fn command(&mut self, line: &str) -> serde_json::Value {
+    pub(crate) fn command(&mut self, line: &str) -> serde_json::Value {
         writeln!(self.input, "{line}").unwrap();
         self.answer()
     }
 
     /// Sends `bytes` from device `name` (spaces as `_`).
-    fn send(&mut self, name: &str, bytes: &[u8]) {
+    pub(crate) fn send(&mut self, name: &str, bytes: &[u8]) {
         let hex: String = bytes.iter().map(|b| format!("{b:02x}")).collect();
         assert_eq!(self.command(&format!("send {} {hex}", name.replace(' ', "_"))), "sent");
     }
 
     /// A press and release of a note-on pad or button.
-    fn press(&mut self, name: &str, status: u8, number: u8) {
+    pub(crate) fn press(&mut self, name: &str, status: u8, number: u8) {
         // A note on of velocity 0 is a release, as a control change of 0 is.
         self.send(name, &[status, number, 127, status, number, 0]);
     }
 
     /// What device `name` received since the last take: (seconds, bytes).
-    fn take(&mut self, name: &str) -> Vec<(f64, Vec<u8>)> {
+    pub(crate) fn take(&mut self, name: &str) -> Vec<(f64, Vec<u8>)> {
         let answer = self.command(&format!("take {}", name.replace(' ', "_")));
         let list = answer.as_array().unwrap_or_else(|| panic!("{answer}"));
         (list.iter())
@@ -139,15 +151,15 @@ impl Devices {
             .collect()
     }
 
-    /// Waits (at most 20 s) until device `name` has been sent `message`; returns every message
+    /// Waits (at most 30 s) until device `name` has been sent `message`; returns every message
     /// it received meanwhile.
-    fn wait_for(&mut self, name: &str, message: &[u8]) -> Vec<(f64, Vec<u8>)> {
+    pub(crate) fn wait_for(&mut self, name: &str, message: &[u8]) -> Vec<(f64, Vec<u8>)> {
         self.wait_for_all(name, &[message])
     }
 
     /// [`Devices::wait_for`] for several messages, in any order.
-    fn wait_for_all(&mut self, name: &str, messages: &[&[u8]]) -> Vec<(f64, Vec<u8>)> {
-        let deadline = Instant::now() + Duration::from_secs(20);
+    pub(crate) fn wait_for_all(&mut self, name: &str, messages: &[&[u8]]) -> Vec<(f64, Vec<u8>)> {
+        let deadline = Instant::now() + Duration::from_secs(30);
         let mut seen = Vec::new();
         loop {
             seen.extend(self.take(name));
@@ -176,7 +188,8 @@ const SHOW: &str = r#"(
     layers: [
         (name: "one", clips: [(scene: "kleinian", id: "k1"), (scene: "kleinian", id: "k2"), (scene: "kleinian", id: "k3"),
             (scene: "kleinian", id: "k4"), (scene: "kleinian", id: "k5")]),
-        (name: "two", start: 0, clips: [(scene: "kleinian", id: "w1", transition: (kind: "crossfade", beats: 1.0, quantize: Bar))]),
+        (name: "two", start: 0, transition: (kind: "crossfade", beats: 1.0, quantize: Bar),
+            clips: [(scene: "kleinian", id: "w1"), (scene: "kleinian", id: "w2")]),
     ],
     cues: [(name: "first", clips: [(1, 1)])],
 )"#;
@@ -266,21 +279,26 @@ fn controllers_trigger_clips_light_their_pads_page_fade_and_come_back_after_an_u
     }
 
     // A quantized trigger blinks in tempo until its bar: lit (yellow, 13) the first half of each
-    // beat, its other state (loaded) the second; then it lights "playing".
+    // beat, its other state (loaded) the second; then it lights "playing". The second trigger
+    // goes right after a bar, so it waits (and blinks) most of a bar.
     devices.press(LPX, 0x90, 21);
+    wait_playing(2, 1.0);
+    devices.press(LPX, 0x90, 22);
     devices.take(LPX);
-    let seen = devices.wait_for(LPX, &[0x90, 21, 21]);
-    let pad: Vec<(f64, Vec<u8>)> = seen.into_iter().filter(|(_, m)| m[1] == 21).collect();
+    let seen = devices.wait_for(LPX, &[0x90, 22, 21]);
+    let pad: Vec<(f64, Vec<u8>)> = seen.into_iter().filter(|(_, m)| m[1] == 22).collect();
     let toggles: Vec<f64> = pad.windows(2).filter(|w| w[0].1 != w[1].1).map(|w| w[1].0).collect();
     assert!(pad.iter().any(|(_, m)| m[2] == 13), "the queued pad never blinked: {pad:02x?}");
-    // Measured where the messages arrive: each end of a gap may be a frame late, so the
-    // median gap is held to the half beat, and every gap to a quarter beat of it.
+    // Measured where the messages arrive: each end of a gap may be a frame late, and a busy
+    // machine stalls a frame now and then; so the median gap is held to the half beat, and
+    // three in four gaps to a tenth of a beat of it.
     let mut gaps: Vec<f64> = toggles.windows(2).map(|g| (g[1] - g[0]) / 0.5).collect();
     gaps.sort_by(f64::total_cmp);
-    assert!(gaps.len() >= 2, "too few blinks to time: {pad:02x?}");
+    assert!(gaps.len() >= 4, "too few blinks to time: {pad:02x?}");
     assert!((gaps[gaps.len() / 2] - 0.5).abs() < 0.1, "the blink is not half a beat: {gaps:.2?} beats");
-    assert!(gaps.iter().all(|g| (g - 0.5).abs() < 0.25), "a blink was far from half a beat: {gaps:.2?} beats");
-    wait_playing(2, 1.0);
+    let close = gaps.iter().filter(|g| (*g - 0.5).abs() < 0.1).count();
+    assert!(close * 4 >= gaps.len() * 3, "blinks far from half a beat: {gaps:.2?} beats");
+    wait_playing(2, 2.0);
 
     // Paging: the generic grid's four columns show clips 1–4; a page right shows clip 5 at
     // column 1 (loaded) and empty pads after it; its pad plays clip 5.

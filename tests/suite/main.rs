@@ -24,6 +24,7 @@ mod live;
 #[path = "../support/live_show.rs"]
 mod live_show;
 mod media;
+mod midi_out;
 mod msaa;
 mod ndi;
 mod osc;
