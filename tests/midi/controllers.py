@@ -38,8 +38,11 @@ class Device:
                 except queue.Empty:
                     break
                 output.write_midi_event(0, data)
+            # Stamped on the wall clock when the cycle runs (JACK's frame clock runs behind it
+            # on a busy machine, where the server waits for late clients).
+            now = time.monotonic()
             for _, data in inport.incoming_midi_events():
-                self.received.put((time.monotonic(), bytes(data).hex()))
+                self.received.put((now, bytes(data).hex()))
 
         client.set_process_callback(process)
         client.activate()

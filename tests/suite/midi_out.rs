@@ -46,14 +46,14 @@ fn mapped_parameters_and_the_clock_go_out_to_a_desk() {
     devices.wait_for("desk", &[0xB0, 1, 20]);
     // The clock: 24 pulses a beat at 150 BPM.
     devices.take("desk");
-    std::thread::sleep(Duration::from_secs(2));
+    std::thread::sleep(Duration::from_secs(3));
     let pulses: Vec<f64> = devices.take("desk").into_iter().filter(|(_, m)| m == &[0xF8]).map(|(t, _)| t).collect();
-    // Pulses follow the show's beat, which stops when a busy machine stalls the show: the
-    // median gap is held close, the count only loosely (two seconds hold 120 pulses).
-    assert!(pulses.len() >= 60, "{} pulses in two seconds", pulses.len());
-    let mut gaps: Vec<f64> = pulses.windows(2).map(|w| w[1] - w[0]).collect();
-    gaps.sort_by(f64::total_cmp);
-    let median = gaps[gaps.len() / 2];
-    assert!((median * 150.0 * 24.0 / 60.0 - 1.0).abs() < 0.1, "median pulse gap {median:.4} s, not 1/60 s");
+    // Pulses follow the show's beat; on a machine busy with other tests a frame may stall (the
+    // clock then slows with the show) and JACK's cycles run late and then back to back (pulses
+    // arrive bunched, so single gaps say little). So the rate over three seconds is held to 8 %:
+    // enough to catch a clock at another tempo, or another count of pulses a beat.
+    let span = pulses.last().unwrap() - pulses.first().unwrap();
+    let bpm = (pulses.len() - 1) as f64 / span * 60.0 / 24.0;
+    assert!((bpm / 150.0 - 1.0).abs() < 0.08, "{} pulses in {span:.3} s: {bpm:.1} BPM", pulses.len());
     assert!(show.child.try_wait().unwrap().is_none(), "the show is still running");
 }
