@@ -5,7 +5,6 @@
 //! session's phase, when Link drives the tempo). A thread owns the port: the render thread only
 //! queues messages (bounded) and offers its beat.
 
-use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::sync::{Arc, Mutex};
@@ -45,21 +44,21 @@ pub fn position(value: ParamValue, binding: &Binding, view: &SceneView<'_>) -> O
     Some(if m.invert { 1.0 - pos } else { pos })
 }
 
-/// The messages that put binding's control where `pos` (0–1) is.
-pub fn messages(binding: &Binding, pos: f32) -> Vec<[u8; 3]> {
+/// The messages (one, or a 14-bit pair) that put binding's control where `pos` (0–1) is.
+pub fn messages(binding: &Binding, pos: f32) -> [Option<[u8; 3]>; 2] {
     let m = &binding.mapping;
     let channel = m.channel.unwrap_or(1).clamp(1, 16) - 1;
     match (m.cc, m.note) {
         (Some(cc), _) if m.fine => {
             let v = (pos * 16383.0).round() as u16;
-            vec![[0xB0 | channel, cc, (v >> 7) as u8], [0xB0 | channel, cc + 32, (v & 0x7F) as u8]]
+            [Some([0xB0 | channel, cc, (v >> 7) as u8]), Some([0xB0 | channel, cc + 32, (v & 0x7F) as u8])]
         }
-        (Some(cc), _) => vec![[0xB0 | channel, cc, (pos * 127.0).round() as u8]],
+        (Some(cc), _) => [Some([0xB0 | channel, cc, (pos * 127.0).round() as u8]), None],
         (None, Some(note)) => match (pos * 127.0).round() as u8 {
-            0 => vec![[0x80 | channel, note, 0]],
-            velocity => vec![[0x90 | channel, note, velocity]],
+            0 => [Some([0x80 | channel, note, 0]), None],
+            velocity => [Some([0x90 | channel, note, velocity]), None],
         },
-        (None, None) => Vec::new(),
+        (None, None) => [None, None],
     }
 }
 
@@ -81,7 +80,7 @@ pub struct MidiOut {
     queue: SyncSender<Vec<u8>>,
     shared: Arc<Shared>,
     /// Per binding (scene's then learned, as the mapper lists them): the messages last sent.
-    last: HashMap<String, Vec<[u8; 3]>>,
+    last: Vec<[Option<[u8; 3]>; 2]>,
     thread: Option<JoinHandle<()>>,
     clock: bool,
 }
@@ -97,23 +96,24 @@ impl MidiOut {
             .name("indra-midi-out".into())
             .spawn(move || run(&port, clock, &messages, &thread_shared))
             .map_err(|e| format!("cannot start the MIDI out thread: {e}"))?;
-        Ok(Self { queue, shared, last: HashMap::new(), thread: Some(thread), clock })
+        Ok(Self { queue, shared, last: Vec::new(), thread: Some(thread), clock })
     }
 
     /// After a frame: queues the mapped parameters whose control position changed, and offers
     /// the tempo to the clock (never waiting for its lock).
     pub fn after_frame(&mut self, bindings: &[Binding], view: &SceneView<'_>) {
-        for binding in bindings {
+        // A learned or unlearned binding shifts the list: what follows it is sent once more.
+        self.last.resize(bindings.len(), [None, None]);
+        for (binding, last) in bindings.iter().zip(&mut self.last) {
             let value = view.params(binding.target.node).target_at(binding.target.param);
             let Some(pos) = position(value, binding, view) else { continue };
             let out = messages(binding, pos);
-            let key = format!("{}|{:?}|{:?}", binding.mapping.target, binding.mapping.cc, binding.mapping.note);
-            if self.last.get(&key) == Some(&out) {
+            if *last == out {
                 continue;
             }
-            let bytes: Vec<u8> = out.iter().flatten().copied().collect();
+            let bytes: Vec<u8> = out.iter().flatten().flatten().copied().collect();
             if self.queue.try_send(bytes).is_ok() {
-                self.last.insert(key, out);
+                *last = out;
             } else {
                 self.shared.dropped.fetch_add(1, Ordering::Relaxed);
             }
@@ -258,8 +258,7 @@ fn reconnect(
     output: Option<(String, midir::MidiOutputConnection)>,
     port: &str,
 ) -> Option<(String, midir::MidiOutputConnection)> {
-    let ports: Vec<(midir::MidiOutputPort, String)> =
-        probe.ports().into_iter().filter_map(|p| Some((p.clone(), probe.port_name(&p).ok()?))).collect();
+    let ports = super::controller::port::named_ports(probe);
     if let Some((name, connection)) = output {
         if ports.iter().any(|(_, n)| *n == name) {
             return Some((name, connection));

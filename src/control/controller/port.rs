@@ -108,6 +108,8 @@ impl Drop for ControllerPorts {
 struct Session {
     input: Option<(String, midir::MidiInputConnection<()>)>,
     output: Option<(String, midir::MidiOutputConnection)>,
+    /// The newest lights offered (kept: those the budget held back go at a later tick).
+    wanted: Lights,
     /// The message last sent per control.
     shown: std::collections::HashMap<Control, [u8; 3]>,
     /// Messages it may send now (refilled at the profile's rate, at most a second's worth).
@@ -149,14 +151,19 @@ fn watch(profiles: Vec<Profile>, shared: Arc<Shared>, tx: SyncSender<(usize, Vec
         for (i, (profile, session)) in profiles.iter().zip(&mut sessions).enumerate() {
             let rate = f64::from(profile.rate);
             session.budget = (session.budget + elapsed * rate).min(rate);
-            let lights = shared.lights[i].lock().ok().and_then(|slot| slot.clone());
-            session.greet(profile, &shared);
-            if let Some(lights) = lights {
-                session.show(&lights, &shared);
+            if let Some(offered) = shared.lights[i].lock().ok().and_then(|mut slot| slot.take()) {
+                session.wanted = offered;
             }
+            session.greet(profile, &shared);
+            session.show(&shared);
         }
         std::thread::sleep(TICK);
     }
+}
+
+/// The ports a client sees, with their names (those whose name cannot be read are left out).
+pub fn named_ports<T: midir::MidiIO>(client: &T) -> Vec<(T::Port, String)> {
+    client.ports().into_iter().filter_map(|p| Some((p.clone(), client.port_name(&p).ok()?))).collect()
 }
 
 /// Clients that list ports (kept: a JACK client per scan would churn the server).
@@ -177,10 +184,7 @@ impl Session {
         tx: &SyncSender<(usize, Vec<u8>)>,
         shared: &Arc<Shared>,
     ) {
-        let in_names: Vec<(midir::MidiInputPort, String)> =
-            inputs.ports().into_iter().filter_map(|p| Some((p.clone(), inputs.port_name(&p).ok()?))).collect();
-        let out_names: Vec<(midir::MidiOutputPort, String)> =
-            outputs.ports().into_iter().filter_map(|p| Some((p.clone(), outputs.port_name(&p).ok()?))).collect();
+        let (in_names, out_names) = (named_ports(inputs), named_ports(outputs));
         if let Some((name, connection)) = self.input.take_if(|(name, _)| !in_names.iter().any(|(_, n)| n == name)) {
             connection.close();
             log::info!("controller {}: input {name} went away", profile.name);
@@ -240,12 +244,12 @@ impl Session {
 
     /// Sends the lights that differ from those shown, as many as the budget allows (the rest
     /// go at the next tick: they still differ).
-    fn show(&mut self, lights: &Lights, shared: &Shared) {
+    fn show(&mut self, shared: &Shared) {
         let Some((_, output)) = self.output.as_mut() else { return };
         if self.lights_from.is_none_or(|t| Instant::now() < t) {
             return;
         }
-        for (control, message) in lights {
+        for (control, message) in &self.wanted {
             if self.budget < 1.0 {
                 return;
             }

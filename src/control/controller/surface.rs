@@ -110,9 +110,17 @@ impl Surface {
 
     /// The layer and clip index (within the layer) pad (`column`, `row`) stands for.
     fn cell(&self, column: u8, row: u8) -> (usize, usize) {
-        let grid = &self.profile.grid;
-        let layer = self.page.1 * usize::from(grid.rows) + usize::from(row);
-        (layer, self.page.0 * usize::from(grid.columns) + usize::from(column))
+        (self.paged_row(row + 1), self.paged_column(column + 1))
+    }
+
+    /// The show column of the page's `n`-th column (from 1).
+    fn paged_column(&self, n: u8) -> usize {
+        self.page.0 * usize::from(self.profile.grid.columns) + usize::from(n.max(1) - 1)
+    }
+
+    /// The show layer of the page's `n`-th row (from 1, the bottom).
+    fn paged_row(&self, n: u8) -> usize {
+        self.page.1 * usize::from(self.profile.grid.rows) + usize::from(n.max(1) - 1)
     }
 
     /// Pages there are: (clip pages, layer pages).
@@ -126,7 +134,6 @@ impl Surface {
     fn press(&mut self, action: Action, view: &SceneView<'_>, out: &mut Handled) {
         let show = view.show.map(|(show, _)| show);
         let pages = self.pages(show);
-        let grid = &self.profile.grid;
         let mut command = |c: ShowCommand| out.events.push(ControlEvent::Show(c));
         match action {
             Action::Go if show.is_some_and(|s| !s.cues.is_empty()) => command(ShowCommand::CueGo),
@@ -137,13 +144,13 @@ impl Surface {
             Action::PageDown => self.page.1 = self.page.1.saturating_sub(1),
             Action::PageUp => self.page.1 = (self.page.1 + 1).min(pages.1 - 1),
             Action::Column(n) => {
-                let column = self.page.0 * usize::from(grid.columns) + usize::from(n.max(1) - 1);
+                let column = self.paged_column(n);
                 if show.is_some_and(|s| column < s.columns.len()) {
                     command(ShowCommand::Column(column));
                 }
             }
             Action::Stop(n) => {
-                let layer = self.page.1 * usize::from(grid.rows) + usize::from(n.max(1) - 1);
+                let layer = self.paged_row(n);
                 if show.is_some_and(|s| layer < s.layers.len()) {
                     command(ShowCommand::Trigger { layer, clip: None });
                 }
@@ -233,7 +240,6 @@ impl Surface {
         let show = view.show.map(|(show, _)| show);
         let state = view.show.map(|(_, state)| state);
         let pages = self.pages(show);
-        let grid = &self.profile.grid;
         match action {
             Action::Go => show.is_some_and(|s| !s.cues.is_empty()),
             Action::Back => state.and_then(|s| s.cue()).is_some_and(|c| c > 0),
@@ -242,14 +248,8 @@ impl Surface {
             Action::PageRight => self.page.0 + 1 < pages.0,
             Action::PageDown => self.page.1 > 0,
             Action::PageUp => self.page.1 + 1 < pages.1,
-            Action::Column(n) => {
-                let column = self.page.0 * usize::from(grid.columns) + usize::from(n.max(1) - 1);
-                show.is_some_and(|s| column < s.columns.len())
-            }
-            Action::Stop(n) => {
-                let layer = self.page.1 * usize::from(grid.rows) + usize::from(n.max(1) - 1);
-                state.is_some_and(|s| s.playing(layer).is_some())
-            }
+            Action::Column(n) => show.is_some_and(|s| self.paged_column(n) < s.columns.len()),
+            Action::Stop(n) => state.is_some_and(|s| s.playing(self.paged_row(n)).is_some()),
             Action::BypassLayer(..) | Action::BypassMaster(_) => bypass_of(action, view).is_some_and(|(.., on)| on),
             Action::Blend(_) => false,
         }
