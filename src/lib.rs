@@ -3,7 +3,7 @@
 //!
 //! Layers, from the bottom (a module imports only lower layers; `docs/architecture.md` is the
 //! map, and a test holds it to this crate): [`time`], [`files`], [`atomic_file`] → [`assets`],
-//! [`geometry`], [`gpu`], [`graph`] → [`params`], [`dmx`] → [`techniques`] → [`scene`] → [`control`],
+//! [`checkpoint`], [`geometry`], [`gpu`], [`graph`] → [`params`], [`dmx`] → [`techniques`] → [`scene`] → [`control`],
 //! [`live`] → [`offscreen`] → [`app`]; `main.rs` is the command line only.
 
 #![warn(missing_docs)]
@@ -11,6 +11,7 @@
 pub mod app;
 pub mod assets;
 pub mod atomic_file;
+pub mod checkpoint;
 pub mod control;
 pub mod dmx;
 pub mod files;

@@ -62,8 +62,13 @@ struct GpuArgs {
 enum Command {
     /// Open a scene in a window with live controls (default: the kleinian scene).
     Run(Box<cli::RunArgs>),
-    /// Render frames off-screen to a PNG sequence.
-    Render(cli::RenderArgs),
+    /// Render frames off-screen to a PNG sequence (with a manifest of SHA-256 sums) or a video.
+    Render(Box<cli::RenderArgs>),
+    /// Step through frames without drawing and write checkpoints of the whole state, so a
+    /// render can start anywhere (`render --checkpoints`) without simulating what comes before.
+    Bake(Box<cli::BakeArgs>),
+    /// Check the frames of a chunked render against their manifests and make one video.
+    Assemble(cli::AssembleArgs),
     /// Validate every scene and shader (or the given files); non-zero exit on any error.
     Check {
         /// Scene (.ron) or shader (.wgsl) files; all known ones when empty.
@@ -95,6 +100,8 @@ fn main() -> ExitCode {
         None => cli::run(&assets, &gpu, &cli::RunArgs::default()),
         Some(Command::Run(args)) => cli::run(&assets, &gpu, &args),
         Some(Command::Render(args)) => cli::render(&assets, &gpu, &args),
+        Some(Command::Bake(args)) => cli::bake(&assets, &gpu, &args),
+        Some(Command::Assemble(args)) => cli::assemble(&args),
         Some(Command::Check { files }) => cli::check(&assets, &files),
         Some(Command::List) => cli::list(&assets),
         Some(Command::Bench(args)) => cli::bench(&assets, &gpu, &args),

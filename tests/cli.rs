@@ -34,7 +34,18 @@ fn render_writes_a_png_sequence_of_the_requested_size() {
     let mut names: Vec<String> =
         std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();
-    assert_eq!(names, ["kleinian_00010.png", "kleinian_00011.png", "kleinian_00012.png"]);
+    // The frames and their sums, as sha256sum writes them.
+    assert_eq!(
+        names,
+        ["kleinian_00010-00012.sha256", "kleinian_00010.png", "kleinian_00011.png", "kleinian_00012.png"]
+    );
+    let manifest = std::fs::read_to_string(out.join("kleinian_00010-00012.sha256")).unwrap();
+    let first = std::fs::read(out.join("kleinian_00010.png")).unwrap();
+    assert!(
+        manifest.starts_with(&format!("{}  kleinian_00010.png\n", indra::checkpoint::sha256_hex(&first))),
+        "{manifest}"
+    );
+    assert_eq!(manifest.lines().count(), 3);
     let img = image::open(out.join("kleinian_00011.png")).unwrap();
     assert_eq!((img.width(), img.height()), (64, 48));
 }
@@ -485,5 +496,5 @@ fn a_clip_without_ffmpeg_is_one_sentence_and_the_render_goes_on() {
     assert!(o.status.success(), "the render goes on: {said}");
     assert!(said.contains("no-such-ffprobe was not found") && said.contains("apt-get install ffmpeg"), "{said}");
     assert_eq!(said.matches("was not found").count(), 1, "said once: {said}");
-    assert_eq!(std::fs::read_dir(&out_dir).unwrap().count(), 2, "both frames written (black)");
+    assert_eq!(std::fs::read_dir(&out_dir).unwrap().count(), 3, "both frames written (black), and their sums");
 }

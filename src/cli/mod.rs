@@ -14,6 +14,8 @@ macro_rules! say {
     }};
 }
 
+mod assemble;
+mod bake;
 mod bench;
 mod bench_fx;
 mod bench_record;
@@ -22,8 +24,11 @@ mod list;
 mod render;
 mod render_dmx;
 mod run;
+mod source;
 mod triangulate;
 
+pub use assemble::{AssembleArgs, assemble};
+pub use bake::{BakeArgs, bake};
 pub use bench::{BenchArgs, bench};
 pub use check::check;
 pub use list::{list, list_cameras, list_ndi};
@@ -49,6 +54,55 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
     match (parse(w), parse(h)) {
         (Some(w), Some(h)) => Ok((w, h)),
         _ => Err(format!("'{text}' is not WxH with sides from 1 to 16384")),
+    }
+}
+
+/// `--frames`: a count from `--start`, or a range of frame numbers with both ends included.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FrameSpan {
+    /// This many frames.
+    Count(u64),
+    /// Frames A to B.
+    Range(u64, u64),
+}
+
+impl FrameSpan {
+    fn parse(text: &str) -> Result<Self, String> {
+        let number = |s: &str| {
+            s.trim().parse::<u64>().map_err(|_| format!("'{text}' is not a frame count (120) or range (600-699)"))
+        };
+        match text.split_once('-') {
+            None => Ok(FrameSpan::Count(number(text)?)),
+            Some((a, b)) => match (number(a)?, number(b)?) {
+                (a, b) if a <= b => Ok(FrameSpan::Range(a, b)),
+                (a, b) => Err(format!("the range {a}-{b} ends before it starts")),
+            },
+        }
+    }
+
+    /// A range as Open Job Description writes a contiguous chunk: `A-B`, `A,B` (two frames) or
+    /// `A` (one frame).
+    fn parse_chunk(text: &str) -> Result<Self, String> {
+        let bad = || format!("'{text}' is not a range of frames (600-699, 600,601 or 600)");
+        let number = |s: &str| s.trim().parse::<u64>().map_err(|_| bad());
+        let (a, b) = match text.split_once(['-', ',']) {
+            None => (number(text)?, number(text)?),
+            Some((a, b)) => (number(a)?, number(b)?),
+        };
+        let two = text.contains(',');
+        if a > b || (two && b != a + 1) {
+            return Err(bad());
+        }
+        Ok(FrameSpan::Range(a, b))
+    }
+
+    /// The first frame and how many, given `--start`.
+    fn resolve(self, start: u64) -> Result<(u64, u64), String> {
+        match self {
+            FrameSpan::Count(n) => Ok((start, n)),
+            FrameSpan::Range(a, b) if start == 0 => Ok((a, b - a + 1)),
+            FrameSpan::Range(a, b) => Err(format!("--frames {a}-{b} names its first frame: leave out --start {start}")),
+        }
     }
 }
 

@@ -1,25 +1,22 @@
 //! `indra render`: frames to PNGs or a video file, off-screen and exact.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use clap::Args;
 use indra::assets::Assets;
-use indra::gpu::{Gpu, GpuOptions};
-use indra::offscreen::{OffscreenRenderer, RenderedFrame, VideoSettings, VideoWriter, write_png};
+use indra::gpu::GpuOptions;
+use indra::offscreen::{RenderedFrame, VideoSettings, VideoWriter, write_png};
 
-use super::{SceneEdits, check_timing, parse_size, scene_with_edits, with_scene_folder};
+use super::assemble::{Manifest, frame_file};
+use super::source::LoadedSource;
+use super::{FrameSpan, SceneEdits, check_timing, parse_size};
 
-/// `indra render`.
+/// What fixes a render's frames — the scene and its edits, size, step, seed, and the control
+/// events it plays — shared by `render` and `bake`, whose checkpoints pin all of it.
 #[derive(Args, Clone)]
-pub struct RenderArgs {
+pub struct RenderSource {
     /// Scene name (from scenes/) or path to a .ron file.
     pub scene: String,
-    /// Number of frames to render.
-    #[arg(long, default_value_t = 1)]
-    pub frames: u64,
-    /// First frame index (time = frame × dt).
-    #[arg(long, default_value_t = 0)]
-    pub start: u64,
     /// Output size WxH (default: the scene's).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
@@ -29,7 +26,44 @@ pub struct RenderArgs {
     /// Seed (default: the scene's).
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Output folder; frames are written as <scene>_<frame>.png.
+    #[command(flatten)]
+    pub edits: SceneEdits,
+    /// Replay a control stream recorded with `run --record-controls`, frame-exactly.
+    #[arg(long)]
+    pub replay: Option<PathBuf>,
+    /// A sound file the scene's audio mappings hear (frame n hears it up to (n + 1) × dt, so
+    /// renders are exact): WAV, or any format ffmpeg decodes (MP3, FLAC, Ogg, …); with --video it
+    /// is also the video's sound track.
+    #[arg(long, value_name = "FILE")]
+    pub audio: Option<PathBuf>,
+}
+
+/// `indra render`.
+#[derive(Args, Clone)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub source: RenderSource,
+    /// Frames to render: a count from --start (120), or a range of frame numbers, both ends
+    /// included (600-699: a farm task's chunk).
+    #[arg(long, default_value = "1", value_parser = FrameSpan::parse)]
+    pub frames: FrameSpan,
+    /// The frames of a farm task as Open Job Description writes a CHUNK[INT] range — 600-699,
+    /// 600,601 or 600 — in place of --frames and --start.
+    #[arg(long, value_name = "RANGE", value_parser = FrameSpan::parse_chunk, conflicts_with_all = ["frames", "start"])]
+    pub chunk: Option<FrameSpan>,
+    /// First frame index (time = frame × dt), with a count of --frames.
+    #[arg(long, default_value_t = 0)]
+    pub start: u64,
+    /// Start from the nearest checkpoint at or before the first frame in this folder (made by
+    /// `indra bake`) instead of simulating every frame before it.
+    #[arg(long, value_name = "DIR")]
+    pub checkpoints: Option<PathBuf>,
+    /// Take a checkpoint made on another adapter or driver: the frames are then close to,
+    /// not the same bytes as, a render from frame 0 here.
+    #[arg(long, requires = "checkpoints")]
+    pub accept_other_adapter: bool,
+    /// Output folder; frames are written as <scene>_<frame>.png, with a manifest of their
+    /// SHA-256 sums (<scene>_<first>-<last>.sha256, as sha256sum writes it).
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
     /// Write the frames as one video file instead of PNGs (.mp4 and .mkv: H.264; .mov: ProRes
@@ -57,20 +91,10 @@ pub struct RenderArgs {
     /// the ProRes profile (0 proxy … 3 HQ, 4 4444).
     #[arg(long, requires = "video")]
     pub quality: Option<u32>,
-    #[command(flatten)]
-    pub edits: SceneEdits,
-    /// Replay a control stream recorded with `run --record-controls`, frame-exactly.
-    #[arg(long)]
-    pub replay: Option<PathBuf>,
     /// Which output to render: 0 the scene's output (default), 1… its `outputs` as their
     /// windows show them (warped).
     #[arg(long, default_value_t = 0)]
     pub output: usize,
-    /// A sound file the scene's audio mappings hear (frame n hears it up to (n + 1) × dt, so
-    /// renders are exact): WAV, or any format ffmpeg decodes (MP3, FLAC, Ogg, …); with --video it
-    /// is also the video's sound track.
-    #[arg(long, value_name = "FILE")]
-    pub audio: Option<PathBuf>,
     /// Send the fixtures of this DMX patch file (Art-Net or sACN, see docs/lights.md) the
     /// pixels of each frame, in real time (each frame waits until it is due at 1/dt); default:
     /// the patch the scene or show names (`dmx:`).
@@ -82,27 +106,13 @@ pub struct RenderArgs {
     pub dmx_record: Option<PathBuf>,
 }
 
-/// Renders a PNG sequence.
+/// Renders a PNG sequence (with its manifest) or a video.
 pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<(), String> {
-    check_timing(args.start, args.frames, args.dt)?;
-    let assets = &with_scene_folder(assets, &args.scene).rendering_at(args.size);
-    let scene = scene_with_edits(assets, &args.scene, &args.edits)?;
-    let mut script = match &args.replay {
-        Some(path) => indra::control::record::read_replay(path, &scene, assets)?,
-        None => Default::default(),
-    };
-    let dt = f64::from(args.dt.unwrap_or(scene.dt));
-    if let Some(path) = &args.audio {
-        let file = indra::control::audio::AudioFile::open(path)?;
-        if scene.audio.is_empty() {
-            eprintln!("'{}' maps no audio (controls.audio): the file is only the sound track", scene.name);
-        }
-        let frames = args.start.saturating_add(args.frames);
-        for (frame, events) in indra::control::audio::file_script(&file, &scene, frames, dt) {
-            script.entry(frame).or_default().extend(events);
-        }
-    }
-    scene.check_texture_budget(args.size.unwrap_or(scene.size))?;
+    let (start, frames) = args.chunk.unwrap_or(args.frames).resolve(args.start)?;
+    check_timing(start, frames, args.source.dt)?;
+    let loaded = LoadedSource::load(assets, &args.source, start.saturating_add(frames))?;
+    let (assets, scene) = (&loaded.assets, &loaded.scene);
+    let dt = f64::from(args.source.dt.unwrap_or(scene.dt));
     // A patch the scene names but that cannot be found costs the lights, not the frames.
     let patch = super::dmx_file(assets, args.dmx_out.as_deref(), scene.dmx.as_deref(), &scene.name, "DMX patch")
         .unwrap_or_else(|e| {
@@ -112,8 +122,7 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     if args.dmx_record.is_some() && patch.is_none() {
         return Err(format!("--dmx-record needs a patch: '{}' names none; give --dmx-out", scene.name));
     }
-    let stem = Path::new(&args.scene).file_stem().map_or("frame".into(), |s| s.to_string_lossy().into_owned());
-    let size = args.size.unwrap_or(scene.size);
+    let size = args.source.size.unwrap_or(scene.size);
     let fps = 1.0 / dt;
     // ffmpeg starts before the GPU and the seek, so a missing one or a bad codec fails at once.
     let mut sink = match &args.video {
@@ -128,7 +137,7 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
                 fps,
                 codec: args.codec.clone(),
                 quality: args.quality,
-                audio: args.audio.clone().map(|file| (file, args.start as f64 * dt)),
+                audio: args.source.audio.clone().map(|file| (file, start as f64 * dt)),
                 stream: false,
                 pace: false,
             };
@@ -140,7 +149,7 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
         }
         None => {
             std::fs::create_dir_all(&args.out).map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
-            FrameSink::Png { folder: args.out.clone(), stem }
+            FrameSink::Png { folder: args.out.clone(), stem: loaded.stem.clone(), manifest: Manifest::default() }
         }
     };
     // Sends beside the frames written. A render is faster than real time: each send paces the
@@ -152,29 +161,26 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     if let Some(name) = &args.pipewire_out {
         sends.push(Box::new(indra::offscreen::PipeWireOut::start(name, size, fps, true)?));
     }
-    let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
-    eprintln!("rendering '{}' on {}", scene.name, device.adapter_label());
-    let mut renderer =
-        OffscreenRenderer::new(device, assets, scene, args.size, args.dt, args.seed).map_err(|e| e.to_string())?;
+    let mut renderer = loaded.renderer(gpu, &args.source, "rendering")?;
     renderer.show_output(args.output)?;
-    // Replayed events apply at their own frames, also those a seek passes over.
-    for (frame, events) in script {
-        renderer.schedule(frame, events);
+    if let Some(folder) = &args.checkpoints {
+        super::bake::resume(&mut renderer, folder, start, &loaded.controls, args.accept_other_adapter)?;
     }
-    if args.start > 0 {
-        eprintln!("seeking to frame {} (every step runs; nothing before it is drawn)", args.start);
+    loaded.schedule(&mut renderer);
+    if start > renderer.next_frame() {
+        eprintln!("seeking to frame {start} (every step runs; nothing before it is drawn)");
     }
-    renderer.seek(args.start).map_err(|e| e.to_string())?;
+    renderer.seek(start).map_err(|e| e.to_string())?;
     let mut lights = match patch {
         Some(patch) => Some(super::RenderDmx::start(&patch, args.dmx_record.as_deref(), &mut renderer, dt)?),
         None => None,
     };
-    let bar = indicatif::ProgressBar::new(args.frames);
+    let bar = indicatif::ProgressBar::new(frames);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}")
             .expect("valid template"),
     );
-    for _ in 0..args.frames {
+    for _ in 0..frames {
         let frame = renderer.render_next().map_err(|e| e.to_string())?;
         sink.write(&frame)?;
         for send in &mut sends {
@@ -200,7 +206,10 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
             video.finish().map_err(|e| e.to_string())?;
             path
         }
-        FrameSink::Png { folder, .. } => folder.display().to_string(),
+        FrameSink::Png { folder, stem, manifest } => {
+            let path = manifest.write(&folder, &stem)?;
+            format!("{} (SHA-256 in {})", folder.display(), path.display())
+        }
     };
     for send in sends {
         send.close().map_err(|e| e.to_string())?;
@@ -208,14 +217,14 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     if let Some(lights) = lights {
         eprintln!("sent {} DMX packet(s)", lights.finish()?);
     }
-    eprintln!("wrote {} frame(s) to {place}", args.frames);
+    eprintln!("wrote {frames} frame(s) to {place}");
     Ok(())
 }
 
 /// Where `render` puts its frames.
 enum FrameSink {
-    /// `<folder>/<stem>_<frame>.png`.
-    Png { folder: PathBuf, stem: String },
+    /// `<folder>/<stem>_<frame>.png`, and their sums.
+    Png { folder: PathBuf, stem: String, manifest: Manifest },
     /// One video file.
     Video(VideoWriter),
 }
@@ -223,8 +232,11 @@ enum FrameSink {
 impl FrameSink {
     fn write(&mut self, frame: &RenderedFrame) -> Result<(), String> {
         match self {
-            FrameSink::Png { folder, stem } => {
-                write_png(&folder.join(format!("{stem}_{:05}.png", frame.time.frame)), frame.size, &frame.rgba)
+            FrameSink::Png { folder, stem, manifest } => {
+                let name = frame_file(stem, frame.time.frame);
+                let path = folder.join(&name);
+                write_png(&path, frame.size, &frame.rgba)?;
+                manifest.add(frame.time.frame, &name, &path)
             }
             FrameSink::Video(video) => video.write(&frame.rgba).map_err(|e| e.to_string()),
         }

@@ -114,6 +114,39 @@ impl<const N: usize> PoissonDisk<N> {
         sampler
     }
 
+    /// The run's progress — the samples, the active list and the generator's state — which
+    /// with the settings is all of it (the grid follows from the samples).
+    pub fn progress(&self) -> (&[[f64; N]], &[usize], u64) {
+        (&self.points, &self.active, self.rng.state())
+    }
+
+    /// A run resumed from [`PoissonDisk::progress`]; `None` when the parts are not a run of
+    /// `settings` (a sample outside the box, two in one cell, an active index past the samples).
+    pub fn resume(settings: PoissonSettings<N>, points: Vec<[f64; N]>, active: Vec<usize>, rng: u64) -> Option<Self> {
+        let mut sampler = Self::new(settings);
+        sampler.grid.fill(0);
+        sampler.points.clear();
+        sampler.active.clear();
+        for p in points {
+            if !(0..N).all(|d| p[d] >= 0.0 && p[d] < sampler.settings.extent[d]) {
+                return None;
+            }
+            let home = sampler.cell_of(&p);
+            let index = sampler.neighbour(&home, &[0; N])?;
+            if sampler.grid[index] != 0 {
+                return None;
+            }
+            sampler.points.push(p);
+            sampler.grid[index] = sampler.points.len() as u32;
+        }
+        if active.iter().any(|&i| i >= sampler.points.len()) {
+            return None;
+        }
+        sampler.active = active;
+        sampler.rng = SplitMix64::new(rng);
+        Some(sampler)
+    }
+
     /// Runs to completion and returns every sample.
     pub fn generate(mut self) -> Vec<[f64; N]> {
         while self.step() != Step::Done {}
@@ -258,6 +291,24 @@ pub fn min_distance<const N: usize>(points: &[[f64; N]], extent: [f64; N], perio
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_resumed_run_goes_on_as_the_run_would_have() {
+        let settings = || PoissonSettings::new([20.0, 12.0, 8.0], 1.0, 5);
+        let mut whole = PoissonDisk::new(settings());
+        for _ in 0..300 {
+            whole.step();
+        }
+        let (points, active, rng) = whole.progress();
+        let resumed = PoissonDisk::resume(settings(), points.to_vec(), active.to_vec(), rng).expect("a run");
+        assert_eq!(resumed.generate(), whole.generate());
+        let mut crowded = PoissonDisk::new(settings());
+        crowded.step();
+        let p = crowded.points()[0];
+        assert!(PoissonDisk::resume(settings(), vec![p, p], vec![0], 1).is_none(), "two samples in one cell");
+        assert!(PoissonDisk::resume(settings(), vec![[30.0, 1.0, 1.0]], vec![0], 1).is_none(), "outside the box");
+        assert!(PoissonDisk::resume(settings(), vec![p], vec![1], 1).is_none(), "an active index past the samples");
+    }
 
     fn run<const N: usize>(extent: [f64; N], radius: f64, periodic: bool) -> Vec<[f64; N]> {
         PoissonDisk::new(PoissonSettings { periodic, ..PoissonSettings::new(extent, radius, 42) }).generate()

@@ -158,6 +158,16 @@ impl PingPong {
     pub fn swap(&mut self) {
         self.current = 1 - self.current;
     }
+
+    /// Both textures, and which of them is the current state (for checkpoints).
+    pub fn sides(&self) -> (&[PersistentTexture; 2], usize) {
+        (&self.textures, self.current)
+    }
+
+    /// Makes texture `side` (0 or 1) the current state (a checkpoint's).
+    pub fn set_current(&mut self, side: usize) {
+        self.current = side.min(1);
+    }
 }
 
 #[cfg(test)]

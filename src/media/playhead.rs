@@ -56,6 +56,16 @@ impl Playhead {
         self.seconds
     }
 
+    /// The whole state — seconds into the clip and the ping-pong direction — for checkpoints.
+    pub fn parts(&self) -> [f64; 2] {
+        [self.seconds, self.bounce]
+    }
+
+    /// A playhead from [`Playhead::parts`]; `None` for parts no playhead has.
+    pub fn from_parts([seconds, bounce]: [f64; 2]) -> Option<Self> {
+        (seconds.is_finite() && bounce.is_finite()).then_some(Self { seconds, bounce })
+    }
+
     /// The in and out points in seconds.
     fn range(settings: &PlaySettings, duration: f64) -> (f64, f64) {
         let start = settings.in_point.clamp(0.0, 1.0) * duration;

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use crate::assets::Assets;
+use crate::checkpoint::{Checkpoint, CheckpointError, Header};
 use crate::dmx::PixelMap;
 use crate::gpu::DEFAULT_STALL_TIMEOUT;
 use crate::gpu::{Blit, Gpu, read_texture_rgba8};
@@ -148,6 +149,46 @@ impl OffscreenRenderer {
     /// the same bytes as when played from 0. Forward only.
     pub fn seek(&mut self, frame: u64) -> Result<(), SeekError> {
         self.player.seek(&self.gpu, &mut self.runtime, self.size, frame)
+    }
+
+    /// What a checkpoint of this render pins, at the next frame: the scene (its validated form,
+    /// edits included, but not the folder it was read from), `controls` (a hash of the
+    /// scheduled events), size, step, seed, adapter and driver.
+    pub fn checkpoint_header(&self, controls: &str) -> Header {
+        let mut scene = self.player.instance().scene().clone();
+        scene.origin.clear();
+        let info = self.gpu.adapter.get_info();
+        let now = self.player.now();
+        Header {
+            format: crate::checkpoint::FORMAT,
+            indra: env!("CARGO_PKG_VERSION").to_string(),
+            scene: scene.name.clone(),
+            scene_hash: crate::checkpoint::sha256_hex(format!("{scene:?}").as_bytes()),
+            controls_hash: crate::checkpoint::sha256_hex(controls.as_bytes()),
+            adapter: format!("{} ({:?})", info.name, info.backend),
+            driver: format!("{} {}", info.driver, info.driver_info).trim().to_string(),
+            frame: now.frame,
+            size: self.size,
+            dt_bits: now.dt.to_bits(),
+            seed: now.seed,
+        }
+    }
+
+    /// A checkpoint of the state before the next frame (waits for the GPU); `controls` as for
+    /// [`OffscreenRenderer::checkpoint_header`].
+    pub fn checkpoint(&self, controls: &str) -> Result<Checkpoint, CheckpointError> {
+        let _ = self.gpu.device.poll(wgpu::PollType::wait_indefinitely());
+        let sections = self.player.save_state(&self.gpu)?;
+        Ok(Checkpoint { header: self.checkpoint_header(controls), sections })
+    }
+
+    /// Goes on from `checkpoint` (made by a render of the same scene, checked by the caller
+    /// against [`OffscreenRenderer::checkpoint_header`]): the next frame is its frame. Only a
+    /// renderer that has drawn nothing yet may take one.
+    pub fn restore(&mut self, checkpoint: &Checkpoint) -> Result<(), CheckpointError> {
+        self.player.load_state(&self.gpu, checkpoint)?;
+        let _ = self.gpu.device.poll(wgpu::PollType::wait_indefinitely());
+        Ok(())
     }
 
     /// Schedules control events to apply just before frame `frame` steps (a replayed control

@@ -98,7 +98,7 @@ impl Lfo {
 }
 
 /// The show's tempo and beat position, advanced on the fixed clock.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TempoClock {
     /// Beats per minute.
     pub bpm: f64,

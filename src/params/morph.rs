@@ -5,7 +5,7 @@ use super::ParamValue;
 use super::track::mix;
 
 /// A morph from the values a recall found to the preset's values.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Morph {
     /// (node, param, from, to).
     pub entries: Vec<(usize, usize, ParamValue, ParamValue)>,

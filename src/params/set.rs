@@ -38,6 +38,29 @@ impl ParamSet {
         self.targets[i]
     }
 
+    /// Every parameter's target and smoothed value, in declaration order (for checkpoints).
+    pub fn parts(&self) -> (&[ParamValue], &[ParamValue]) {
+        (&self.targets, &self.values)
+    }
+
+    /// Puts back targets and smoothed values from [`ParamSet::parts`]; refused (false, nothing
+    /// changed) unless there is one of each per parameter, of its type and finite.
+    pub fn set_parts(&mut self, targets: &[ParamValue], values: &[ParamValue]) -> bool {
+        let n = self.decls.len();
+        let fits = |v: &[ParamValue]| {
+            v.len() == n
+                && v.iter()
+                    .zip(&self.decls)
+                    .all(|(v, d)| v.ty() == d.ty() && v.components().iter().all(|c| c.is_finite()))
+        };
+        if !fits(targets) || !fits(values) {
+            return false;
+        }
+        self.targets = targets.to_vec();
+        self.values = values.to_vec();
+        true
+    }
+
     /// Sets parameter `i`'s target, converting to its type and clamping to its range. Without
     /// smoothing (or for discrete types) the value follows at once. A value with a NaN or
     /// infinite component is refused (the parameter keeps its value; returns false): every

@@ -97,7 +97,7 @@ impl fmt::Display for ParamType {
 }
 
 /// A parameter value.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum ParamValue {
     /// See [`ParamType::Float`].
     Float(f32),

@@ -193,7 +193,7 @@ mod tests {
         let big = scene(100, "(3840, 2160)", 1);
         assert!(parse_scene_with(&at((1920, 1080)), "big.ron", &big).is_ok(), "4K in the file, rendered at 1080p");
         let small = scene(100, "(1920, 1080)", 1);
-        let e = parse_scene_with(&at((3840, 2160)), "big.ron", &small).err().expect("refused").to_string();
+        let e = parse_scene_with(&at((3840, 2160)), "big.ron", &small).expect_err("refused").to_string();
         assert!(e.contains("at 3840x2160") && e.contains("12.4 GiB"), "{e}");
     }
 
@@ -214,7 +214,7 @@ mod tests {
         assert_eq!(wall.texture_bytes((3840, 2160)), drawn as u64 * pixels * 16 + 2 * pixels * 48);
         // With every clip running while hidden, all of them draw: refused, naming the clips.
         let continuing = show.replace(r#"id: "c"#, r#"policy: Continue, id: "c"#);
-        let e = crate::scene::show::parse_show(&assets, "wall.ron", &continuing, false).err().expect("refused");
+        let e = crate::scene::show::parse_show(&assets, "wall.ron", &continuing, false).expect_err("refused");
         let e = e.to_string();
         assert!(e.contains("what can be on screen at once") && e.contains("c7_7"), "{e}");
     }

@@ -23,7 +23,7 @@ pub const MAX_NODES: usize = 256;
 pub const MAX_TEXTURE_BYTES: u64 = 8 << 30;
 
 /// A validated scene: every name resolved, every value typed.
-#[derive(Clone)]
+#[derive(Clone, Debug)]
 pub struct Scene {
     /// Where it was loaded from.
     pub origin: String,
@@ -175,7 +175,14 @@ pub struct BoundTrack {
 
 impl std::fmt::Debug for SceneNode {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("SceneNode").field("id", &self.id).field("technique", &self.technique.name).finish()
+        f.debug_struct("SceneNode")
+            .field("id", &self.id)
+            .field("technique", &self.technique.name)
+            .field("params", &self.params)
+            .field("inputs", &self.inputs)
+            .field("slots", &self.slots)
+            .field("hears_audio", &self.hears_audio)
+            .finish()
     }
 }
 

@@ -10,6 +10,7 @@
 use std::collections::BTreeMap;
 
 use super::instance::SceneInstance;
+use crate::checkpoint::{Checkpoint, CheckpointError};
 use crate::gpu::Gpu;
 use crate::graph::{FrameGraph, FrameOutput, GraphError, GraphRuntime};
 use crate::params::{ControlEvent, Remap};
@@ -126,6 +127,26 @@ impl Player {
                 let _ = gpu.device.poll(wgpu::PollType::wait_indefinitely());
             }
         }
+        Ok(())
+    }
+
+    /// The checkpoint sections of the state before the next step (see
+    /// [`SceneInstance::save_state`]); the GPU must be idle.
+    pub fn save_state(&self, gpu: &Gpu) -> Result<Vec<(String, Vec<u8>)>, CheckpointError> {
+        self.instance.save_state(gpu)
+    }
+
+    /// Takes the state of `checkpoint`, made before step `checkpoint.header.frame`, into this
+    /// player (just made for the same scene): the next step is that frame. Scheduled events
+    /// before it are dropped: the checkpoint holds what they did.
+    pub fn load_state(&mut self, gpu: &Gpu, checkpoint: &Checkpoint) -> Result<(), CheckpointError> {
+        let frame = checkpoint.header.frame;
+        self.clock.seek(frame.saturating_sub(1));
+        let last = self.clock.now();
+        self.clock.seek(frame);
+        self.instance.load_state(gpu, checkpoint, &last)?;
+        self.last = last;
+        self.script = self.script.split_off(&frame);
         Ok(())
     }
 

@@ -26,6 +26,7 @@ pub mod picture_pass;
 pub mod poisson;
 pub mod polygon_draw;
 pub mod runner;
+pub mod saved;
 pub mod space_colonization;
 pub mod splat_draw;
 pub mod star_glow;
@@ -37,6 +38,7 @@ pub mod warp;
 pub mod wgsl_effect;
 
 use crate::assets::{AssetKind, Assets};
+use crate::checkpoint::{CheckpointError, NodeState};
 use crate::gpu::{Gpu, ShaderError};
 use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{AudioSnapshot, ParamDecl, ParamSet, ParamValue};
@@ -283,6 +285,26 @@ pub trait Technique: Send {
     /// Things to tell the performer since the last call (e.g. "the cloth blew up and was reset").
     fn take_messages(&mut self) -> Vec<String> {
         Vec::new()
+    }
+
+    /// Writes what survives a frame — GPU buffers and textures read back, CPU simulation state —
+    /// into `state`, for a checkpoint. Called between frames with every step recorded and the GPU
+    /// idle. The default saves nothing: the node is a function of its parameters and the time.
+    fn save_state(&self, _gpu: &Gpu, _state: &mut NodeState) -> Result<(), CheckpointError> {
+        Ok(())
+    }
+
+    /// Puts back what [`Technique::save_state`] wrote, into a node just created for the same
+    /// scene; `params` and `time` are the checkpoint's (its last step), so a node sized by its
+    /// parameters is first brought to that size.
+    fn load_state(
+        &mut self,
+        _gpu: &Gpu,
+        _params: &ParamSet,
+        _time: &FrameTime,
+        _state: &NodeState,
+    ) -> Result<(), CheckpointError> {
+        Ok(())
     }
 
     /// Adds this frame's passes; returns the texture downstream nodes (or the output) see.

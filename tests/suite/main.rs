@@ -6,6 +6,7 @@
 mod architecture;
 mod audio;
 mod browser;
+mod checkpoints;
 #[path = "../support/chromium.rs"]
 mod chromium;
 #[path = "../common/mod.rs"]
@@ -14,6 +15,7 @@ mod control;
 mod controllers;
 mod effects;
 mod errors;
+mod farm;
 mod file_imports;
 mod flood;
 mod gl_transitions;
@@ -33,6 +35,8 @@ mod pipewire;
 mod recovery;
 mod seek;
 mod show;
+#[cfg(target_os = "linux")]
+mod slurm;
 mod triangulate;
 mod video;
 mod window;

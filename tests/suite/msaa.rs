@@ -77,7 +77,7 @@ fn four_samples_come_close_to_supersampling_and_one_does_not() {
 fn a_sample_count_other_than_1_2_4_or_8_is_a_located_error() {
     let ron = r#"(name: "m", size: (32, 32), msaa: 3,
         nodes: [(id: "k", technique: "kleinian")], output: "k")"#;
-    let e = indra::scene::parse_scene("m.ron", ron).err().expect("msaa 3 is refused").to_string();
+    let e = indra::scene::parse_scene("m.ron", ron).expect_err("msaa 3 is refused").to_string();
     assert!(e.contains("msaa") && e.contains("1, 2, 4 or 8"), "{e}");
     let ok = indra::scene::parse_scene("m.ron", &ron.replace("msaa: 3", "msaa: 8")).unwrap();
     assert_eq!(ok.msaa, 8);

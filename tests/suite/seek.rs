@@ -18,7 +18,7 @@ const N: u64 = 12;
 
 /// Scenes too slow on lavapipe at their own settings run with these overrides instead, with the
 /// reason; none is skipped. Keep it short.
-const CI_SETTINGS: &[(&str, &[&str], &str)] = &[
+pub(crate) const CI_SETTINGS: &[(&str, &[&str], &str)] = &[
     (
         "cloth_1024.ron",
         &["cloth.resolution=64", "cloth.rest_length=0.08", "cloth.mass=0.256"],

@@ -377,8 +377,7 @@ fn a_broken_clip_is_left_out_and_the_rest_plays() {
     let text =
         TWO_COLOURS.replace(r#"(scene: "kleinian_classic", id: "blue""#, r#"(scene: "no_such_scene", id: "blue""#);
     // `check` and renders refuse it, located at the clip.
-    let e =
-        parse_show(&assets(), "test-show.ron", &text, false).err().expect("a missing scene is an error").to_string();
+    let e = parse_show(&assets(), "test-show.ron", &text, false).expect_err("a missing scene is an error").to_string();
     assert!(e.contains("test-show.ron:8:") && e.contains("clip 'blue'") && e.contains("no_such_scene"), "{e}");
     // A running show leaves it out, says so, and plays the rest.
     let scene = parse_show(&assets(), "test-show.ron", &text, true).unwrap();

@@ -8,6 +8,7 @@
 //! until `resume_tracks`, so a performer's fader is never yanked back by automation.
 
 mod chain;
+mod checkpoint;
 mod rebuild;
 
 use std::collections::BTreeSet;

@@ -124,7 +124,7 @@ pub struct Clip {
 }
 
 /// A transition, resolved.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Transition {
     /// Index into [`Show::kinds`]; `None`: a cut.
     pub kind: Option<usize>,
@@ -135,7 +135,7 @@ pub struct Transition {
 }
 
 /// A length on the fixed clock or the tempo.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Length {
     /// Seconds.
     Seconds(f64),

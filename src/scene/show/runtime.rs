@@ -141,6 +141,17 @@ impl ShowRuntime {
         }
     }
 
+    /// Takes the play state of a checkpoint: the clips on screen ran, so they are not fresh
+    /// (their nodes get the checkpoint's state); hidden restart clips stay fresh copies.
+    pub fn restore_state(&mut self, state: ShowState) {
+        self.state = state;
+        for c in 0..self.plan.clips.len() {
+            if self.state.visible(c) || self.plan.clips[c].policy != ClipPolicy::Restart {
+                self.spares.mark_stale(c);
+            }
+        }
+    }
+
     /// Takes transitions rebuilt with `assets` (a shader edit) in place of the old ones.
     pub fn install_mixer(&mut self, mixer: Mixer, assets: &Assets) {
         self.mixer = mixer;

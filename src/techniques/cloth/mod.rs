@@ -17,7 +17,8 @@ pub use params::{ClothUniforms, Pin, Settings, Solver, View, rest_pose, sphere_c
 use render::{ClothView, Renderer};
 use state::State;
 
-use crate::gpu::{ComputeKernel, ShaderError};
+use crate::checkpoint::{CheckpointError, NodeState};
+use crate::gpu::{ComputeKernel, Gpu, ShaderError};
 use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
 use crate::params::ParamSet;
 use crate::time::{FrameTime, MAX_CATCH_UP_STEPS};
@@ -167,6 +168,21 @@ impl Technique for Cloth {
 
     fn take_messages(&mut self) -> Vec<String> {
         std::mem::take(&mut self.messages)
+    }
+
+    fn save_state(&self, gpu: &Gpu, state: &mut NodeState) -> Result<(), CheckpointError> {
+        self.state.save(gpu, state)
+    }
+
+    fn load_state(
+        &mut self,
+        gpu: &Gpu,
+        params: &ParamSet,
+        _time: &FrameTime,
+        state: &NodeState,
+    ) -> Result<(), CheckpointError> {
+        self.ensure_state(&Settings::read(params));
+        self.state.load(gpu, state)
     }
 
     fn add_passes<'r>(

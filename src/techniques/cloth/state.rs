@@ -6,8 +6,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 
 use super::ClothUniforms;
-use crate::gpu::BindGroupCache;
+use crate::checkpoint::{CheckpointError, NodeState};
+use crate::gpu::{BindGroupCache, Gpu};
 use crate::graph::{BufferHandle, FrameGraph};
+use crate::techniques::saved::{load_buffer, save_buffer};
 
 /// (uniform slot, previous, current, next): which buffers a simulation dispatch binds.
 pub type Key = (usize, usize, usize, usize);
@@ -171,6 +173,30 @@ impl State {
         let flat: Vec<[f32; 4]> = vec![[0.0, 0.0, 1.0, 0.0]; pose.len()];
         queue.write_buffer(&self.normals, 0, bytemuck::cast_slice(&flat));
         queue.write_buffer(&self.status, 0, &[0; 4]);
+    }
+
+    /// Saves the particles (all three buffers and their roles), the normals and the NaN flag.
+    pub fn save(&self, gpu: &Gpu, state: &mut NodeState) -> Result<(), CheckpointError> {
+        state.put_pod("roles", &[self.prev as u32, self.cur as u32]);
+        for (i, buffer) in self.particles.iter().enumerate() {
+            save_buffer(gpu, state, &format!("particles{i}"), buffer)?;
+        }
+        save_buffer(gpu, state, "normals", &self.normals)?;
+        save_buffer(gpu, state, "status", &self.status)
+    }
+
+    /// Puts back what [`State::save`] wrote, into buffers of the same resolution.
+    pub fn load(&mut self, gpu: &Gpu, state: &NodeState) -> Result<(), CheckpointError> {
+        let roles = state.get_pod::<u32>("roles")?;
+        match roles[..] {
+            [prev, cur] if prev != cur && prev < 3 && cur < 3 => (self.prev, self.cur) = (prev as usize, cur as usize),
+            _ => return Err(state.error("roles", format!("{roles:?} are not two of the three buffers"))),
+        }
+        for (i, buffer) in self.particles.iter().enumerate() {
+            load_buffer(gpu, state, &format!("particles{i}"), buffer)?;
+        }
+        load_buffer(gpu, state, "normals", &self.normals)?;
+        load_buffer(gpu, state, "status", &self.status)
     }
 
     /// The lowest buffer index not among `used`.

@@ -21,11 +21,13 @@ pub use plan::{Field, FluidDispatch, Kernel, Planned, step_dispatches};
 
 use std::cell::RefCell;
 
-use crate::gpu::{BindGroupCache, ComputeKernel, ShaderError};
+use crate::checkpoint::{CheckpointError, NodeState};
+use crate::gpu::{BindGroupCache, ComputeKernel, Gpu, ShaderError};
 use crate::graph::{Extent, FrameGraph, TextureDesc, TextureHandle};
 use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 
+use super::saved::{load_buffer, save_buffer};
 use super::{NodeSetup, Technique, TechniqueInfo};
 
 /// The registry entry.
@@ -219,6 +221,28 @@ fn uniform_blocks(device: &wgpu::Device, blocks: u64) -> wgpu::Buffer {
 impl Technique for GridFluid {
     fn simulates_on_gpu(&self) -> bool {
         true
+    }
+
+    fn save_state(&self, gpu: &Gpu, state: &mut NodeState) -> Result<(), CheckpointError> {
+        // The cursor of the last step: a drag that goes on past the checkpoint moves from it.
+        let cursor = self.last_cursor.map_or([f32::NAN; 2], |c| c);
+        state.put_pod("last_cursor", &cursor);
+        save_buffer(gpu, state, "fields", &self.fields.0)
+    }
+
+    fn load_state(
+        &mut self,
+        gpu: &Gpu,
+        params: &ParamSet,
+        _time: &FrameTime,
+        state: &NodeState,
+    ) -> Result<(), CheckpointError> {
+        self.ensure_fields(&Settings::read(params));
+        self.last_cursor = match state.get_pod::<f32>("last_cursor")?[..] {
+            [x, y] if x.is_finite() && y.is_finite() => Some([x, y]),
+            _ => None,
+        };
+        load_buffer(gpu, state, "fields", &self.fields.0)
     }
 
     fn step(&mut self, params: &ParamSet, time: &FrameTime) {

@@ -4,6 +4,8 @@
 
 use std::collections::BTreeMap;
 
+mod saved;
+
 use super::compile::Compiled;
 use super::header::InputKind;
 use super::pipeline::{FormatKey, OUTPUT_FORMAT, Pipeline, Pipelines, build_pipelines};
@@ -11,7 +13,8 @@ use super::program::{FIRST_TEXTURE_BINDING, SAMPLER_BINDING, TextureSource, UNIF
 use super::sound::{AUDIO_WIDTH, AudioTexture};
 use super::targets::{BYTE_FORMAT, FLOAT_FORMAT};
 use super::{IsfFiles, Settings};
-use crate::gpu::{BindGroupCache, DEFAULT_MAX_AGE, ShaderError};
+use crate::checkpoint::{CheckpointError, NodeState};
+use crate::gpu::{BindGroupCache, DEFAULT_MAX_AGE, Gpu, ShaderError};
 use crate::graph::{Extent, FrameGraph, PersistentTexture, PingPong, TextureDesc, TextureHandle};
 use crate::params::{AudioSnapshot, ParamSet, ParamValue};
 use crate::techniques::image_pass::{self, ImageKernel, ImagePass};
@@ -322,6 +325,14 @@ impl Technique for IsfNode {
 
     fn take_messages(&mut self) -> Vec<String> {
         std::mem::take(&mut self.messages)
+    }
+
+    fn save_state(&self, gpu: &Gpu, state: &mut NodeState) -> Result<(), CheckpointError> {
+        saved::save(self, gpu, state)
+    }
+
+    fn load_state(&mut self, gpu: &Gpu, _: &ParamSet, _: &FrameTime, state: &NodeState) -> Result<(), CheckpointError> {
+        saved::load(self, gpu, state)
     }
 
     fn status(&self) -> Option<String> {

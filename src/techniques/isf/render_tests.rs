@@ -492,6 +492,6 @@ fn a_nodes_targets_are_bounded_together_and_counted_in_the_scene_budget() {
     let few = parse_scene_with(&assets, "few.ron", &ron(2)).unwrap_or_else(|e| panic!("{e}"));
     // Per node: the target twice and the output pass (8-bit, at the scene's 64×64).
     assert_eq!(few.own_texture_bytes, 2 * (8192 * 4096 * 8 * 2 + 64 * 64 * 4));
-    let e = parse_scene_with(&assets, "many.ron", &ron(17)).err().expect("over the budget").to_string();
+    let e = parse_scene_with(&assets, "many.ron", &ron(17)).expect_err("over the budget").to_string();
     assert!(e.contains("GiB of textures"), "{e}");
 }

@@ -7,12 +7,16 @@
 //! (the same discs drawn in compute through `shaders/splat_draw.wgsl`),
 //! `shaders/msaa_samples.wgsl`.
 
-use crate::geometry::poisson::{PoissonDisk, PoissonSettings, Step};
-use crate::gpu::ShaderError;
+use crate::checkpoint::{CheckpointError, NodeState};
+use crate::gpu::{Gpu, ShaderError};
 use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
 use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
 use std::cell::RefCell;
+
+mod sampler;
+
+use sampler::Sampler;
 
 use super::splat_draw::{self, SplatDraw, SplatUniforms};
 use super::{NodeSetup, Rasterizer, Technique, TechniqueInfo};
@@ -182,60 +186,6 @@ fn check_settings(params: &ParamSet) -> Result<(), String> {
     ))
 }
 
-enum Sampler {
-    Flat(PoissonDisk<2>),
-    Volume(PoissonDisk<3>),
-}
-
-impl Sampler {
-    fn new(key: &RunKey) -> Self {
-        fn settings<const N: usize>(key: &RunKey, extent: [f64; N]) -> PoissonSettings<N> {
-            let mut s = PoissonSettings::new(extent, f64::from(key.radius), key.seed as u64);
-            s.attempts = key.attempts.max(1) as u32;
-            s
-        }
-        let [x, y, z] = key.extent.map(f64::from);
-        if key.three_d {
-            Sampler::Volume(PoissonDisk::new(settings(key, [x, y, z])))
-        } else {
-            Sampler::Flat(PoissonDisk::new(settings(key, [x, y])))
-        }
-    }
-
-    /// One sampler step; false when the run is complete.
-    fn step(&mut self) -> bool {
-        match self {
-            Sampler::Flat(s) => !matches!(s.step(), Step::Done),
-            Sampler::Volume(s) => !matches!(s.step(), Step::Done),
-        }
-    }
-
-    /// Sample positions from `from` on, centred on the origin, as (x, y, z, insertion index).
-    fn instances_from(&self, from: usize, key: &RunKey, out: &mut Vec<[f32; 4]>) {
-        fn centred<const N: usize>(points: &[[f64; N]], from: usize, half: [f32; 3], out: &mut Vec<[f32; 4]>) {
-            out.extend(points[from..].iter().enumerate().map(|(i, p)| {
-                let mut v = [0.0, 0.0, 0.0, (from + i) as f32];
-                for k in 0..N {
-                    v[k] = p[k] as f32 - half[k];
-                }
-                v
-            }));
-        }
-        let half = key.extent.map(|e| e / 2.0);
-        match self {
-            Sampler::Flat(s) => centred(s.points(), from, half, out),
-            Sampler::Volume(s) => centred(s.points(), from, half, out),
-        }
-    }
-
-    fn len(&self) -> usize {
-        match self {
-            Sampler::Flat(s) => s.points().len(),
-            Sampler::Volume(s) => s.points().len(),
-        }
-    }
-}
-
 /// A Poisson disk node.
 pub struct Poisson {
     pipeline: wgpu::RenderPipeline,
@@ -352,6 +302,32 @@ impl Technique for Poisson {
 
     fn take_messages(&mut self) -> Vec<String> {
         std::mem::take(&mut self.messages)
+    }
+
+    fn save_state(&self, _gpu: &Gpu, state: &mut NodeState) -> Result<(), CheckpointError> {
+        let (points, active, rng) = self.sampler.progress();
+        state.put_pod("points", &points);
+        state.put_pod("active", &active);
+        state.put_u64("rng", rng);
+        state.put_u64("next_frame", self.next_frame);
+        Ok(())
+    }
+
+    fn load_state(
+        &mut self,
+        _gpu: &Gpu,
+        params: &ParamSet,
+        time: &FrameTime,
+        state: &NodeState,
+    ) -> Result<(), CheckpointError> {
+        self.sync(&Settings::read(params), time);
+        let (points, active) = (state.get_pod::<f64>("points")?, state.get_pod::<u64>("active")?);
+        self.sampler = Sampler::resume(&self.fitted, &points, active, state.get_u64("rng")?)
+            .ok_or_else(|| state.error("points", "are not a run of this node's settings".into()))?;
+        self.next_frame = state.get_u64("next_frame")?;
+        self.uploaded = 0;
+        self.pending.clear();
+        Ok(())
     }
 
     fn add_passes<'r>(

@@ -10,8 +10,9 @@
 //! Shader: `polygon_draw.wgsl`.
 
 use super::mesh2d_draw::{self as gpu, DrawStyle};
+use crate::checkpoint::{CheckpointError, NodeState};
 use crate::geometry::triangulate::{Mesh2D, Triangulator};
-use crate::gpu::ShaderError;
+use crate::gpu::{Gpu, ShaderError};
 use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{InputRole, ParamDecl, ParamSet, ParamValue};
 use crate::time::FrameTime;
@@ -192,6 +193,30 @@ impl Technique for PolygonDraw {
 
     fn take_messages(&mut self) -> Vec<String> {
         std::mem::take(&mut self.messages)
+    }
+
+    fn save_state(&self, _gpu: &Gpu, state: &mut NodeState) -> Result<(), CheckpointError> {
+        // Drawn polygons and the one being drawn: each is one ring, the rings in order.
+        let rings: Vec<&Vec<[f64; 2]>> = self.polygons.iter().chain([&self.drawing]).collect();
+        state.put_pod("ring_lengths", &rings.iter().map(|r| r.len() as u64).collect::<Vec<_>>());
+        state.put_pod("points", &rings.iter().flat_map(|r| r.iter().copied()).collect::<Vec<_>>());
+        state.put_u64("started", self.started.map_or(u64::MAX, u64::from));
+        Ok(())
+    }
+
+    fn load_state(&mut self, _: &Gpu, _: &ParamSet, _: &FrameTime, state: &NodeState) -> Result<(), CheckpointError> {
+        let lengths = state.get_pod::<u64>("ring_lengths")?;
+        let mut points = state.get_pod::<[f64; 2]>("points")?.into_iter();
+        if lengths.is_empty() || lengths.iter().sum::<u64>() != points.len() as u64 {
+            return Err(state.error("ring_lengths", "do not add up to the points saved".into()));
+        }
+        let mut rings: Vec<Vec<[f64; 2]>> =
+            lengths.iter().map(|&n| points.by_ref().take(n as usize).collect()).collect();
+        self.drawing = rings.pop().unwrap_or_default();
+        self.polygons = rings;
+        self.started = u32::try_from(state.get_u64("started")?).ok();
+        self.retriangulate();
+        Ok(())
     }
 
     fn add_passes<'r>(

@@ -3,9 +3,11 @@
 //! of dispatches a frame records — so that `add_passes` only replays it.
 
 use super::cloud::{Attraction, Cloud, Node};
-use super::params::{GridLayout, GrowthUniforms, PoseUniforms};
-use crate::gpu::{ComputeKernel, PrefixSum, ScanTarget, ShaderError, storage_entry, uniform_entry};
+use super::params::{GridLayout, GrowthUniforms, MAX_CELLS, PoseUniforms};
+use crate::checkpoint::{CheckpointError, NodeState};
+use crate::gpu::{ComputeKernel, Gpu, PrefixSum, ScanTarget, ShaderError, storage_entry, uniform_entry};
 use crate::techniques::NodeSetup;
+use crate::techniques::saved::{load_buffer, save_buffer};
 
 /// Bytes between uniform blocks (wgpu's minimum uniform offset alignment).
 pub const BLOCK: u64 = 256;
@@ -365,17 +367,80 @@ impl GrowthState {
         ops
     }
 
+    /// Saves every buffer a step reads before it writes (the grid of the last step included,
+    /// which the next step's branch search reuses) and the layout the grid was built for.
+    pub fn save(&self, gpu: &Gpu, state: &mut NodeState) -> Result<(), CheckpointError> {
+        for (name, buffer) in self.buffers() {
+            save_buffer(gpu, state, name, buffer)?;
+        }
+        state.put_u64("cells", u64::from(self.cells.as_ref().map_or(0, |c| c.0)));
+        if let Some((_, start, fill, _)) = &self.cells {
+            save_buffer(gpu, state, "cell_start", start)?;
+            save_buffer(gpu, state, "cell_fill", fill)?;
+        }
+        let grid = self.grid_for.map(|g| [g.origin[0], g.origin[1], g.origin[2], g.cell_size].map(f32::to_bits));
+        let grid: Vec<u32> = grid.into_iter().flatten().chain(self.grid_for.into_iter().flat_map(|g| g.dims)).collect();
+        state.put_pod("grid_for", &grid);
+        Ok(())
+    }
+
+    /// Puts back what [`GrowthState::save`] wrote, into the state of the same cloud.
+    pub fn load(&mut self, gpu: &Gpu, kernels: &Kernels, state: &NodeState) -> Result<(), CheckpointError> {
+        for (name, buffer) in self.buffers() {
+            load_buffer(gpu, state, name, buffer)?;
+        }
+        let cells = u32::try_from(state.get_u64("cells")?).unwrap_or(u32::MAX);
+        if cells > 0 {
+            if !cells.is_power_of_two() || cells > MAX_CELLS.next_power_of_two() {
+                return Err(state.error("cells", format!("{cells} cells is not a grid this node makes")));
+            }
+            self.make_cells(&gpu.device, kernels, cells);
+            let (_, start, fill, _) = self.cells.as_ref().expect("made above");
+            load_buffer(gpu, state, "cell_start", start)?;
+            load_buffer(gpu, state, "cell_fill", fill)?;
+        }
+        self.grid_for = match state.get_pod::<u32>("grid_for")?[..] {
+            [] => None,
+            [x, y, z, side, dx, dy, dz] => Some(GridLayout {
+                origin: [x, y, z].map(f32::from_bits),
+                cell_size: f32::from_bits(side),
+                dims: [dx, dy, dz],
+            }),
+            _ => return Err(state.error("grid_for", "is not a grid layout".into())),
+        };
+        Ok(())
+    }
+
+    /// The buffers of one cloud that a step reads before it writes, by name.
+    fn buffers(&self) -> [(&'static str, &wgpu::Buffer); 9] {
+        [
+            ("attractions", &self.attractions.buffer),
+            ("nodes", &self.nodes.buffer),
+            ("posed", &self.posed.buffer),
+            ("args", &self.args.buffer),
+            ("counters", &self.counters),
+            ("accum", &self.accum),
+            ("flags", &self.flags),
+            ("candidates", &self.candidates),
+            ("sorted", &self.sorted),
+        ]
+    }
+
+    /// Cell buffers for `n` cells (a power of two); the growth group is made again.
+    fn make_cells(&mut self, device: &wgpu::Device, kernels: &Kernels, n: u32) {
+        let none = wgpu::BufferUsages::empty();
+        let start = buffer(device, "sc_cell_start", u64::from(n + 1) * 4, none);
+        let fill = buffer(device, "sc_cell_fill", u64::from(n) * 4, none);
+        let scan = kernels.scan.target(device, &start, n);
+        self.cells = Some((n, start, fill, scan));
+        self.growth_group = None;
+        self.grid_for = None;
+    }
+
     /// Makes sure the cell buffers hold `cells` and the growth group binds `uniforms`.
     pub fn prepare(&mut self, device: &wgpu::Device, kernels: &Kernels, uniforms: &wgpu::Buffer, cells: u32) {
         if self.cells.as_ref().is_none_or(|c| c.0 < cells) {
-            let n = cells.next_power_of_two().max(64);
-            let none = wgpu::BufferUsages::empty();
-            let start = buffer(device, "sc_cell_start", u64::from(n + 1) * 4, none);
-            let fill = buffer(device, "sc_cell_fill", u64::from(n) * 4, none);
-            let scan = kernels.scan.target(device, &start, n);
-            self.cells = Some((n, start, fill, scan));
-            self.growth_group = None;
-            self.grid_for = None;
+            self.make_cells(device, kernels, cells.next_power_of_two().max(64));
         }
         let uniform_id = uniforms.size();
         if self.growth_group.as_ref().is_some_and(|g| g.0 == uniform_id) {

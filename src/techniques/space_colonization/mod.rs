@@ -52,8 +52,9 @@ use std::sync::Arc;
 use growth::{BLOCK, GrowthState, Kernels};
 use render::{Extras, Renderer, Style};
 
+use crate::checkpoint::{CheckpointError, NodeState};
 use crate::geometry::skinned::SkinnedMesh;
-use crate::gpu::ShaderError;
+use crate::gpu::{Gpu, ShaderError};
 use crate::graph::{FrameGraph, TextureDesc, TextureHandle};
 use crate::params::ParamSet;
 use crate::time::FrameTime;
@@ -399,6 +400,24 @@ impl Technique for SpaceColonization {
 
     fn take_messages(&mut self) -> Vec<String> {
         std::mem::take(&mut self.messages)
+    }
+
+    fn save_state(&self, gpu: &Gpu, state: &mut NodeState) -> Result<(), CheckpointError> {
+        // Growth runs every `update_every` frames counted from the last reset.
+        state.put_u64("frames_since_reset", self.frames_since_reset);
+        self.state.save(gpu, state)
+    }
+
+    fn load_state(
+        &mut self,
+        gpu: &Gpu,
+        params: &ParamSet,
+        time: &FrameTime,
+        state: &NodeState,
+    ) -> Result<(), CheckpointError> {
+        self.ensure_state(&Settings::read(params), time.seed);
+        self.frames_since_reset = state.get_u64("frames_since_reset")?;
+        self.state.load(gpu, &self.kernels, state)
     }
 
     fn bench_report(&mut self) -> Vec<String> {

@@ -20,8 +20,9 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use crate::assets::Assets;
+use crate::checkpoint::{CheckpointError, NodeState};
 use crate::files::{LoadWait, Loader};
-use crate::gpu::ShaderError;
+use crate::gpu::{Gpu, ShaderError};
 use crate::graph::{FrameGraph, TextureHandle};
 use crate::media::clip::Clip;
 use crate::media::picture::Picture;
@@ -217,6 +218,27 @@ impl Video {
         self.last_error = None;
     }
 
+    /// Asks for the clip the settings name if it changed, and starts one that has been opened
+    /// (true then).
+    fn take_up_clip(&mut self, settings: &Settings) -> bool {
+        let key = ClipKey::of(settings);
+        if key != self.requested {
+            let (assets, wanted) = (self.assets.clone(), key.clone());
+            let max_side = self.device.limits().max_texture_dimension_2d;
+            self.loader.request(&key.name, move || wanted.open(&assets, max_side));
+            self.requested = key;
+        }
+        match self.loader.poll() {
+            Some((_, Ok(clip))) => {
+                self.start(clip, settings);
+                return true;
+            }
+            Some((_, Err(e))) => self.messages.push(format!("{e}; keeping the last clip")),
+            None => {}
+        }
+        false
+    }
+
     /// Live frames whose decode was not ready in time.
     pub fn late_frames(&self) -> u64 {
         self.late
@@ -267,22 +289,7 @@ impl Video {
 impl Technique for Video {
     fn step(&mut self, params: &ParamSet, time: &FrameTime) {
         let settings = Settings::read(params);
-        let key = ClipKey::of(&settings);
-        if key != self.requested {
-            let (assets, wanted) = (self.assets.clone(), key.clone());
-            let max_side = self.device.limits().max_texture_dimension_2d;
-            self.loader.request(&key.name, move || wanted.open(&assets, max_side));
-            self.requested = key;
-        }
-        let mut started = false;
-        match self.loader.poll() {
-            Some((_, Ok(clip))) => {
-                self.start(clip, &settings);
-                started = true;
-            }
-            Some((_, Err(e))) => self.messages.push(format!("{e}; keeping the last clip")),
-            None => {}
-        }
+        let started = self.take_up_clip(&settings);
         // A clip taken up in this step shows its first frame now.
         let steps = match self.stepped {
             Some(last) if time.frame > last && !started => (time.frame - last).min(MAX_STEPS_AT_ONCE),
@@ -316,6 +323,36 @@ impl Technique for Video {
 
     fn take_messages(&mut self) -> Vec<String> {
         std::mem::take(&mut self.messages)
+    }
+
+    fn save_state(&self, _gpu: &Gpu, state: &mut NodeState) -> Result<(), CheckpointError> {
+        // The playhead moves by steps (speed, ping-pong, loops): its position is state.
+        let head = self.clip.as_ref().map_or([f64::NAN; 2], |p| p.head.parts());
+        state.put_pod("head", &head);
+        state.put_u64("stepped", self.stepped.map_or(u64::MAX, |f| f));
+        state.put_pod("scrubbed", &[self.scrubbed]);
+        Ok(())
+    }
+
+    fn load_state(
+        &mut self,
+        _gpu: &Gpu,
+        params: &ParamSet,
+        _time: &FrameTime,
+        state: &NodeState,
+    ) -> Result<(), CheckpointError> {
+        // The clip is opened now (an off-screen render waits for it), so the first step goes on
+        // from the checkpoint's playhead instead of starting the clip again.
+        self.take_up_clip(&Settings::read(params));
+        let head = state.get_pod::<f64>("head")?;
+        if let (Some(playing), &[seconds, bounce]) = (&mut self.clip, &head[..]) {
+            playing.head = Playhead::from_parts([seconds, bounce])
+                .ok_or_else(|| state.error("head", "is not a playhead (the clip had not opened)".into()))?;
+        }
+        let stepped = state.get_u64("stepped")?;
+        self.stepped = (stepped != u64::MAX).then_some(stepped);
+        self.scrubbed = state.get_pod::<f32>("scrubbed")?.first().copied().unwrap_or(0.0);
+        Ok(())
     }
 
     fn bench_report(&mut self) -> Vec<String> {

@@ -11,9 +11,10 @@
 use std::path::PathBuf;
 
 use crate::assets::Assets;
+use crate::checkpoint::{CheckpointError, NodeState};
 use crate::files::Loader;
 use crate::geometry::warp::{Corners, EdgeBlend, Homography, MAX_MESH_SIDE, MeshWarp, Region, WarpFile};
-use crate::gpu::ShaderError;
+use crate::gpu::{Gpu, ShaderError};
 use crate::graph::{FrameGraph, TextureHandle};
 use crate::params::{ParamDecl, ParamSet, ParamValue, Text};
 use crate::time::FrameTime;
@@ -272,6 +273,9 @@ impl Warp {
     }
 }
 
+/// A warp node's checkpoint: its mesh, the size and point edits last applied, the file last read.
+type Saved = (MeshWarp, [u32; 2], [f32; 3], Option<String>);
+
 /// The source point the mesh sends to `target` (Newton's method from the target itself, with a
 /// finite-difference Jacobian); None when it does not converge.
 fn invert_mesh(mesh: &MeshWarp, target: [f32; 2]) -> Option<[f32; 2]> {
@@ -419,6 +423,33 @@ impl Technique for Warp {
 
     fn take_messages(&mut self) -> Vec<String> {
         std::mem::take(&mut self.messages)
+    }
+
+    fn save_state(&self, _gpu: &Gpu, state: &mut NodeState) -> Result<(), CheckpointError> {
+        // Mesh edits are writes applied once each; the file last read is not read again.
+        let saved: Saved = (self.mesh.clone(), self.applied_size, self.applied_point, self.requested.clone());
+        state.put("mesh", ron::to_string(&saved).expect("a mesh serialises").into_bytes());
+        Ok(())
+    }
+
+    fn load_state(
+        &mut self,
+        _: &Gpu,
+        params: &ParamSet,
+        _: &FrameTime,
+        state: &NodeState,
+    ) -> Result<(), CheckpointError> {
+        let text = std::str::from_utf8(state.get("mesh")?).map_err(|_| state.error("mesh", "is not text".into()))?;
+        let (mesh, size, point, requested): Saved =
+            ron::from_str(text).map_err(|e| state.error("mesh", format!("does not parse: {e}")))?;
+        let sides_fit = [mesh.columns, mesh.rows].iter().all(|s| (2..=MAX_MESH_SIDE).contains(s));
+        if !sides_fit || mesh.points.len() != (mesh.columns * mesh.rows) as usize {
+            return Err(state.error("mesh", "is not a mesh this node makes".into()));
+        }
+        let warp = warp_from(&Settings::read(params), None);
+        (self.pin, self.region) = (warp.corners.homography(), warp.region);
+        (self.mesh, self.applied_size, self.applied_point, self.requested) = (mesh, size, point, requested);
+        Ok(())
     }
 
     fn map_pointer(&self, view: [f32; 2]) -> Option<[f32; 2]> {

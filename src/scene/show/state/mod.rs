@@ -6,7 +6,7 @@ use super::{ClipPolicy, Length, Quantize, Show, Transition};
 use crate::params::ShowCommand;
 
 /// The clock a step runs at: frame, seconds and the tempo's beat position.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Clock {
     /// Frame index.
     pub frame: u64,
@@ -17,7 +17,7 @@ pub struct Clock {
 }
 
 /// A running transition on a layer.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 struct Fade {
     from: Option<usize>,
     transition: Transition,
@@ -25,14 +25,14 @@ struct Fade {
 }
 
 /// One layer's state.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 struct LayerState {
     playing: Option<usize>,
     fade: Option<Fade>,
 }
 
 /// A trigger waiting for its beat or bar.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 struct Pending {
     due_beats: f64,
     layer: usize,
@@ -76,7 +76,7 @@ impl LayerView {
 }
 
 /// The play state of a show.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct ShowState {
     layers: Vec<LayerState>,
     pending: Vec<Pending>,
@@ -162,6 +162,21 @@ impl ShowState {
     /// Whether clip `clip` is drawn now (playing, or the outgoing side of a transition).
     pub fn visible(&self, clip: usize) -> bool {
         self.layers.iter().any(|l| l.playing == Some(clip) || l.fade.is_some_and(|f| f.from == Some(clip)))
+    }
+
+    /// Whether this state can be `show`'s (a checkpoint's is checked before it is taken): one
+    /// entry per layer and clip, and every clip, layer, cue and transition one the show has.
+    pub fn fits(&self, show: &Show) -> bool {
+        let clip = |c: Option<usize>| c.is_none_or(|c| c < show.clips.len());
+        let transition = |t: &Transition| t.kind.is_none_or(|k| k < show.kinds.len());
+        self.layers.len() == show.layers.len()
+            && self.started.len() == show.clips.len()
+            && self.cue.is_none_or(|c| c < show.cues.len())
+            && self
+                .layers
+                .iter()
+                .all(|l| clip(l.playing) && l.fade.is_none_or(|f| clip(f.from) && transition(&f.transition)))
+            && self.pending.iter().all(|p| p.layer < show.layers.len() && clip(p.clip) && transition(&p.transition))
     }
 
     /// Whether a trigger is waiting for its beat on layer `layer`.
