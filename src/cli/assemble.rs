@@ -34,16 +34,14 @@ impl Manifest {
         Ok(())
     }
 
-    /// Writes the manifest into `folder` (atomically) and returns its path.
-    pub fn write(&self, folder: &Path, stem: &str) -> Result<PathBuf, String> {
-        let (Some(first), Some(last)) = (self.frames.first(), self.frames.last()) else {
-            return Err("no frame was rendered".into());
-        };
+    /// Writes the manifest into `folder` (atomically) and returns its path; none for no frames.
+    pub fn write(&self, folder: &Path, stem: &str) -> Result<Option<PathBuf>, String> {
+        let (Some(first), Some(last)) = (self.frames.first(), self.frames.last()) else { return Ok(None) };
         let path = folder.join(format!("{stem}_{:05}-{:05}.{EXTENSION}", first.0, last.0));
         let text: String = self.frames.iter().map(|(_, name, sum)| format!("{sum}  {name}\n")).collect();
         indra::atomic_file::write(&path, text.as_bytes())
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-        Ok(path)
+        Ok(Some(path))
     }
 }
 

@@ -206,10 +206,10 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
             video.finish().map_err(|e| e.to_string())?;
             path
         }
-        FrameSink::Png { folder, stem, manifest } => {
-            let path = manifest.write(&folder, &stem)?;
-            format!("{} (SHA-256 in {})", folder.display(), path.display())
-        }
+        FrameSink::Png { folder, stem, manifest } => match manifest.write(&folder, &stem)? {
+            Some(path) => format!("{} (SHA-256 in {})", folder.display(), path.display()),
+            None => folder.display().to_string(),
+        },
     };
     for send in sends {
         send.close().map_err(|e| e.to_string())?;
