@@ -20,6 +20,7 @@ pub(super) enum Sampler {
 }
 
 impl Sampler {
+    /// A run of `key` with its first sample placed.
     pub(super) fn new(key: &RunKey) -> Self {
         let [x, y, z] = key.extent.map(f64::from);
         if key.three_d {
@@ -85,6 +86,7 @@ impl Sampler {
         }
     }
 
+    /// Samples so far.
     pub(super) fn len(&self) -> usize {
         match self {
             Sampler::Flat(s) => s.points().len(),
