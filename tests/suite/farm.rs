@@ -11,10 +11,10 @@ use std::process::{Command, Stdio};
 
 use crate::common::{indra, text};
 
-/// Frames of the farm runs here: 6 chunks of 20 at 96×54 (the 600 frames of a million
+/// Frames of the farm runs here: 6 chunks of 10 at 96×54 (the 600 frames of a million
 /// particles take hours on lavapipe; docs/farm.md has those figures from the H200).
-const FRAMES: &str = "0-119";
-const PER_TASK: &str = "20";
+const FRAMES: &str = "0-59";
+const PER_TASK: &str = "10";
 const SIZE: &str = "96x54";
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -228,9 +228,9 @@ fn the_openjd_template_renders_the_bytes_of_one_render() {
     let log = text(&o);
     assert!(o.status.success(), "openjd run: {log}");
     assert_eq!(log.matches("starting from ").count(), 6, "six chunks, each from its checkpoint: {log}");
-    let whole = one_render(scene.to_str().unwrap(), 119, &dir.join("whole"));
+    let whole = one_render(scene.to_str().unwrap(), 59, &dir.join("whole"));
     assert_eq!(pngs(&out.join("frames")), whole, "the OpenJD job's frames differ from one render");
-    assert_eq!(video_frames(&out.join("render.mov")), 120);
+    assert_eq!(video_frames(&out.join("render.mov")), 60);
 }
 
 #[cfg(target_os = "linux")]
@@ -255,7 +255,7 @@ fn the_slurm_array_job_renders_the_bytes_of_one_render() {
     assert!(o.status.success(), "sbatch --wait: {}\n{logs}", text(&o));
     assert!(text(&o).contains("(6 tasks)"), "{}", text(&o));
     assert_eq!(logs.matches("starting from ").count(), 6, "six chunks, each from its checkpoint: {logs}");
-    let whole = one_render(scene.to_str().unwrap(), 119, &dir.join("whole"));
+    let whole = one_render(scene.to_str().unwrap(), 59, &dir.join("whole"));
     assert_eq!(pngs(&out.join("frames")), whole, "the Slurm job's frames differ from one render");
-    assert_eq!(video_frames(&out.join("render.mov")), 120);
+    assert_eq!(video_frames(&out.join("render.mov")), 60);
 }
