@@ -32,6 +32,11 @@ impl NodeState {
         self.put(name, bytemuck::cast_slice(values).to_vec());
     }
 
+    /// Adds a value that may be absent (an empty blob for none).
+    pub fn put_option<T: bytemuck::Pod>(&mut self, name: &str, value: Option<T>) {
+        self.put_pod(name, value.as_slice());
+    }
+
     /// Adds one number.
     pub fn put_u64(&mut self, name: &str, value: u64) {
         self.put(name, value.to_le_bytes().to_vec());
@@ -62,6 +67,15 @@ impl NodeState {
             return Err(self.error(name, format!("{} bytes is not a whole number of values", bytes.len())));
         }
         Ok(bytemuck::pod_collect_to_vec(bytes))
+    }
+
+    /// The value [`NodeState::put_option`] wrote as `name`.
+    pub fn get_option<T: bytemuck::Pod>(&self, name: &str) -> Result<Option<T>, CheckpointError> {
+        match self.get_pod::<T>(name)?[..] {
+            [] => Ok(None),
+            [value] => Ok(Some(value)),
+            ref more => Err(self.error(name, format!("holds {} values where this node keeps one", more.len()))),
+        }
     }
 
     /// The number `name`.

@@ -27,11 +27,9 @@ pub struct Manifest {
 }
 
 impl Manifest {
-    /// Adds frame `frame`, written as `name` at `path` (read back, so the sum is of the file).
-    pub fn add(&mut self, frame: u64, name: &str, path: &Path) -> Result<(), String> {
-        let bytes = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-        self.frames.push((frame, name.to_string(), indra::checkpoint::sha256_hex(&bytes)));
-        Ok(())
+    /// Adds frame `frame`, written as `name` with the bytes `png`.
+    pub fn add(&mut self, frame: u64, name: &str, png: &[u8]) {
+        self.frames.push((frame, name.to_string(), indra::checkpoint::sha256_hex(png)));
     }
 
     /// Writes the manifest into `folder` (atomically) and returns its path; none for no frames.

@@ -38,9 +38,12 @@ pub struct BakeArgs {
 pub fn bake(assets: &Assets, gpu: &GpuOptions, args: &BakeArgs) -> Result<(), String> {
     let (first, count) = args.frames.resolve(0)?;
     check_timing(first, count, args.source.dt)?;
-    let last = first + count.max(1) - 1;
+    if count == 0 {
+        return Err("--frames 0 bakes nothing: give a range A-B".into());
+    }
+    let last = first + count - 1;
     let frames: Vec<u64> = (first..=last).filter(|f| f.is_multiple_of(args.every)).collect();
-    if count == 0 || frames.is_empty() {
+    if frames.is_empty() {
         return Err(format!("no frame from {first} to {last} is a multiple of --every {}", args.every));
     }
     let loaded = LoadedSource::load(assets, &args.source, last + 1)?;

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::Args;
 use indra::assets::Assets;
 use indra::gpu::GpuOptions;
-use indra::offscreen::{RenderedFrame, VideoSettings, VideoWriter, write_png};
+use indra::offscreen::{RenderedFrame, VideoSettings, VideoWriter, encode_png};
 
 use super::assemble::{Manifest, frame_file};
 use super::source::LoadedSource;
@@ -235,8 +235,10 @@ impl FrameSink {
             FrameSink::Png { folder, stem, manifest } => {
                 let name = frame_file(stem, frame.time.frame);
                 let path = folder.join(&name);
-                write_png(&path, frame.size, &frame.rgba)?;
-                manifest.add(frame.time.frame, &name, &path)
+                let png = encode_png(frame.size, &frame.rgba)?;
+                std::fs::write(&path, &png).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+                manifest.add(frame.time.frame, &name, &png);
+                Ok(())
             }
             FrameSink::Video(video) => video.write(&frame.rgba).map_err(|e| e.to_string()),
         }

@@ -15,5 +15,5 @@ pub use capture::{CaptureCounts, CaptureReport, FinishingTake, FrameOutlet, Live
 pub use golden::{FlipScore, GoldenCheck, flip_score};
 pub use ndi_out::ndi_outlet;
 pub use pipewire_out::{GST_LAUNCH_ENV, PipeWireOut};
-pub use renderer::{OffscreenRenderer, RenderError, RenderedFrame, write_png};
+pub use renderer::{OffscreenRenderer, RenderError, RenderedFrame, encode_png, write_png};
 pub use video::{VideoError, VideoSettings, VideoWriter};

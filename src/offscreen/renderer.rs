@@ -303,6 +303,15 @@ pub enum RenderError {
 
 /// Writes RGBA8 rows as a PNG.
 pub fn write_png(path: &Path, size: (u32, u32), rgba: &[u8]) -> Result<(), String> {
-    image::save_buffer(path, rgba, size.0, size.1, image::ExtendedColorType::Rgba8)
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+    std::fs::write(path, encode_png(size, rgba)?).map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+/// RGBA8 rows as the bytes of a PNG file (what [`write_png`] writes, for callers that also hash
+/// them).
+pub fn encode_png(size: (u32, u32), rgba: &[u8]) -> Result<Vec<u8>, String> {
+    let mut bytes = Vec::new();
+    let (png, rgba8) = (image::ImageFormat::Png, image::ExtendedColorType::Rgba8);
+    image::write_buffer_with_format(&mut std::io::Cursor::new(&mut bytes), rgba, size.0, size.1, rgba8, png)
+        .map_err(|e| format!("cannot encode a PNG: {e}"))?;
+    Ok(bytes)
 }

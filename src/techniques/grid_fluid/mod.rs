@@ -225,8 +225,7 @@ impl Technique for GridFluid {
 
     fn save_state(&self, gpu: &Gpu, state: &mut NodeState) -> Result<(), CheckpointError> {
         // The cursor of the last step: a drag that goes on past the checkpoint moves from it.
-        let cursor = self.last_cursor.map_or([f32::NAN; 2], |c| c);
-        state.put_pod("last_cursor", &cursor);
+        state.put_option("last_cursor", self.last_cursor);
         save_buffer(gpu, state, "fields", &self.fields.0)
     }
 
@@ -238,10 +237,8 @@ impl Technique for GridFluid {
         state: &NodeState,
     ) -> Result<(), CheckpointError> {
         self.ensure_fields(&Settings::read(params));
-        self.last_cursor = match state.get_pod::<f32>("last_cursor")?[..] {
-            [x, y] if x.is_finite() && y.is_finite() => Some([x, y]),
-            _ => None,
-        };
+        let cursor = state.get_option::<[f32; 2]>("last_cursor")?;
+        self.last_cursor = cursor.filter(|c| c.iter().all(|v| v.is_finite()));
         load_buffer(gpu, state, "fields", &self.fields.0)
     }
 

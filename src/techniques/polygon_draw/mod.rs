@@ -200,7 +200,7 @@ impl Technique for PolygonDraw {
         let rings: Vec<&Vec<[f64; 2]>> = self.polygons.iter().chain([&self.drawing]).collect();
         state.put_pod("ring_lengths", &rings.iter().map(|r| r.len() as u64).collect::<Vec<_>>());
         state.put_pod("points", &rings.iter().flat_map(|r| r.iter().copied()).collect::<Vec<_>>());
-        state.put_u64("started", self.started.map_or(u64::MAX, u64::from));
+        state.put_option("started", self.started);
         Ok(())
     }
 
@@ -214,7 +214,7 @@ impl Technique for PolygonDraw {
             lengths.iter().map(|&n| points.by_ref().take(n as usize).collect()).collect();
         self.drawing = rings.pop().unwrap_or_default();
         self.polygons = rings;
-        self.started = u32::try_from(state.get_u64("started")?).ok();
+        self.started = state.get_option("started")?;
         self.retriangulate();
         Ok(())
     }

@@ -327,9 +327,8 @@ impl Technique for Video {
 
     fn save_state(&self, _gpu: &Gpu, state: &mut NodeState) -> Result<(), CheckpointError> {
         // The playhead moves by steps (speed, ping-pong, loops): its position is state.
-        let head = self.clip.as_ref().map_or([f64::NAN; 2], |p| p.head.parts());
-        state.put_pod("head", &head);
-        state.put_u64("stepped", self.stepped.map_or(u64::MAX, |f| f));
+        state.put_option("head", self.clip.as_ref().map(|p| p.head.parts()));
+        state.put_option("stepped", self.stepped);
         state.put_pod("scrubbed", &[self.scrubbed]);
         Ok(())
     }
@@ -344,13 +343,11 @@ impl Technique for Video {
         // The clip is opened now (an off-screen render waits for it), so the first step goes on
         // from the checkpoint's playhead instead of starting the clip again.
         self.take_up_clip(&Settings::read(params));
-        let head = state.get_pod::<f64>("head")?;
-        if let (Some(playing), &[seconds, bounce]) = (&mut self.clip, &head[..]) {
-            playing.head = Playhead::from_parts([seconds, bounce])
-                .ok_or_else(|| state.error("head", "is not a playhead (the clip had not opened)".into()))?;
+        if let (Some(playing), Some(parts)) = (&mut self.clip, state.get_option::<[f64; 2]>("head")?) {
+            playing.head =
+                Playhead::from_parts(parts).ok_or_else(|| state.error("head", "is not a playhead".into()))?;
         }
-        let stepped = state.get_u64("stepped")?;
-        self.stepped = (stepped != u64::MAX).then_some(stepped);
+        self.stepped = state.get_option("stepped")?;
         self.scrubbed = state.get_pod::<f32>("scrubbed")?.first().copied().unwrap_or(0.0);
         Ok(())
     }
