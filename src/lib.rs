@@ -2,7 +2,7 @@
 //! techniques of *Unity Graphics Programming vol.4* with wgpu.
 //!
 //! Layers, from the bottom (a module imports only lower layers; `docs/architecture.md` is the
-//! map, and a test holds it to this crate): [`time`], [`files`], [`atomic_file`] → [`assets`],
+//! map, and a test holds it to this crate): [`time`], [`timecode`], [`files`], [`atomic_file`] → [`assets`],
 //! [`checkpoint`], [`geometry`], [`gpu`], [`graph`] → [`params`], [`dmx`] → [`techniques`] → [`scene`] → [`control`],
 //! [`live`] → [`offscreen`] → [`app`]; `main.rs` is the command line only.
 
@@ -25,6 +25,7 @@ pub mod params;
 pub mod scene;
 pub mod techniques;
 pub mod time;
+pub mod timecode;
 
 // A technique's golden renders live in its folder (`techniques/<name>/render_tests.rs`) and run
 // as this crate's tests, written as the integration tests are: against `indra::` and with the

@@ -37,6 +37,7 @@ mod seek;
 mod show;
 #[cfg(target_os = "linux")]
 mod slurm;
+mod timecode;
 mod triangulate;
 mod video;
 mod window;
