@@ -5,9 +5,11 @@ use std::path::PathBuf;
 use clap::Args;
 use indra::assets::Assets;
 use indra::gpu::GpuOptions;
-use indra::offscreen::{RenderedFrame, VideoSettings, VideoWriter, encode_png};
+use indra::offscreen::{OffscreenRenderer, RenderedFrame, VideoSettings, VideoWriter, encode_png};
+use indra::timecode::chase::{Follow, follow};
 
 use super::assemble::{Manifest, frame_file};
+use super::chase::{LtcArgs, LtcTrack};
 use super::source::LoadedSource;
 use super::{FrameSpan, SceneEdits, check_timing, parse_size};
 
@@ -98,19 +100,24 @@ pub struct RenderArgs {
     /// Send the fixtures of this DMX patch file (Art-Net or sACN, see docs/lights.md) the
     /// pixels of each frame, in real time (each frame waits until it is due at 1/dt); default:
     /// the patch the scene or show names (`dmx:`).
-    #[arg(long, value_name = "PATCH")]
+    #[arg(long, value_name = "PATCH", conflicts_with = "ltc")]
     pub dmx_out: Option<PathBuf>,
     /// Also write every frame's universes to this file (per universe: the frame as u64, the
     /// universe as u16, little-endian, then its 512 channels).
     #[arg(long, value_name = "FILE")]
     pub dmx_record: Option<PathBuf>,
+    #[command(flatten)]
+    pub ltc: LtcArgs,
 }
 
 /// Renders a PNG sequence (with its manifest) or a video.
 pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<(), String> {
     let (start, frames) = args.chunk.unwrap_or(args.frames).resolve(args.start)?;
     check_timing(start, frames, args.source.dt)?;
-    let loaded = LoadedSource::load(assets, &args.source, start.saturating_add(frames))?;
+    let mut ltc = LtcTrack::open(&args.ltc)?;
+    // Chasing a code, the timeline may be anywhere the code says, past the last output frame.
+    let end = |dt| start.saturating_add(frames).max(ltc.as_ref().map_or(0, |track| track.last_frame(dt) + 1));
+    let loaded = LoadedSource::load(assets, &args.source, end)?;
     let (assets, scene) = (&loaded.assets, &loaded.scene);
     let dt = f64::from(args.source.dt.unwrap_or(scene.dt));
     // A patch the scene names but that cannot be found costs the lights, not the frames.
@@ -161,16 +168,11 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     if let Some(name) = &args.pipewire_out {
         sends.push(Box::new(indra::offscreen::PipeWireOut::start(name, size, fps, true)?));
     }
-    let mut renderer = loaded.renderer(gpu, &args.source, "rendering")?;
-    renderer.show_output(args.output)?;
-    if let Some(folder) = &args.checkpoints {
-        super::bake::resume(&mut renderer, folder, start, &loaded.controls, args.accept_other_adapter)?;
-    }
-    loaded.schedule(&mut renderer);
-    if start > renderer.next_frame() {
-        eprintln!("seeking to frame {start} (every step runs; nothing before it is drawn)");
-    }
-    renderer.seek(start).map_err(|e| e.to_string())?;
+    let first = match ltc.as_mut() {
+        Some(track) => track.frame_at(start as f64 * dt, dt),
+        None => start,
+    };
+    let mut renderer = start_renderer(&loaded, gpu, args, first)?;
     let mut lights = match patch {
         Some(patch) => Some(super::RenderDmx::start(&patch, args.dmx_record.as_deref(), &mut renderer, dt)?),
         None => None,
@@ -180,11 +182,32 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames  {per_sec}  eta {eta}")
             .expect("valid template"),
     );
-    for _ in 0..frames {
-        let frame = renderer.render_next().map_err(|e| e.to_string())?;
-        sink.write(&frame)?;
+    let mut shown: Option<RenderedFrame> = None;
+    for index in start..start + frames {
+        let wanted = ltc.as_mut().map(|track| track.frame_at(index as f64 * dt, dt));
+        let drawn = shown.as_ref().map(|f| f.time.frame);
+        let fresh = match wanted.map(|w| (w, follow(w, drawn, u32::MAX, 0))) {
+            None => Some(renderer.render_next().map_err(|e| e.to_string())?),
+            // The code stands (or holds after a dropout): the frame on screen stays.
+            Some((_, Follow::Hold)) => None,
+            Some((wanted, _)) => {
+                if wanted < renderer.next_frame() {
+                    // The code jumped back: the timeline plays again from its start (or the
+                    // nearest checkpoint), as `--start` does.
+                    bar.suspend(|| eprintln!("the code jumped back: seeking to frame {wanted}"));
+                    renderer = start_renderer(&loaded, gpu, args, wanted)?;
+                }
+                renderer.seek(wanted).map_err(|e| e.to_string())?;
+                Some(renderer.render_next().map_err(|e| e.to_string())?)
+            }
+        };
+        let frame = match fresh {
+            Some(frame) => shown.insert(frame),
+            None => shown.as_mut().expect("a frame is drawn before one is held"),
+        };
+        sink.write(index, frame)?;
         for send in &mut sends {
-            send.take(&frame.rgba, 1, frame.time.frame).map_err(|e| e.to_string())?;
+            send.take(&frame.rgba, 1, index).map_err(|e| e.to_string())?;
         }
         if let Some(lights) = lights.as_mut() {
             lights.frame(&mut renderer, frame.time.frame)?;
@@ -217,8 +240,32 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     if let Some(lights) = lights {
         eprintln!("sent {} DMX packet(s)", lights.finish()?);
     }
+    if let Some(track) = ltc {
+        eprintln!("read {} LTC frame(s)", track.frames_read());
+    }
     eprintln!("wrote {frames} frame(s) to {place}");
     Ok(())
+}
+
+/// A renderer of `loaded` whose next frame is `frame`: from the nearest checkpoint at or
+/// before it when `--checkpoints` is given, with the control events from there on.
+fn start_renderer(
+    loaded: &LoadedSource,
+    gpu: &GpuOptions,
+    args: &RenderArgs,
+    frame: u64,
+) -> Result<OffscreenRenderer, String> {
+    let mut renderer = loaded.renderer(gpu, &args.source, "rendering")?;
+    renderer.show_output(args.output)?;
+    if let Some(folder) = &args.checkpoints {
+        super::bake::resume(&mut renderer, folder, frame, &loaded.controls, args.accept_other_adapter)?;
+    }
+    loaded.schedule(&mut renderer);
+    if frame > renderer.next_frame() {
+        eprintln!("seeking to frame {frame} (every step runs; nothing before it is drawn)");
+    }
+    renderer.seek(frame).map_err(|e| e.to_string())?;
+    Ok(renderer)
 }
 
 /// Where `render` puts its frames.
@@ -230,14 +277,15 @@ enum FrameSink {
 }
 
 impl FrameSink {
-    fn write(&mut self, frame: &RenderedFrame) -> Result<(), String> {
+    /// Writes `frame` as output frame `index` (the timeline's frame, unless a code is chased).
+    fn write(&mut self, index: u64, frame: &RenderedFrame) -> Result<(), String> {
         match self {
             FrameSink::Png { folder, stem, manifest } => {
-                let name = frame_file(stem, frame.time.frame);
+                let name = frame_file(stem, index);
                 let path = folder.join(&name);
                 let png = encode_png(frame.size, &frame.rgba)?;
                 std::fs::write(&path, &png).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-                manifest.add(frame.time.frame, &name, &png);
+                manifest.add(index, &name, &png);
                 Ok(())
             }
             FrameSink::Video(video) => video.write(&frame.rgba).map_err(|e| e.to_string()),

@@ -5,6 +5,7 @@
 //! Pure arithmetic on integers, below every other layer: a timeline chasing a desk turns the
 //! frame count into its own position, and seeks when the count jumps.
 
+pub mod chase;
 pub mod ltc;
 pub mod mtc;
 

@@ -20,10 +20,20 @@ impl AudioFile {
     /// Reads a WAV file, or has ffmpeg decode any other; every failure is one sentence naming the
     /// file.
     pub fn open(path: &Path) -> Result<Self, String> {
+        Self::open_as(path, None)
+    }
+
+    /// Reads channel `channel` (from 1) alone, as [`AudioFile::open`] reads the mix: a
+    /// timecode track beside the music is read unmixed.
+    pub fn open_channel(path: &Path, channel: u16) -> Result<Self, String> {
+        Self::open_as(path, Some(channel))
+    }
+
+    fn open_as(path: &Path, channel: Option<u16>) -> Result<Self, String> {
         match hound::WavReader::open(path) {
-            Ok(reader) => read_wav(reader).map_err(|e| format!("{}: {e}", path.display())),
+            Ok(reader) => read_wav(reader, channel).map_err(|e| format!("{}: {e}", path.display())),
             Err(hound::Error::IoError(io)) => Err(format!("cannot read audio file {}: {io}", path.display())),
-            Err(_) => decode_with_ffmpeg(path),
+            Err(_) => decode_with_ffmpeg(path, channel),
         }
     }
 
@@ -41,10 +51,13 @@ impl AudioFile {
 }
 
 /// The samples of an open WAV file (8–32-bit integer or float), mixed to mono by the mean of
-/// the channels; a damaged file says why.
-fn read_wav<R: std::io::Read>(reader: hound::WavReader<R>) -> Result<AudioFile, String> {
+/// the channels or only `channel` (from 1); a damaged file or a missing channel says why.
+fn read_wav<R: std::io::Read>(reader: hound::WavReader<R>, channel: Option<u16>) -> Result<AudioFile, String> {
     let spec = reader.spec();
     let channels = usize::from(spec.channels.max(1));
+    if let Some(c) = channel.filter(|c| *c == 0 || usize::from(*c) > channels) {
+        return Err(format!("no channel {c}: the file has {channels} (numbered from 1)"));
+    }
     let interleaved: Vec<f32> = match spec.sample_format {
         hound::SampleFormat::Float => reader.into_samples::<f32>().collect::<Result<_, _>>(),
         hound::SampleFormat::Int => {
@@ -53,14 +66,19 @@ fn read_wav<R: std::io::Read>(reader: hound::WavReader<R>) -> Result<AudioFile, 
         }
     }
     .map_err(|e| format!("damaged audio data ({e})"))?;
-    let samples = interleaved.chunks(channels).map(|c| c.iter().sum::<f32>() / channels as f32).collect();
+    let samples = match channel {
+        Some(c) => {
+            interleaved.chunks(channels).map(|frame| frame.get(usize::from(c) - 1).copied().unwrap_or(0.0)).collect()
+        }
+        None => interleaved.chunks(channels).map(|c| c.iter().sum::<f32>() / channels as f32).collect(),
+    };
     Ok(AudioFile { rate: spec.sample_rate, samples })
 }
 
 /// Decodes a file that is not WAV with ffmpeg (`INDRA_FFMPEG`, as for video export, or `ffmpeg`
 /// on the PATH) into a temporary 32-bit float WAV at the file's own rate and channels, then reads
 /// that like any WAV file (ffmpeg's own downmix would not be the plain mean the WAV path takes).
-fn decode_with_ffmpeg(path: &Path) -> Result<AudioFile, String> {
+fn decode_with_ffmpeg(path: &Path, channel: Option<u16>) -> Result<AudioFile, String> {
     let name = path.display();
     let program = std::env::var_os("INDRA_FFMPEG").unwrap_or_else(|| "ffmpeg".into());
     let decoded = tempfile_path();
@@ -82,7 +100,7 @@ fn decode_with_ffmpeg(path: &Path) -> Result<AudioFile, String> {
         }
         Ok(_) => hound::WavReader::open(&decoded)
             .map_err(|e| e.to_string())
-            .and_then(read_wav)
+            .and_then(|reader| read_wav(reader, channel))
             .map_err(|e| format!("{name}: ffmpeg's decoding cannot be read ({e})")),
     };
     let _ = std::fs::remove_file(&decoded);
