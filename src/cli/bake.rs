@@ -46,7 +46,7 @@ pub fn bake(assets: &Assets, gpu: &GpuOptions, args: &BakeArgs) -> Result<(), St
     if frames.is_empty() {
         return Err(format!("no frame from {first} to {last} is a multiple of --every {}", args.every));
     }
-    let loaded = LoadedSource::load(assets, &args.source, |_| last + 1)?;
+    let loaded = LoadedSource::load(assets, &args.source, |_, _| last + 1)?;
     std::fs::create_dir_all(&args.out).map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let mut renderer = loaded.renderer(gpu, &args.source, "baking")?;
     loaded.schedule(&mut renderer);

@@ -7,6 +7,7 @@
 use std::path::PathBuf;
 
 use indra::control::audio::AudioFile;
+use indra::scene::Scene;
 use indra::timecode::Timecode;
 use indra::timecode::chase::{Chase, ChaseSettings, frame_at};
 use indra::timecode::ltc::{LtcDecoder, LtcFrame};
@@ -22,12 +23,22 @@ pub struct LtcArgs {
     /// right for a file of the code alone).
     #[arg(long, value_name = "N", requires = "ltc")]
     pub ltc_channel: Option<u16>,
-    /// The code's label at the timeline's first frame.
-    #[arg(long, value_name = "HH:MM:SS:FF", default_value = "00:00:00:00", value_parser = Timecode::parse, requires = "ltc")]
-    pub ltc_start: Timecode,
-    /// Seconds the timeline runs on when the code drops out, before it holds.
-    #[arg(long, value_name = "SECONDS", default_value_t = 2.0, requires = "ltc")]
-    pub freewheel: f64,
+    /// The code's label at the timeline's first frame (default: the show's `timeline.chase`,
+    /// else 00:00:00:00).
+    #[arg(long, value_name = "HH:MM:SS:FF", value_parser = Timecode::parse, requires = "ltc")]
+    pub ltc_start: Option<Timecode>,
+    /// Seconds the timeline runs on when the code drops out, before it holds (default: the
+    /// show's, else 2).
+    #[arg(long, value_name = "SECONDS", requires = "ltc")]
+    pub freewheel: Option<f64>,
+}
+
+impl LtcArgs {
+    /// How `scene` chases: these flags over its show's `timeline.chase`, over the defaults.
+    pub fn settings(&self, scene: &Scene) -> ChaseSettings {
+        let own = scene.show.as_ref().and_then(|show| show.timeline.chase).unwrap_or_default();
+        ChaseSettings { start: self.ltc_start.unwrap_or(own.start), freewheel: self.freewheel.unwrap_or(own.freewheel) }
+    }
 }
 
 /// A sound file's LTC, read whole before the render.
@@ -43,12 +54,9 @@ pub struct LtcTrack {
 
 impl LtcTrack {
     /// The track `args` names, if any; an unreadable file or channel, or a file without code,
-    /// is one sentence.
+    /// is one sentence. It chases with the defaults until [`LtcTrack::chase_with`].
     pub fn open(args: &LtcArgs) -> Result<Option<Self>, String> {
         let Some(path) = &args.ltc else { return Ok(None) };
-        if !args.freewheel.is_finite() || args.freewheel < 0.0 {
-            return Err(format!("--freewheel {} is not a number of seconds", args.freewheel));
-        }
         let audio = match args.ltc_channel {
             Some(channel) => AudioFile::open_channel(path, channel)?,
             None => AudioFile::open(path)?,
@@ -58,12 +66,22 @@ impl LtcTrack {
         if frames.is_empty() {
             return Err(format!("{}: no LTC found (is it on another channel? --ltc-channel)", path.display()));
         }
-        let chase = Chase::new(ChaseSettings { start: args.ltc_start, freewheel: args.freewheel });
+        let chase = Chase::new(ChaseSettings::default());
         Ok(Some(LtcTrack { frames, rate: f64::from(audio.rate), heard: 0, chase }))
     }
 
+    /// Chases with `settings` from the start of the file; a freewheel that is not a number of
+    /// seconds is one sentence.
+    pub fn chase_with(&mut self, settings: ChaseSettings) -> Result<(), String> {
+        if !settings.freewheel.is_finite() || settings.freewheel < 0.0 {
+            return Err(format!("a freewheel of {} is not a number of seconds", settings.freewheel));
+        }
+        (self.chase, self.heard) = (Chase::new(settings), 0);
+        Ok(())
+    }
+
     /// The timeline's frame (at step `dt`) at `seconds` into the file: the first frame before
-    /// any code, and before the code reaches `--ltc-start`.
+    /// any code, and before the code reaches the chase's start.
     pub fn frame_at(&mut self, seconds: f64, dt: f64) -> u64 {
         while let Some(frame) = self.frames.get(self.heard).filter(|f| f.end / self.rate <= seconds + 1e-6) {
             self.heard += 1;
@@ -75,15 +93,16 @@ impl LtcTrack {
         self.chase.at(seconds).seconds().map_or(0, |s| frame_at(s, dt))
     }
 
-    /// The last timeline frame (at step `dt`) the code can ask for: its latest label, freewheel
-    /// included. Control events (a replay, an audio file's mappings) are read up to it.
-    pub fn last_frame(&self, dt: f64) -> u64 {
-        let mut probe = Chase::new(self.chase.settings());
+    /// The last timeline frame (at step `dt`) the code can ask for when chased with `settings`:
+    /// its latest label, freewheel included. Control events (a replay, an audio file's
+    /// mappings) are read up to it.
+    pub fn last_frame(&self, settings: ChaseSettings, dt: f64) -> u64 {
+        let mut probe = Chase::new(settings);
         let mut last = 0;
         for frame in &self.frames {
             if let Ok(count) = frame.rate.count(frame.timecode) {
                 probe.heard(count as f64 + 1.0, frame.rate, 0.0);
-                last = last.max(probe.at(self.chase.settings().freewheel).seconds().map_or(0, |s| frame_at(s, dt)));
+                last = last.max(probe.at(settings.freewheel).seconds().map_or(0, |s| frame_at(s, dt)));
             }
         }
         last

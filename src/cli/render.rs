@@ -6,6 +6,7 @@ use clap::Args;
 use indra::assets::Assets;
 use indra::gpu::GpuOptions;
 use indra::offscreen::{OffscreenRenderer, RenderedFrame, VideoSettings, VideoWriter, encode_png};
+use indra::scene::Scene;
 use indra::timecode::chase::{Follow, follow};
 
 use super::assemble::{Manifest, frame_file};
@@ -116,8 +117,14 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     check_timing(start, frames, args.source.dt)?;
     let mut ltc = LtcTrack::open(&args.ltc)?;
     // Chasing a code, the timeline may be anywhere the code says, past the last output frame.
-    let end = |dt| start.saturating_add(frames).max(ltc.as_ref().map_or(0, |track| track.last_frame(dt) + 1));
+    let end = |scene: &Scene, dt| {
+        let last = ltc.as_ref().map_or(0, |track| track.last_frame(args.ltc.settings(scene), dt) + 1);
+        start.saturating_add(frames).max(last)
+    };
     let loaded = LoadedSource::load(assets, &args.source, end)?;
+    if let Some(track) = ltc.as_mut() {
+        track.chase_with(args.ltc.settings(&loaded.scene))?;
+    }
     let (assets, scene) = (&loaded.assets, &loaded.scene);
     let dt = f64::from(args.source.dt.unwrap_or(scene.dt));
     // A patch the scene names but that cannot be found costs the lights, not the frames.

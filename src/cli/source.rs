@@ -29,12 +29,12 @@ pub struct LoadedSource {
 }
 
 impl LoadedSource {
-    /// Loads `source`'s scene and control events for frames before `end(dt)` (`dt` the step
-    /// the render runs at).
-    pub fn load(assets: &Assets, source: &RenderSource, end: impl FnOnce(f64) -> u64) -> Result<Self, String> {
+    /// Loads `source`'s scene and control events for frames before `end(scene, dt)` (`dt` the
+    /// step the render runs at).
+    pub fn load(assets: &Assets, source: &RenderSource, end: impl FnOnce(&Scene, f64) -> u64) -> Result<Self, String> {
         let assets = with_scene_folder(assets, &source.scene).rendering_at(source.size);
         let scene = scene_with_edits(&assets, &source.scene, &source.edits)?;
-        let end = end(f64::from(source.dt.unwrap_or(scene.dt)));
+        let end = end(&scene, f64::from(source.dt.unwrap_or(scene.dt)));
         let mut script = match &source.replay {
             Some(path) => indra::control::record::read_replay(path, &scene, &assets)?,
             None => Default::default(),

@@ -171,6 +171,9 @@ pub struct BoundTrack {
     pub component: Option<usize>,
     /// The keys.
     pub track: Track,
+    /// Whether it runs on the show's clock (a timeline lane) rather than its node's (a clip's
+    /// own track restarts with the clip).
+    pub show_clock: bool,
 }
 
 impl std::fmt::Debug for SceneNode {

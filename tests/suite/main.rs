@@ -38,6 +38,7 @@ mod show;
 #[cfg(target_os = "linux")]
 mod slurm;
 mod timecode;
+mod timeline;
 mod triangulate;
 mod video;
 mod window;

@@ -134,6 +134,7 @@ pub(crate) fn mixer_show(kinds: &[&str]) -> Show {
         kinds: kinds.iter().map(|k| k.to_string()).collect(),
         sources: Vec::new(),
         broken: Vec::new(),
+        timeline: Default::default(),
     }
 }
 

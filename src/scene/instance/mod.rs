@@ -224,7 +224,8 @@ impl SceneInstance {
                 if self.overridden.contains(&(bound.node, bound.param)) {
                     continue;
                 }
-                let Some(local) = self.node_time(bound.node, time) else { continue };
+                let local = if bound.show_clock { Some(*time) } else { self.node_time(bound.node, time) };
+                let Some(local) = local else { continue };
                 let value = bound.track.sample(local.seconds);
                 let params = &mut self.params[bound.node];
                 // Track values come from validated keys: always finite.

@@ -89,6 +89,9 @@ pub struct ShowFile {
     /// `<clip>/<node>.<param>`.
     #[serde(default)]
     pub controls: ControlsFile,
+    /// Lanes, markers and the timecode chased (see [`super::timeline`]).
+    #[serde(default)]
+    pub timeline: super::timeline::TimelineFile,
 }
 
 /// One layer of the composition.

@@ -282,6 +282,7 @@ impl Builder<'_> {
             kinds: Vec::new(),
             sources,
             broken,
+            timeline: Default::default(),
         };
         if [file.go_note, file.back_note].iter().flatten().any(|&n| n > 127) {
             self.error(&["go_note", "back_note"], "a cue note must be 0–127".into());
@@ -291,6 +292,10 @@ impl Builder<'_> {
         } else {
             show.cues = file.cues.iter().enumerate().filter_map(|(i, c)| self.cue(&show, i, c)).collect();
         }
+        let (lanes, timeline, problems) = super::timeline::build_timeline(&file.timeline, &nodes, &show, file.dt);
+        problems.into_iter().for_each(|(anchor, message)| self.error(&[anchor.as_str()], message));
+        tracks.extend(lanes);
+        show.timeline = timeline;
         if !show.effects.is_empty() {
             // An effect's dry/wet mix is the crossfade transition at the mix amount.
             show.mix_kind = self.transition(&TransitionFile::default(), &["effects"]).and_then(|t| t.kind);
@@ -328,7 +333,7 @@ impl Builder<'_> {
         }
         show.file = Some(Arc::new(ShowSource { file, text: self.source.into() }));
         scene.show = Some(Arc::new(show));
-        if let Err(e) = budget(&scene, size) {
+        if let Err(e) = super::budget(&scene, size) {
             self.error(&["size"], e);
         }
         Some(scene)
@@ -559,27 +564,6 @@ fn note_problem(clip: &ClipFile) -> Option<String> {
         return Some("channel must be 1–16".into());
     }
     None
-}
-
-/// Whether the show's textures fit the scene budget at `size`; if not, one sentence on which
-/// clips take what.
-fn budget(scene: &Scene, size: (u32, u32)) -> Result<(), String> {
-    scene.check_texture_budget(size).map_err(|_| {
-        let per_node = scene.texture_bytes_of(1, size);
-        let gib = |b: u64| b as f64 / f64::from(1u32 << 30);
-        let show = scene.show.as_deref().expect("a show");
-        let clips: Vec<String> =
-            show.clips.iter().map(|c| format!("{} {:.1} GiB", c.id, gib(per_node * c.nodes.len() as u64))).collect();
-        format!(
-            "the show needs about {:.1} GiB of textures at {}x{} with msaa {} (what can be on screen at once), over the {:.0} GiB a show may use: {} (lower the size or the msaa, or move clips to another show)",
-            gib(scene.texture_bytes(size)),
-            size.0,
-            size.1,
-            scene.msaa,
-            gib(crate::scene::model::MAX_TEXTURE_BYTES),
-            clips.join(", ")
-        )
-    })
 }
 
 /// Why shader file `file` cannot be a transition (it does not load, or lacks the image inputs

@@ -14,6 +14,7 @@ mod mixer;
 mod runtime;
 mod spares;
 mod state;
+pub mod timeline;
 
 pub use file::{
     ClipFile, ClipPolicy, CueFile, EffectFile, Hold, LayerFile, Quantize, ShowFile, TransitionFile, is_show,
@@ -23,9 +24,12 @@ pub use mixer::{Mixer, MixerFrame, TRANSITION_BASE, TransitionUniforms, transiti
 pub use runtime::ShowRuntime;
 pub use spares::Spares;
 pub use state::{BEATS_PER_BAR, Clock, LayerView, ShowState, StepChanges};
+pub use timeline::{Marker, Timeline, TimelineFile};
 
 use std::ops::Range;
 use std::sync::Arc;
+
+use super::Scene;
 
 /// The most layers a show may have.
 pub const MAX_LAYERS: usize = 8;
@@ -67,6 +71,8 @@ pub struct Show {
     pub sources: Vec<String>,
     /// Clips that could not be loaded (a lenient load, for a running show): clip id and why.
     pub broken: Vec<(String, String)>,
+    /// The timeline's markers and chase.
+    pub timeline: Timeline,
 }
 
 /// A show file as parsed (and edited live since), and the text errors are located in.
@@ -213,4 +219,25 @@ impl Show {
             .position(|c| c.name == name)
             .or_else(|| name.parse::<usize>().ok().filter(|n| (1..=self.cues.len()).contains(n)).map(|n| n - 1))
     }
+}
+
+/// Whether the show's textures fit the scene budget at `size`; if not, one sentence on which
+/// clips take what.
+pub(super) fn budget(scene: &Scene, size: (u32, u32)) -> Result<(), String> {
+    scene.check_texture_budget(size).map_err(|_| {
+        let per_node = scene.texture_bytes_of(1, size);
+        let gib = |b: u64| b as f64 / f64::from(1u32 << 30);
+        let show = scene.show.as_deref().expect("a show");
+        let clips: Vec<String> =
+            show.clips.iter().map(|c| format!("{} {:.1} GiB", c.id, gib(per_node * c.nodes.len() as u64))).collect();
+        format!(
+            "the show needs about {:.1} GiB of textures at {}x{} with msaa {} (what can be on screen at once), over the {:.0} GiB a show may use: {} (lower the size or the msaa, or move clips to another show)",
+            gib(scene.texture_bytes(size)),
+            size.0,
+            size.1,
+            scene.msaa,
+            gib(crate::scene::model::MAX_TEXTURE_BYTES),
+            clips.join(", ")
+        )
+    })
 }

@@ -183,6 +183,13 @@ impl ShowRuntime {
         for done in self.spares.finished() {
             self.install(done, nodes, &mut messages);
         }
+        // The timeline's markers ask at their frame, as a performer's commands do (so a seek
+        // passes through them all).
+        for marker in self.plan.markers_at(time.frame) {
+            if let Err(e) = self.state.request(&self.plan, marker.command) {
+                messages.push(format!("marker '{}' at frame {}: {e}", marker.name, marker.frame));
+            }
+        }
         let clock = Clock { frame: time.frame, seconds: time.seconds, beats };
         let changes = self.state.step(&self.plan, clock);
         messages.extend(changes.messages);

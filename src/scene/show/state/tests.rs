@@ -33,6 +33,7 @@ fn show(transition: Transition, cues: Vec<Cue>) -> Show {
         kinds: vec!["crossfade".into()],
         sources: Vec::new(),
         broken: Vec::new(),
+        timeline: Default::default(),
     }
 }
 
