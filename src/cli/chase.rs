@@ -85,10 +85,9 @@ impl LtcTrack {
     pub fn frame_at(&mut self, seconds: f64, dt: f64) -> u64 {
         while let Some(frame) = self.frames.get(self.heard).filter(|f| f.end / self.rate <= seconds + 1e-6) {
             self.heard += 1;
-            let Ok(count) = frame.rate.count(frame.timecode) else { continue };
-            // Forwards a frame ends where the next begins; backwards, where it began.
-            let position = if frame.reverse { count as f64 } else { count as f64 + 1.0 };
-            self.chase.heard(position, frame.rate, frame.end / self.rate);
+            if let Some(position) = position(frame) {
+                self.chase.heard(position, frame.rate, frame.end / self.rate);
+            }
         }
         self.chase.at(seconds).seconds().map_or(0, |s| frame_at(s, dt))
     }
@@ -100,8 +99,8 @@ impl LtcTrack {
         let mut probe = Chase::new(settings);
         let mut last = 0;
         for frame in &self.frames {
-            if let Ok(count) = frame.rate.count(frame.timecode) {
-                probe.heard(count as f64 + 1.0, frame.rate, 0.0);
+            if let Some(position) = position(frame) {
+                probe.heard(position, frame.rate, 0.0);
                 last = last.max(probe.at(settings.freewheel).seconds().map_or(0, |s| frame_at(s, dt)));
             }
         }
@@ -112,4 +111,11 @@ impl LtcTrack {
     pub fn frames_read(&self) -> usize {
         self.frames.len()
     }
+}
+
+/// The code's position (a frame count) when `frame` has just been read: forwards a frame ends
+/// where the next begins, backwards where it began.
+fn position(frame: &LtcFrame) -> Option<f64> {
+    let count = frame.rate.count(frame.timecode).ok()? as f64;
+    Some(if frame.reverse { count } else { count + 1.0 })
 }
