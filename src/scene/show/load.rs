@@ -333,7 +333,7 @@ impl Builder<'_> {
         }
         show.file = Some(Arc::new(ShowSource { file, text: self.source.into() }));
         scene.show = Some(Arc::new(show));
-        if let Err(e) = super::budget(&scene, size) {
+        if let Err(e) = super::budget::budget(&scene, size) {
             self.error(&["size"], e);
         }
         Some(scene)

@@ -6,6 +6,7 @@
 //! clip each layer plays, running transitions, pending quantized triggers, the cue), the
 //! transition passes ([`Mixer`]) and the fresh copies of restarting clips ([`Spares`]).
 
+mod budget;
 pub mod chain_edit;
 pub mod effects;
 mod file;
@@ -28,8 +29,6 @@ pub use timeline::{Marker, Timeline, TimelineFile};
 
 use std::ops::Range;
 use std::sync::Arc;
-
-use super::Scene;
 
 /// The most layers a show may have.
 pub const MAX_LAYERS: usize = 8;
@@ -219,25 +218,4 @@ impl Show {
             .position(|c| c.name == name)
             .or_else(|| name.parse::<usize>().ok().filter(|n| (1..=self.cues.len()).contains(n)).map(|n| n - 1))
     }
-}
-
-/// Whether the show's textures fit the scene budget at `size`; if not, one sentence on which
-/// clips take what.
-pub(super) fn budget(scene: &Scene, size: (u32, u32)) -> Result<(), String> {
-    scene.check_texture_budget(size).map_err(|_| {
-        let per_node = scene.texture_bytes_of(1, size);
-        let gib = |b: u64| b as f64 / f64::from(1u32 << 30);
-        let show = scene.show.as_deref().expect("a show");
-        let clips: Vec<String> =
-            show.clips.iter().map(|c| format!("{} {:.1} GiB", c.id, gib(per_node * c.nodes.len() as u64))).collect();
-        format!(
-            "the show needs about {:.1} GiB of textures at {}x{} with msaa {} (what can be on screen at once), over the {:.0} GiB a show may use: {} (lower the size or the msaa, or move clips to another show)",
-            gib(scene.texture_bytes(size)),
-            size.0,
-            size.1,
-            scene.msaa,
-            gib(crate::scene::model::MAX_TEXTURE_BYTES),
-            clips.join(", ")
-        )
-    })
 }
