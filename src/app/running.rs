@@ -236,7 +236,7 @@ impl Running {
         for (i, shown) in projected {
             self.outputs[i].present(shown, &self.gpu.queue);
         }
-        self.hub.after_frame(self.player.instance().view());
+        self.hub.after_frame(self.player.instance().view(), self.player.last_step().seconds);
         for m in self.player.instance_mut().take_messages() {
             self.overlay.report(m);
         }

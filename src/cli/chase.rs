@@ -23,14 +23,21 @@ pub struct LtcArgs {
     /// right for a file of the code alone).
     #[arg(long, value_name = "N", requires = "ltc")]
     pub ltc_channel: Option<u16>,
-    /// The code's label at the timeline's first frame (default: the show's `timeline.chase`,
-    /// else 00:00:00:00).
-    #[arg(long, value_name = "HH:MM:SS:FF", value_parser = Timecode::parse, requires = "ltc")]
+    /// The code's label at the timeline's first frame, for --ltc and --ltc-out (default: the
+    /// show's `timeline.chase`, else 00:00:00:00).
+    #[arg(long, value_name = "HH:MM:SS:FF", value_parser = Timecode::parse)]
     pub ltc_start: Option<Timecode>,
     /// Seconds the timeline runs on when the code drops out, before it holds (default: the
     /// show's, else 2).
     #[arg(long, value_name = "SECONDS", requires = "ltc")]
     pub freewheel: Option<f64>,
+    /// Also write the LTC of the rendered frames to this WAV (48 kHz mono): sample 0 is the
+    /// first frame's time, labelled from --ltc-start.
+    #[arg(long, value_name = "FILE", conflicts_with = "ltc", requires = "ltc_rate")]
+    pub ltc_out: Option<PathBuf>,
+    /// The rate of --ltc-out's code: 24, 25, 29.97df or 30.
+    #[arg(long, value_name = "RATE", requires = "ltc_out")]
+    pub ltc_rate: Option<indra::timecode::Rate>,
 }
 
 impl LtcArgs {

@@ -22,6 +22,7 @@ mod bench_record;
 mod chase;
 mod check;
 mod list;
+mod ltc_out;
 mod render;
 mod render_dmx;
 mod run;

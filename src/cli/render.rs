@@ -115,6 +115,9 @@ pub struct RenderArgs {
 pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<(), String> {
     let (start, frames) = args.chunk.unwrap_or(args.frames).resolve(args.start)?;
     check_timing(start, frames, args.source.dt)?;
+    if args.ltc.ltc_start.is_some() && args.ltc.ltc.is_none() && args.ltc.ltc_out.is_none() {
+        return Err("--ltc-start labels the code of --ltc or --ltc-out: give one of them".into());
+    }
     let mut ltc = LtcTrack::open(&args.ltc)?;
     // Chasing a code, the timeline may be anywhere the code says, past the last output frame.
     let end = |scene: &Scene, dt| {
@@ -249,6 +252,11 @@ pub fn render(assets: &Assets, gpu: &GpuOptions, args: &RenderArgs) -> Result<()
     }
     if let Some(track) = ltc {
         eprintln!("read {} LTC frame(s)", track.frames_read());
+    }
+    if let (Some(path), Some(rate)) = (&args.ltc.ltc_out, args.ltc.ltc_rate) {
+        let (from, to) = (start as f64 * dt, (start + frames) as f64 * dt);
+        let written = super::ltc_out::write_ltc(path, rate, args.ltc.settings(scene).start, from, to)?;
+        eprintln!("wrote {written} LTC frame(s) at {rate} to {}", path.display());
     }
     eprintln!("wrote {frames} frame(s) to {place}");
     Ok(())

@@ -77,6 +77,10 @@ pub struct RunArgs {
     /// Send MIDI clock at the show's tempo on the --midi-out port.
     #[arg(long, requires = "midi_out")]
     pub midi_clock: bool,
+    /// Send MTC on the --midi-out port at this rate (24, 25, 29.97df or 30): the show's position,
+    /// its first frame labelled as its timeline's chase start says (else 00:00:00:00).
+    #[arg(long, value_name = "RATE", requires = "midi_out")]
+    pub mtc_out: Option<indra::timecode::Rate>,
     /// Audio input device: the first whose name contains this (default: the default device,
     /// opened when the scene maps audio).
     #[arg(long, value_name = "NAME")]
@@ -225,6 +229,7 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         controllers_dir: indra::files::user_data("controllers"),
         midi_out: args.midi_out.clone(),
         midi_clock: args.midi_clock,
+        mtc_out: args.mtc_out,
         record: args.record_controls.clone(),
         presets_dir: args.presets.clone().unwrap_or_else(|| indra::files::user_data("presets")),
         learn_file: args.midi_learn.clone().unwrap_or_else(|| indra::files::user_data("midi-learn.ron")),

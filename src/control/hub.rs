@@ -47,6 +47,8 @@ pub struct ControlOptions {
     pub midi_out: Option<String>,
     /// MIDI clock out (on the `midi_out` port) at the show's tempo.
     pub midi_clock: bool,
+    /// MTC out (on the `midi_out` port) at this rate, for the show's position.
+    pub mtc_out: Option<crate::timecode::Rate>,
     /// Record the control stream to this file.
     pub record: Option<PathBuf>,
     /// Folder of presets.
@@ -79,6 +81,7 @@ impl Default for ControlOptions {
             controllers_dir: "controllers".into(),
             midi_out: None,
             midi_clock: false,
+            mtc_out: None,
             record: None,
             presets_dir: "presets".into(),
             learn_file: "midi-learn.ron".into(),
@@ -195,10 +198,9 @@ impl ControlHub {
         } else {
             None
         };
-        let midi_out = options
-            .midi_out
-            .as_deref()
-            .and_then(|port| MidiOut::start(port, options.midi_clock).map_err(|e| report(Err(e))).ok());
+        let midi_out = options.midi_out.as_deref().and_then(|port| {
+            MidiOut::start(port, options.midi_clock, options.mtc_out).map_err(|e| report(Err(e))).ok()
+        });
         let recorder = options.record.as_deref().and_then(|p| Recorder::create(p).map_err(|e| report(Err(e))).ok());
         let learn = LearnStore { path: options.learn_file.clone() };
         let mapper = MidiMapper::new(scene, &learn.load());
@@ -502,9 +504,10 @@ impl ControlHub {
         }
     }
 
-    /// After a frame: sends changed values to the OSC feedback target and to OSCQuery listeners,
-    /// and refreshes the OSCQuery tree (every 6th frame: clients poll far slower than that).
-    pub fn after_frame(&mut self, instance: SceneView<'_>) {
+    /// After a frame at `seconds` of the show: sends changed values to the OSC feedback target,
+    /// OSCQuery listeners and MIDI out, and refreshes the OSCQuery tree (every 6th frame: clients
+    /// poll far slower than that).
+    pub fn after_frame(&mut self, instance: SceneView<'_>, seconds: f64) {
         // The changes are found once, and only when someone receives them.
         let listening = self.oscquery.as_ref().is_some_and(OscQueryServer::listening);
         let changes = if self.feedback.is_some() || listening { self.changes.collect(instance) } else { Vec::new() };
@@ -521,7 +524,7 @@ impl ControlHub {
             c.show(&instance);
         }
         if let Some(out) = self.midi_out.as_mut() {
-            out.after_frame(self.mapper.bindings(), &instance);
+            out.after_frame(self.mapper.bindings(), &instance, seconds);
         }
         self.frame_count += 1;
     }

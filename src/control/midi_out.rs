@@ -2,8 +2,9 @@
 //! is sent back as its control change (7-bit, or 14-bit as an MSB/LSB pair) or note whenever its
 //! value changes, from whatever source — so motor faders, LED rings and other gear follow indra —
 //! and, when asked, MIDI clock at the show's tempo, its pulses on the show's own beat (so a Link
-//! session's phase, when Link drives the tempo). A thread owns the port: the render thread only
-//! queues messages (bounded) and offers its beat.
+//! session's phase, when Link drives the tempo), and MTC for the show's position ([`super::mtc_out`]).
+//! A thread owns the port: the render thread only queues messages (bounded) and offers its beat
+//! and position.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
@@ -12,8 +13,10 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use super::midi::Binding;
+use super::mtc_out::{MtcFollower, code_seconds};
 use crate::params::{ParamType, ParamValue, TempoClock};
 use crate::scene::{MidiCurve, SceneView};
+use crate::timecode::Rate;
 
 /// Messages waiting for the port at most; past that a frame's changes are dropped and counted.
 const QUEUE: usize = 4096;
@@ -67,6 +70,8 @@ pub fn messages(binding: &Binding, pos: f32) -> [Option<[u8; 3]>; 2] {
 struct Shared {
     /// The show's tempo at an instant, for the clock.
     beat: Mutex<Option<(TempoClock, Instant)>>,
+    /// The show's position in code seconds at an instant, for MTC.
+    position: Mutex<Option<(f64, Instant)>>,
     /// Messages sent.
     sent: AtomicU64,
     /// Messages dropped on a full queue.
@@ -83,25 +88,27 @@ pub struct MidiOut {
     last: Vec<[Option<[u8; 3]>; 2]>,
     thread: Option<JoinHandle<()>>,
     clock: bool,
+    mtc: Option<Rate>,
 }
 
 impl MidiOut {
     /// Sends to the first output port whose name contains `port` (connecting when it appears);
-    /// with `clock`, MIDI clock too (Start, then 24 pulses a beat).
-    pub fn start(port: &str, clock: bool) -> Result<Self, String> {
+    /// with `clock`, MIDI clock too (Start, then 24 pulses a beat); with `mtc`, MTC at that rate.
+    pub fn start(port: &str, clock: bool, mtc: Option<Rate>) -> Result<Self, String> {
         let (queue, messages) = sync_channel(QUEUE);
         let shared = Arc::new(Shared::default());
         let (thread_shared, port) = (Arc::clone(&shared), port.to_lowercase());
         let thread = std::thread::Builder::new()
             .name("indra-midi-out".into())
-            .spawn(move || run(&port, clock, &messages, &thread_shared))
+            .spawn(move || run(&port, clock, mtc, &messages, &thread_shared))
             .map_err(|e| format!("cannot start the MIDI out thread: {e}"))?;
-        Ok(Self { queue, shared, last: Vec::new(), thread: Some(thread), clock })
+        Ok(Self { queue, shared, last: Vec::new(), thread: Some(thread), clock, mtc })
     }
 
-    /// After a frame: queues the mapped parameters whose control position changed, and offers
-    /// the tempo to the clock (never waiting for its lock).
-    pub fn after_frame(&mut self, bindings: &[Binding], view: &SceneView<'_>) {
+    /// After a frame at `seconds` of the show: queues the mapped parameters whose control
+    /// position changed, and offers the tempo to the clock and the position to MTC (never
+    /// waiting for their locks).
+    pub fn after_frame(&mut self, bindings: &[Binding], view: &SceneView<'_>, seconds: f64) {
         // A learned or unlearned binding shifts the list: what follows it is sent once more.
         self.last.resize(bindings.len(), [None, None]);
         for (binding, last) in bindings.iter().zip(&mut self.last) {
@@ -123,6 +130,14 @@ impl MidiOut {
         {
             *beat = Some((view.tempo, Instant::now()));
         }
+        if let Some(rate) = self.mtc
+            && let Ok(mut position) = self.shared.position.try_lock()
+        {
+            // The timeline's first frame carries its chase start's label, when it has one.
+            let start = view.show.and_then(|(show, _)| show.timeline.chase).map(|c| c.start);
+            let start = start.and_then(|label| rate.count(label).ok()).unwrap_or(0);
+            *position = Some((code_seconds(seconds, start, rate), Instant::now()));
+        }
     }
 
     /// Forgets what was sent (a new scene: everything is sent again).
@@ -135,7 +150,9 @@ impl MidiOut {
         let s = &self.shared;
         let state = if s.connected.load(Ordering::Relaxed) { "connected" } else { "waiting for its port" };
         let (sent, dropped) = (s.sent.load(Ordering::Relaxed), s.dropped.load(Ordering::Relaxed));
-        format!("MIDI out {state}: {sent} sent, {dropped} dropped{}", if self.clock { ", clock" } else { "" })
+        let clock = if self.clock { ", clock" } else { "" };
+        let mtc = self.mtc.map(|rate| format!(", MTC at {rate}")).unwrap_or_default();
+        format!("MIDI out {state}: {sent} sent, {dropped} dropped{clock}{mtc}")
     }
 }
 
@@ -150,12 +167,13 @@ impl Drop for MidiOut {
 
 /// The thread: keeps the port connected, sends queued messages and clock pulses.
 #[cfg(feature = "midi")]
-fn run(port: &str, clock: bool, messages: &Receiver<Vec<u8>>, shared: &Shared) {
+fn run(port: &str, clock: bool, mtc: Option<Rate>, messages: &Receiver<Vec<u8>>, shared: &Shared) {
     let mut output: Option<(String, midir::MidiOutputConnection)> = None;
     // Lists the ports (kept: a JACK client a second would churn the server).
     let mut probe: Option<midir::MidiOutput> = None;
     let mut last_scan: Option<Instant> = None;
     let mut clock_state = ClockFollower::default();
+    let mut code = mtc.map(MtcFollower::new);
     while !shared.stop.load(Ordering::Relaxed) {
         if last_scan.is_none_or(|t| t.elapsed() >= Duration::from_secs(1)) {
             last_scan = Some(Instant::now());
@@ -188,6 +206,10 @@ fn run(port: &str, clock: bool, messages: &Receiver<Vec<u8>>, shared: &Shared) {
                 send(&[0xFA]);
             }
             (0..pulses).for_each(|_| send(&[0xF8]));
+        }
+        let position = shared.position.lock().ok().and_then(|p| *p);
+        if let (Some(code), Some((seconds, at))) = (code.as_mut(), position) {
+            code.advance(seconds, at, Instant::now(), &mut send);
         }
         std::thread::sleep(Duration::from_millis(1));
     }
@@ -282,7 +304,7 @@ fn reconnect(
 
 /// A binary built without the `midi` feature sends nothing.
 #[cfg(not(feature = "midi"))]
-fn run(_port: &str, _clock: bool, messages: &Receiver<Vec<u8>>, shared: &Shared) {
+fn run(_port: &str, _clock: bool, _mtc: Option<Rate>, messages: &Receiver<Vec<u8>>, shared: &Shared) {
     log::info!("{}", super::midi::NOT_BUILT_IN);
     while !shared.stop.load(Ordering::Relaxed) {
         while messages.try_recv().is_ok() {}

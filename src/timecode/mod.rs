@@ -117,6 +117,21 @@ impl Rate {
     }
 }
 
+impl std::str::FromStr for Rate {
+    type Err = String;
+
+    /// Reads a rate as a show file writes it: `24`, `25`, `29.97df` (or `29.97`) or `30`.
+    fn from_str(text: &str) -> Result<Rate, String> {
+        match text.trim() {
+            "24" => Ok(Rate::Fps24),
+            "25" => Ok(Rate::Fps25),
+            "29.97df" | "29.97" => Ok(Rate::Fps2997Drop),
+            "30" => Ok(Rate::Fps30),
+            other => Err(format!("'{other}' is not a timecode rate (24, 25, 29.97df or 30)")),
+        }
+    }
+}
+
 impl std::fmt::Display for Rate {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {

@@ -19,18 +19,35 @@ const SHOW: &str = r#"(
     controls: (midi: [(cc: 1, target: "layer/1.opacity"), (cc: 2, fine: true, target: "master.level")]),
 )"#;
 
-#[test]
-fn mapped_parameters_and_the_clock_go_out_to_a_desk() {
-    let Some(jack) = Jack::start() else { return };
-    let Some(mut devices) = Devices::start(&jack, &["desk=desk out,desk in"]) else { return };
+/// A show playing to a desk on a JACK MIDI port (fields drop in order: the show first).
+struct Desk {
+    show: Show,
+    osc: u16,
+    devices: Devices,
+    _display: VirtualDisplay,
+    _jack: Jack,
+}
+
+/// `show` (a show file's text) started with `args`, its MIDI out connected to the desk; `None`
+/// (skipped) without JACK or its Python client.
+fn play_to_desk(name: &str, show: &str, args: &[&str]) -> Option<Desk> {
+    let jack = Jack::start()?;
+    let devices = Devices::start(&jack, &["desk=desk out,desk in"])?;
     let display = VirtualDisplay::start();
-    let dir = scratch_dir("midi-out");
-    let file = dir.join("desk.ron");
-    std::fs::write(&file, SHOW).unwrap();
-    let args = ["--midi-out".as_ref(), "desk in".as_ref(), "--midi-clock".as_ref()];
+    let dir = scratch_dir(name);
+    let file = dir.join(format!("{name}.ron"));
+    std::fs::write(&file, show).unwrap();
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_ref()).collect();
     let env = [("JACK_DEFAULT_SERVER", jack.name.as_ref())];
     let (mut show, osc) = Show::start_with_midi(&display, &dir, file.to_str().unwrap(), &args, &env);
     show.wait_for("MIDI out: desk:desk in connected");
+    Some(Desk { show, osc, devices, _display: display, _jack: jack })
+}
+
+#[test]
+fn mapped_parameters_and_the_clock_go_out_to_a_desk() {
+    let Some(desk) = play_to_desk("midi-out", SHOW, &["--midi-out", "desk in", "--midi-clock"]) else { return };
+    let Desk { mut show, osc, mut devices, .. } = desk;
     // At connect: every mapped value (opacity 1.0, level 1.0 as 16383) and the clock's Start.
     let seen = devices.wait_for_all("desk", &[&[0xB0, 1, 127], &[0xB0, 2, 127], &[0xB0, 34, 127], &[0xFA]]);
     let start = seen.iter().position(|(_, m)| m == &[0xFA]).unwrap();
@@ -55,5 +72,75 @@ fn mapped_parameters_and_the_clock_go_out_to_a_desk() {
     let span = pulses.last().unwrap() - pulses.first().unwrap();
     let bpm = (pulses.len() - 1) as f64 / span * 60.0 / 24.0;
     assert!((bpm / 150.0 - 1.0).abs() < 0.08, "{} pulses in {span:.3} s: {bpm:.1} BPM", pulses.len());
+    assert!(show.child.try_wait().unwrap().is_none(), "the show is still running");
+}
+
+/// A show whose timeline starts at 01:00:00:00.
+const TIMELINE_SHOW: &str = r#"(
+    name: "master", size: (32, 32),
+    layers: [(name: "one", clips: [(scene: "kleinian")])],
+    timeline: (chase: (start: "01:00:00:00")),
+)"#;
+
+/// The labels a run of MTC quarter frames spells (piece 0 to 7 in order), read here without
+/// indra's MTC reader: (arrival, frame count at 25 fps, the rate code of the hours nibble).
+fn quarter_frame_labels(messages: &[(f64, Vec<u8>)]) -> Vec<(f64, u64, u8)> {
+    let mut labels = Vec::new();
+    let mut pieces = Vec::new();
+    for (t, m) in messages {
+        let [0xF1, data] = m.as_slice() else { continue };
+        let (piece, nibble) = (usize::from(data >> 4), u64::from(data & 0xF));
+        if piece != pieces.len() {
+            pieces.clear();
+            if piece != 0 {
+                continue;
+            }
+        }
+        pieces.push(nibble);
+        if pieces.len() == 8 {
+            let p = &pieces;
+            let (frames, seconds) = (p[0] | (p[1] & 1) << 4, p[2] | (p[3] & 3) << 4);
+            let (minutes, hours) = (p[4] | (p[5] & 3) << 4, p[6] | (p[7] & 1) << 4);
+            labels.push((*t, ((hours * 60 + minutes) * 60 + seconds) * 25 + frames, (p[7] >> 1) as u8));
+            pieces.clear();
+        }
+    }
+    labels
+}
+
+#[test]
+fn the_show_is_the_timecode_master_over_mtc() {
+    let Some(desk) = play_to_desk("mtc-out", TIMELINE_SHOW, &["--midi-out", "desk in", "--mtc-out", "25"]) else {
+        return;
+    };
+    let Desk { mut show, mut devices, .. } = desk;
+    // The code starts with a full frame locating the desk in the timeline's first hour.
+    let deadline = std::time::Instant::now() + Duration::from_secs(30);
+    let mut seen = Vec::new();
+    while !seen.iter().any(|(_, m): &(f64, Vec<u8>)| m.first() == Some(&0xF1)) {
+        assert!(std::time::Instant::now() < deadline, "no MTC came: {seen:02x?}");
+        std::thread::sleep(Duration::from_millis(50));
+        seen.extend(devices.take("desk"));
+    }
+    let located = seen.iter().find(|(_, m)| m.first() == Some(&0xF0)).expect("a full-frame message first");
+    let [0xF0, 0x7F, 0x7F, 0x01, 0x01, hh, ..] = located.1.as_slice() else { panic!("{:?}", located.1) };
+    assert_eq!((hh >> 5, hh & 0x1F), (1, 1), "25 fps, hour 1");
+    devices.take("desk");
+    std::thread::sleep(Duration::from_secs(3));
+    let messages = devices.take("desk");
+    let labels = quarter_frame_labels(&messages);
+    assert!(labels.len() >= 30, "{} whole labels in 3 s", labels.len());
+    // Each label two frames after the one before (eight quarter frames), at 25 fps. A frame
+    // stalled on a busy machine may make the code locate again (a full frame) once.
+    let locates = messages.iter().filter(|(_, m)| m.first() == Some(&0xF0)).count();
+    let steps: Vec<u64> = labels.windows(2).map(|pair| pair[1].1.wrapping_sub(pair[0].1)).collect();
+    let breaks = steps.iter().filter(|&&step| step != 2).count();
+    assert!(breaks <= locates && locates <= 1, "{locates} locates, label steps {steps:?}");
+    assert!(labels.iter().all(|label| label.2 == 1), "the rate code says 25 fps");
+    // The code runs at the show's pace: held to 8 % over three seconds, as the clock is.
+    let (first, last) = (labels[0], labels[labels.len() - 1]);
+    let fps = (last.1 - first.1) as f64 / (last.0 - first.0);
+    assert!((fps / 25.0 - 1.0).abs() < 0.08, "{fps:.2} frames a second");
+    assert!(first.1 >= 3600 * 25 && first.1 < 3600 * 25 + 60 * 25, "code {} is in the show's first minute", first.1);
     assert!(show.child.try_wait().unwrap().is_none(), "the show is still running");
 }

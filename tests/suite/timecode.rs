@@ -9,28 +9,32 @@ use indra::timecode::{Rate, Timecode};
 use std::path::PathBuf;
 use std::process::Command;
 
-/// libltc's generator, built once per run; `None` (skipped) without libltc.
-fn ltcgen() -> Option<PathBuf> {
-    static BUILT: std::sync::OnceLock<Result<PathBuf, String>> = std::sync::OnceLock::new();
+/// libltc's generator and reader (`tests/timecode/ltcgen.c`, `ltcread.c`), built once per
+/// run; `None` (skipped) without libltc.
+fn libltc() -> Option<(PathBuf, PathBuf)> {
+    static BUILT: std::sync::OnceLock<Result<(PathBuf, PathBuf), String>> = std::sync::OnceLock::new();
     let built = BUILT.get_or_init(|| {
         let dir = std::env::temp_dir().join(format!("indra-ltcgen-{}", std::process::id()));
         std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-        let exe = dir.join("ltcgen");
-        let source = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/timecode/ltcgen.c");
-        let out = Command::new("cc")
-            .args(["-O2", "-o"])
-            .arg(&exe)
-            .arg(source)
-            .arg("-lltc")
-            .output()
-            .map_err(|e| format!("no C compiler: {e}"))?;
-        if !out.status.success() {
-            return Err(format!("libltc's generator did not build: {}", String::from_utf8_lossy(&out.stderr)));
-        }
-        Ok(exe)
+        let build = |name: &str| {
+            let exe = dir.join(name);
+            let source = format!("{}/tests/timecode/{name}.c", env!("CARGO_MANIFEST_DIR"));
+            let out = Command::new("cc")
+                .args(["-O2", "-o"])
+                .arg(&exe)
+                .arg(source)
+                .arg("-lltc")
+                .output()
+                .map_err(|e| format!("no C compiler: {e}"))?;
+            if !out.status.success() {
+                return Err(format!("libltc's {name} did not build: {}", String::from_utf8_lossy(&out.stderr)));
+            }
+            Ok(exe)
+        };
+        Ok((build("ltcgen")?, build("ltcread")?))
     });
     match built {
-        Ok(exe) => Some(exe.clone()),
+        Ok(programs) => Some(programs.clone()),
         Err(problem) => {
             assert!(
                 std::env::var_os("CI").is_none(),
@@ -40,6 +44,11 @@ fn ltcgen() -> Option<PathBuf> {
             None
         }
     }
+}
+
+/// libltc's generator.
+fn ltcgen() -> Option<PathBuf> {
+    libltc().map(|(generator, _)| generator)
 }
 
 /// What libltc writes for `segments` (see tests/timecode/ltcgen.c) at `fps` and
@@ -216,5 +225,103 @@ fn a_render_chasing_ltc_shows_the_frame_the_code_says_seeking_on_jumps_and_freew
     assert!(shown[124] > 95 && shown[128] < 30, "{:?}", &shown[120..130]);
     assert_eq!((shown[199], shown[205], shown[220]), (95, 95, 95), "held after the freewheel");
     assert!(shown[outputs - 1] > 190);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// What libltc's decoder reads in 48 kHz samples at `fps` (its nominal rate): each frame's
+/// label and the sample its last transition is at.
+fn libltc_read(reader: &PathBuf, samples: &[i16], fps: &str) -> Vec<(Timecode, u64)> {
+    use std::io::Write;
+    let bytes: Vec<u8> = samples.iter().flat_map(|s| s.to_le_bytes()).collect();
+    let mut child = Command::new(reader)
+        .args(["48000", fps])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(&bytes).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success());
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|line| {
+            let fields: Vec<&str> = line.split(' ').collect();
+            assert_eq!(fields[3], "0", "read as reversed: {line}");
+            (Timecode::parse(fields[0]).unwrap(), fields[2].parse().unwrap())
+        })
+        .collect()
+}
+
+/// The samples of a mono 16-bit 48 kHz WAV.
+fn wav_samples(wav: &std::path::Path) -> Vec<i16> {
+    let mut file = hound::WavReader::open(wav).unwrap();
+    let spec = file.spec();
+    assert_eq!((spec.channels, spec.sample_rate, spec.bits_per_sample), (1, 48_000, 16));
+    file.samples::<i16>().map(Result::unwrap).collect()
+}
+
+#[test]
+fn ltc_a_render_writes_is_read_by_libltc_frame_exactly_and_chased_back_to_the_same_frames() {
+    let Some((_, reader)) = libltc() else { return };
+    let dir = std::env::temp_dir().join(format!("indra-ltc-out-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    // Frames 30–179 at 50 frames a second (0.6–3.6 s), the timeline's first frame labelled
+    // 00:00:58:00: the code crosses the minute, where drop-frame skips two labels.
+    let scene = ["render", "isf_feedback", "--dt", "0.02", "--size", "64x36"];
+    let dt = f64::from(0.02f32);
+    let (from, to) = (30.0 * dt, 180.0 * dt);
+    for (rate, fps) in [(Rate::Fps2997Drop, "29.97"), (Rate::Fps24, "24")] {
+        let wav = dir.join(format!("{fps}.wav"));
+        let written = dir.join(format!("written-{fps}"));
+        let out = ["--frames", "30-179", "--out", written.to_str().unwrap(), "--ltc-start", "00:00:58:00"];
+        let code = ["--ltc-out", wav.to_str().unwrap(), "--ltc-rate", if fps == "24" { "24" } else { "29.97df" }];
+        let ran = common::indra(&[&scene[..], &out, &code].concat());
+        assert!(ran.status.success(), "{}", common::text(&ran));
+        let start = rate.count(Timecode::parse("00:00:58:00").unwrap()).unwrap();
+        let read = libltc_read(&reader, &wav_samples(&wav), fps);
+        // Every whole frame of the span is read (the one cut at each end may not be), its
+        // label the next, and its end where the timeline's time puts it, within 3 samples (libltc
+        // reads the ends of its own encoder's frames up to 3 samples early: 1 at 25 and 30 fps,
+        // 2 at 29.97, 3 at 24).
+        let whole = ((to - from) * rate.fps()).floor() as usize;
+        assert!(read.len() + 1 >= whole, "{rate}: {} of {whole} frames read", read.len());
+        let counts: Vec<u64> = read.iter().map(|(label, _)| rate.count(*label).unwrap()).collect();
+        assert!(counts.windows(2).all(|w| w[1] == w[0] + 1), "{rate}: {read:?}");
+        for (count, (label, end)) in counts.iter().zip(&read) {
+            let due = ((*count + 1 - start) as f64 / rate.fps() - from) * 48_000.0;
+            assert!((*end as f64 - due).abs() <= 3.0, "{rate}: {label} ends at sample {end}, not {due:.1}");
+        }
+        if rate == Rate::Fps2997Drop {
+            let labels: Vec<String> = read.iter().map(|(label, _)| label.to_string()).collect();
+            let minute = labels.iter().position(|l| l == "00:00:59:29").expect("the last label of minute 0");
+            assert_eq!(labels[minute + 1], "00:01:00:02", "drop-frame skips 00 and 01");
+        }
+    }
+    // Chased back, frame by frame, output k (k × dt into the file) is frame 30 + k once the
+    // first whole code frame is heard, and the first frame before.
+    let wav = dir.join("29.97.wav");
+    let chased = dir.join("chased");
+    let chase = ["--ltc", wav.to_str().unwrap(), "--ltc-start", "00:00:58:00", "--frames", "0-149"];
+    let ran = common::indra(&[&scene[..], &chase, &["--out", chased.to_str().unwrap()]].concat());
+    assert!(ran.status.success(), "{}", common::text(&ran));
+    let (chased, written) = (frame_sums(&chased), frame_sums(&dir.join("written-29.97")));
+    let heard = libltc_read(&reader, &wav_samples(&wav), "29.97")[0].1 as f64 / 48_000.0;
+    let plain_zero = {
+        let zero = dir.join("zero");
+        let ran = common::indra(&[&scene[..], &["--frames", "0-0", "--out", zero.to_str().unwrap()]].concat());
+        assert!(ran.status.success(), "{}", common::text(&ran));
+        frame_sums(&zero)[&0].clone()
+    };
+    for k in 0..150u64 {
+        let t = k as f64 * dt;
+        let got = &chased[&k];
+        if t > heard + 0.001 {
+            assert_eq!(got, &written[&(30 + k)], "output {k} ({t:.2} s) is not frame {}", 30 + k);
+        } else if t < heard - 0.001 {
+            assert_eq!(got, &plain_zero, "output {k} ({t:.2} s), before any code, is not frame 0");
+        }
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
