@@ -174,6 +174,9 @@ pub struct BoundTrack {
     /// Whether it runs on the show's clock (a timeline lane) rather than its node's (a clip's
     /// own track restarts with the clip).
     pub show_clock: bool,
+    /// Whether its key times are beats of the show's tempo (read at the beat position) rather
+    /// than seconds.
+    pub beats: bool,
 }
 
 impl std::fmt::Debug for SceneNode {

@@ -311,6 +311,10 @@ pub struct TrackFile {
     /// Clock multiplier (default 1).
     #[serde(default = "one")]
     pub time_scale: f32,
-    /// (time in seconds, value) pairs.
+    /// Key times in beats of the show's tempo instead of seconds: the track runs on the beat
+    /// position that tap, MIDI clock and Link move, so a 16-beat loop stays on the music.
+    #[serde(default)]
+    pub beats: bool,
+    /// (time in seconds, or beats, value) pairs.
     pub keys: Vec<(f32, RawValue)>,
 }

@@ -440,7 +440,7 @@ pub(crate) fn bind_track(nodes: &[SceneNode], t: &TrackFile, show_clock: bool) -
     for (time, raw) in &t.keys {
         match coerce(raw, key_type, &options) {
             Some(value) if time.is_finite() => keys.push(Key { time: *time, value }),
-            Some(_) => problems.push(format!("track '{}': a key's time is {time}, not a number of seconds", t.target)),
+            Some(_) => problems.push(format!("track '{}': a key's time is {time}, not a number", t.target)),
             None => problems.push(format!(
                 "track '{}': key at {time} s is {}, expected a {key_type}",
                 t.target,
@@ -452,7 +452,7 @@ pub(crate) fn bind_track(nodes: &[SceneNode], t: &TrackFile, show_clock: bool) -
         return Err(problems);
     }
     let track = Track::new(keys, t.interpolation, t.repeat, t.time_scale);
-    Ok(BoundTrack { target: t.target.clone(), node, param: pi, component, track, show_clock })
+    Ok(BoundTrack { target: t.target.clone(), node, param: pi, component, track, show_clock, beats: t.beats })
 }
 
 fn mismatch(name: &str, decl: &ParamDecl, raw: &RawValue) -> String {

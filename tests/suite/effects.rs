@@ -325,37 +325,11 @@ fn frame_n_is_the_same_played_or_sought_across_adds_moves_and_bypasses() {
     }
 }
 
-/// The show `text` started under `display` with OSCQuery on and its controls recorded, playing:
-/// the show, its OSC port, its folder, the OSCQuery address and the recording's path.
-fn start_recorded(
-    display: &crate::live_show::VirtualDisplay,
-    name: &str,
-    text: &str,
-) -> (crate::live_show::Show, u16, std::path::PathBuf, std::net::SocketAddr, std::path::PathBuf) {
-    let dir = crate::live_show::scratch_dir(name);
-    let file = dir.join("effects.ron");
-    std::fs::write(&file, text).unwrap();
-    let query = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap();
-    let recording = dir.join("take.ron");
-    let args: Vec<std::ffi::OsString> =
-        vec!["--oscquery".into(), query.to_string().into(), "--record-controls".into(), recording.clone().into()];
-    let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
-    let (mut show, port) = crate::live_show::Show::start(display, &dir, file.to_str().unwrap(), &args);
-    show.wait_for("OSCQuery on");
-    show.wait_for("plays clip 'kleinian_classic'");
-    (show, port, dir, query, recording)
-}
-
 /// Ends a running show with Ctrl-C (cleanly, its recording complete), then replays the take
 /// `recording` over the show `text` in a render: the frame after the take's last event, and its
 /// number.
 fn end_and_replay(show: &mut crate::live_show::Show, recording: &std::path::Path, text: &str) -> (Vec<u8>, u64) {
-    let _ = std::process::Command::new("kill").args(["-INT", &show.pid().to_string()]).status();
-    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
-    while show.child.try_wait().unwrap().is_none() {
-        assert!(std::time::Instant::now() < deadline, "the show did not end on Ctrl-C");
-        std::thread::sleep(std::time::Duration::from_millis(100));
-    }
+    show.interrupt();
     let scene = show_from(text);
     let script = indra::control::record::read_replay(recording, &scene, &assets()).unwrap();
     let last = *script.keys().last().expect("the take holds the edits");
@@ -372,7 +346,8 @@ fn effects_edited_over_osc_in_a_running_show_change_the_tree_and_replay_to_the_s
     use crate::live_show::{VirtualDisplay, send};
     use rosc::OscType;
     let display = VirtualDisplay::start();
-    let (mut show, port, _, query, recording) = start_recorded(&display, "effects-osc", &limit_set_show("", "", ""));
+    let (mut show, port, _, query, recording) =
+        crate::live_show::start_recorded(&display, "effects-osc", &limit_set_show("", "", ""));
     let (mut socket, _) = tungstenite::connect(format!("ws://{query}/")).unwrap();
     let osc = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
     let text = |s: &str| vec![OscType::String(s.into())];
@@ -437,7 +412,7 @@ fn a_preset_holds_a_layers_chain_and_its_recall_rebuilds_it_and_morphs_its_value
     let display = VirtualDisplay::start();
     let saved_chain = format!(r#"{KALEIDOSCOPE}, (effect: "shaders/isf/Diagonalize.fs", params: {{ "width": 0.35 }})"#);
     let (mut show, port, dir, query, recording) =
-        start_recorded(&display, "effects-preset", &limit_set_show("", &saved_chain, ""));
+        crate::live_show::start_recorded(&display, "effects-preset", &limit_set_show("", &saved_chain, ""));
     // The show's presets are in `dir/presets` (live_show passes it).
     let presets = dir.join("presets");
     let osc = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();

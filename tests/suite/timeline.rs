@@ -111,3 +111,90 @@ fn a_broken_timeline_is_refused_with_located_errors() {
         assert!(e.contains(says) && e.contains("timeline.ron:"), "{to}: {e}");
     }
 }
+
+#[test]
+fn a_lane_in_beats_follows_the_shows_tempo() {
+    // A 4-beat ramp that loops: one bar of the music, whatever its tempo.
+    let lane = r#"(target: "layer/1.opacity", beats: true, keys: [(0.0, 0.0), (4.0, 1.0)], interpolation: Linear, repeat: Loop)"#;
+    for bpm in [120.0f64, 90.0] {
+        let text = TIMED
+            .replace(r#"(target: "layer/1.opacity", keys: [(0.0, 0.0), (1.0, 1.0)], interpolation: Linear)"#, lane)
+            .replace("seed: 1,", &format!("seed: 1, bpm: {bpm:.1},"));
+        let scene = show_from(&text);
+        let layer = scene.node_index("layer/1").unwrap();
+        let mut r = OffscreenRenderer::new(gpu(), &assets(), scene, Some((16, 16)), None, None).unwrap();
+        for frame in 0..=300u64 {
+            r.render_only().unwrap();
+            let beats = frame as f64 / 60.0 * bpm / 60.0;
+            let opacity = float(r.instance_mut().params(layer).get("opacity"));
+            // At a bar's end the ramp wraps: 1 and 0 are the same point of the loop.
+            let off = (f64::from(opacity) - beats % 4.0 / 4.0).abs();
+            assert!(off.min(1.0 - off) < 1e-3, "{bpm} BPM, frame {frame}: opacity {opacity}");
+        }
+    }
+}
+
+/// A show whose master a lane steps between 0.2 and 0.8 every second.
+const STEPPED: &str = r#"(
+    name: "stepped", size: (16, 16), seed: 1,
+    layers: [(start: 1, clips: [(scene: "kleinian_classic")])],
+    timeline: (lanes: [
+        (target: "master.level", keys: [(0.0, 0.2), (1.0, 0.8), (2.0, 0.2)], interpolation: Step, repeat: Loop),
+    ]),
+)"#;
+
+#[test]
+fn a_lane_is_read_back_over_oscquery_and_a_fader_move_over_it_replays_on_its_frame() {
+    use crate::live_show::{VirtualDisplay, send, start_recorded};
+    use std::time::{Duration, Instant};
+    let display = VirtualDisplay::start();
+    let (mut show, port, _, query, take) = start_recorded(&display, "timeline-live", STEPPED);
+    let level = || crate::osc::http_get(query, "/indra/master/level").1["VALUE"][0].as_f64().unwrap_or(f64::NAN);
+    // The lane's two values, and nothing else, for three seconds (once the tree has the first
+    // frame's values: before it, the master's 1).
+    let lane_value = |value: f64| [0.2, 0.8].iter().any(|v| (value - v).abs() < 1e-6);
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while !lane_value(level()) {
+        assert!(Instant::now() < deadline, "the lane never reached the master: {}", level());
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let mut seen = std::collections::BTreeSet::new();
+    let until = Instant::now() + Duration::from_secs(3);
+    while Instant::now() < until {
+        let value = level();
+        assert!(lane_value(value), "the master read {value}");
+        seen.insert((value * 10.0).round() as u32);
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert_eq!(seen.into_iter().collect::<Vec<_>>(), [2, 8], "the lane steps between its keys");
+    // A fader move takes the master over from the lane.
+    let osc = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    send(&osc, port, "/indra/master", vec![rosc::OscType::Float(0.5)]);
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while (level() - 0.5).abs() > 1e-6 {
+        assert!(Instant::now() < deadline, "the fader move never showed: {}", level());
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let until = Instant::now() + Duration::from_millis(1500);
+    while Instant::now() < until {
+        assert!((level() - 0.5).abs() < 1e-6, "the lane took the master back: {}", level());
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // The take, replayed in a render: the lane's steps up to the move's frame, 0.5 from it on.
+    show.interrupt();
+    let scene = show_from(STEPPED);
+    let master = scene.node_index("master").unwrap();
+    let script = indra::control::record::read_replay(&take, &scene, &assets()).unwrap();
+    let moved = *script.keys().next().expect("the take holds the fader move");
+    let mut r = OffscreenRenderer::new(gpu(), &assets(), scene, Some((16, 16)), None, None).unwrap();
+    for (frame, events) in script {
+        r.schedule(frame, events);
+    }
+    for frame in 0..moved + 180 {
+        r.render_only().unwrap();
+        let got = float(r.instance_mut().params(master).get("level"));
+        let lane = if frame % 120 < 60 { 0.2 } else { 0.8 };
+        let want = if frame < moved { lane } else { 0.5 };
+        assert_eq!(got, want, "frame {frame} (the move at {moved})");
+    }
+}

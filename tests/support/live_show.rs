@@ -130,6 +130,17 @@ impl Show {
         kib.and_then(|k| k.parse::<u64>().ok()).map_or(0, |k| k * 1024)
     }
 
+    /// Ends the show with Ctrl-C, as a performer would (a recording is completed), and waits
+    /// (at most 30 s) until it has.
+    pub(crate) fn interrupt(&mut self) {
+        let _ = Command::new("kill").args(["-INT", &self.pid().to_string()]).status();
+        let deadline = Instant::now() + Duration::from_secs(30);
+        while self.child.try_wait().unwrap().is_none() {
+            assert!(Instant::now() < deadline, "the show did not end on Ctrl-C");
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    }
+
     /// Waits (at most 90 s: debug build on lavapipe) until the log holds `text`; returns the log.
     pub(crate) fn wait_for(&mut self, text: &str) -> String {
         let deadline = Instant::now() + Duration::from_secs(90);
@@ -155,6 +166,28 @@ impl Drop for Show {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
+}
+
+/// The show `text`, written to `<scratch>/<name>.ron` and started with OSCQuery on a free local
+/// port and its control events recorded, once its first clip plays: the show, its OSC port, its
+/// folder, the OSCQuery address and the recording's path.
+pub(crate) fn start_recorded(
+    display: &VirtualDisplay,
+    name: &str,
+    text: &str,
+) -> (Show, u16, PathBuf, std::net::SocketAddr, PathBuf) {
+    let dir = scratch_dir(name);
+    let file = dir.join(format!("{name}.ron"));
+    std::fs::write(&file, text).unwrap();
+    let query = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap();
+    let recording = dir.join("take.ron");
+    let args: Vec<std::ffi::OsString> =
+        vec!["--oscquery".into(), query.to_string().into(), "--record-controls".into(), recording.clone().into()];
+    let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+    let (mut show, port) = Show::start(display, &dir, file.to_str().unwrap(), &args);
+    show.wait_for("OSCQuery on");
+    show.wait_for("plays clip");
+    (show, port, dir, query, recording)
 }
 
 /// An empty folder of this test process under the temporary folder.

@@ -226,7 +226,7 @@ impl SceneInstance {
                 }
                 let local = if bound.show_clock { Some(*time) } else { self.node_time(bound.node, time) };
                 let Some(local) = local else { continue };
-                let value = bound.track.sample(local.seconds);
+                let value = bound.track.sample(if bound.beats { self.tempo.beats } else { local.seconds });
                 let params = &mut self.params[bound.node];
                 // Track values come from validated keys: always finite.
                 let _ = match bound.component {

@@ -1,5 +1,5 @@
 //! A show's timeline: **lanes** — automation on any parameter the show has (a clip's, a
-//! layer's, an effect's, the master's), on the show's own clock — and **markers**, which fire
+//! layer's, an effect's, the master's), on the show's own clock or its beat — and **markers**, which fire
 //! the cue list's cues, clips and columns at their time; and the timecode the timeline chases.
 //! Lanes and markers are functions of the frame, so renders, seeks, checkpoints and recordings
 //! take them as they take a scene's tracks.
