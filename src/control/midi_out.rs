@@ -2,9 +2,9 @@
 //! is sent back as its control change (7-bit, or 14-bit as an MSB/LSB pair) or note whenever its
 //! value changes, from whatever source — so motor faders, LED rings and other gear follow indra —
 //! and, when asked, MIDI clock at the show's tempo, its pulses on the show's own beat (so a Link
-//! session's phase, when Link drives the tempo), and MTC for the show's position ([`super::mtc_out`]).
-//! A thread owns the port: the render thread only queues messages (bounded) and offers its beat
-//! and position.
+//! session's phase, when Link drives the tempo), and MTC for the show's position
+//! ([`super::mtc_out`]). A thread owns the port: the render thread only queues messages (bounded)
+//! and offers its beat and position.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
@@ -165,7 +165,7 @@ impl Drop for MidiOut {
     }
 }
 
-/// The thread: keeps the port connected, sends queued messages and clock pulses.
+/// The thread: keeps the port connected, sends queued messages, clock pulses and MTC.
 #[cfg(feature = "midi")]
 fn run(port: &str, clock: bool, mtc: Option<Rate>, messages: &Receiver<Vec<u8>>, shared: &Shared) {
     let mut output: Option<(String, midir::MidiOutputConnection)> = None;
