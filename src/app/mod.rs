@@ -4,6 +4,7 @@
 //! taken-over parameters back to their tracks, 1–9 recall presets.
 
 mod chain_edits;
+mod chase;
 mod effects_panel;
 mod input;
 mod lights_panel;

@@ -67,6 +67,8 @@ pub(super) struct Running {
     pub(super) outputs: Vec<OutputWindow>,
     /// The DMX patch the output's pixels go to (`--dmx-out`).
     pub(super) lights: Option<crate::dmx::LiveLights>,
+    /// Following the timecode the show chases (`--mtc-in`).
+    pub(super) chase: super::chase::WindowChase,
 }
 
 /// The most takes started in a minute.
@@ -126,7 +128,15 @@ impl Running {
             return;
         }
         let now = Instant::now();
-        let steps = self.player.accumulate((now - self.last).as_secs_f64());
+        let steps = match self.hub.timecode(now) {
+            Some(chasing) => {
+                let assets = self.live.as_ref().map_or(&self.assets, |live| live.running_assets());
+                let size = (self.config.width, self.config.height);
+                let from = super::chase::SeekFrom { gpu: &self.gpu, assets, size };
+                self.chase.steps(chasing, &mut self.player, &mut self.runtime, from, &mut self.overlay)
+            }
+            None => self.player.accumulate((now - self.last).as_secs_f64()),
+        };
         self.last = now;
         self.reload();
         let mut events = std::mem::take(&mut self.ui_events);

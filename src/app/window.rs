@@ -198,6 +198,7 @@ impl WindowApp {
             });
         Ok(Running {
             lights,
+            chase: Default::default(),
             window,
             surface,
             config,
@@ -237,6 +238,7 @@ impl ApplicationHandler for WindowApp {
             r.wait_for_takes();
             // A build still running when the process ends would call the driver as it unloads.
             r.chain_edits.finish();
+            r.chase.finish();
             for (_, send) in std::mem::take(&mut r.sends) {
                 match send.finish(&r.gpu.device) {
                     Ok(report) => log::info!("send ended: {report}"),

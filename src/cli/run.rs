@@ -81,6 +81,19 @@ pub struct RunArgs {
     /// its first frame labelled as its timeline's chase start says (else 00:00:00:00).
     #[arg(long, value_name = "RATE", requires = "midi_out")]
     pub mtc_out: Option<indra::timecode::Rate>,
+    /// Chase MTC from the MIDI inputs (a desk's quarter frames and locates, at 24, 25, 29.97df
+    /// or 30 fps): the timeline shows the frame the code says, holds before any code, runs on
+    /// through a dropout for --freewheel seconds, and seeks when the code jumps.
+    #[arg(long, conflicts_with = "no_midi")]
+    pub mtc_in: bool,
+    /// The code's label at the timeline's first frame for --mtc-in (default: the show's
+    /// `timeline.chase`, else 00:00:00:00).
+    #[arg(long, value_name = "HH:MM:SS:FF", requires = "mtc_in", value_parser = indra::timecode::Timecode::parse)]
+    pub chase_start: Option<indra::timecode::Timecode>,
+    /// Seconds the timeline runs on when --mtc-in's code drops out, before it holds (default:
+    /// the show's, else 2).
+    #[arg(long, value_name = "SECONDS", requires = "mtc_in", value_parser = parse_freewheel)]
+    pub freewheel: Option<f64>,
     /// Audio input device: the first whose name contains this (default: the default device,
     /// opened when the scene maps audio).
     #[arg(long, value_name = "NAME")]
@@ -230,6 +243,9 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         midi_out: args.midi_out.clone(),
         midi_clock: args.midi_clock,
         mtc_out: args.mtc_out,
+        mtc_in: args
+            .mtc_in
+            .then_some(indra::control::mtc_in::ChaseOverrides { start: args.chase_start, freewheel: args.freewheel }),
         record: args.record_controls.clone(),
         presets_dir: args.presets.clone().unwrap_or_else(|| indra::files::user_data("presets")),
         learn_file: args.midi_learn.clone().unwrap_or_else(|| indra::files::user_data("midi-learn.ron")),
@@ -271,6 +287,14 @@ fn parse_web_sessions(text: &str) -> Result<usize, String> {
         .ok()
         .filter(|n| range.contains(n))
         .ok_or_else(|| format!("{text}: WebSocket sessions are {} to {}", range.start(), range.end()))
+}
+
+/// A freewheel time: 0 to 3600 seconds, as a show's `timeline.chase` takes it.
+fn parse_freewheel(text: &str) -> Result<f64, String> {
+    text.parse::<f64>()
+        .ok()
+        .filter(|s| (0.0..=3600.0).contains(s))
+        .ok_or_else(|| format!("{text}: a freewheel is 0 to 3600 seconds"))
 }
 
 /// Prints the audio input devices, one per line.

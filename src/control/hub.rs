@@ -49,6 +49,8 @@ pub struct ControlOptions {
     pub midi_clock: bool,
     /// MTC out (on the `midi_out` port) at this rate, for the show's position.
     pub mtc_out: Option<crate::timecode::Rate>,
+    /// Chase MTC from the MIDI inputs, with these settings over the show's.
+    pub mtc_in: Option<super::mtc_in::ChaseOverrides>,
     /// Record the control stream to this file.
     pub record: Option<PathBuf>,
     /// Folder of presets.
@@ -82,6 +84,7 @@ impl Default for ControlOptions {
             midi_out: None,
             midi_clock: false,
             mtc_out: None,
+            mtc_in: None,
             record: None,
             presets_dir: "presets".into(),
             learn_file: "midi-learn.ron".into(),
@@ -108,6 +111,8 @@ pub struct ControlHub {
     pub web_urls: Vec<String>,
     midi: Option<MidiInput>,
     parser: MidiParser,
+    /// The MTC the timeline chases, when asked for.
+    mtc: Option<super::mtc_in::MtcChase>,
     /// Pad controllers with profiles, when MIDI is on.
     controllers: Option<Controllers>,
     /// MIDI out (mirrored mappings, clock), when asked for.
@@ -234,6 +239,7 @@ impl ControlHub {
             web_urls,
             midi,
             parser: MidiParser::default(),
+            mtc: options.mtc_in.map(|o| super::mtc_in::MtcChase::new(o, scene)),
             controllers,
             midi_out,
             mapper,
@@ -263,6 +269,9 @@ impl ControlHub {
     pub fn set_scene(&mut self, scene: &Scene, remap: Option<&Remap>) {
         self.router = OscRouter::new(scene);
         self.rebuild_audio(scene);
+        if let Some(mtc) = self.mtc.as_mut() {
+            mtc.set_scene(scene);
+        }
         if let Some(dmx) = self.dmx.as_mut() {
             dmx.set_scene(scene, &mut self.notices);
         }
@@ -305,8 +314,10 @@ impl ControlHub {
             }
         }
         let messages = self.midi.as_ref().map(MidiInput::drain).unwrap_or_default();
-        for bytes in messages {
-            events.extend(self.midi_bytes(&bytes, scene, seconds));
+        for (at, bytes) in messages {
+            if !self.mtc.as_mut().is_some_and(|mtc| mtc.message(at, &bytes)) {
+                events.extend(self.midi_bytes(&bytes, scene, seconds));
+            }
         }
         if let Some(polled) = self.controllers.as_mut().map(|c| c.poll(&instance)) {
             events.extend(polled.events);
@@ -529,6 +540,11 @@ impl ControlHub {
         self.frame_count += 1;
     }
 
+    /// Where the chased timecode puts the timeline at `now`; `None` when the show does not chase.
+    pub fn timecode(&self, now: std::time::Instant) -> Option<crate::timecode::chase::Chasing> {
+        self.mtc.as_ref().map(|mtc| mtc.at(now))
+    }
+
     /// One line of input counters for the overlay.
     pub fn status(&self) -> String {
         let mut parts = Vec::new();
@@ -546,6 +562,7 @@ impl ControlHub {
         }
         parts.extend(self.controllers.as_ref().and_then(Controllers::status));
         parts.extend(self.midi_out.as_ref().map(MidiOut::status));
+        parts.extend(self.mtc.as_ref().map(|mtc| mtc.status(std::time::Instant::now())));
         if let Some(dropped) = self.oscquery.as_ref().map(OscQueryServer::dropped).filter(|&d| d > 0) {
             parts.push(format!("OSCQuery LISTEN: {dropped} changes dropped (a controller fell behind)"));
         }

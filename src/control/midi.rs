@@ -440,14 +440,17 @@ pub use port::MidiInput;
 #[cfg(feature = "midi")]
 mod port {
     use std::sync::mpsc::{Receiver, sync_channel};
+    use std::time::Instant;
 
     /// Messages held for the render thread at most; a flood past that is dropped.
     const QUEUE: usize = 4096;
 
-    /// Connections to MIDI input ports; bytes arrive on a channel drained by the render loop.
+    /// Connections to MIDI input ports; bytes arrive on a channel drained by the render loop,
+    /// each stamped on arrival (MTC is chased by when its quarter frames came, not when a frame
+    /// read them).
     pub struct MidiInput {
         _connections: Vec<midir::MidiInputConnection<()>>,
-        bytes: Receiver<Vec<u8>>,
+        bytes: Receiver<(Instant, Vec<u8>)>,
         /// Names of the connected ports.
         pub ports: Vec<String>,
     }
@@ -469,8 +472,10 @@ mod port {
                 }
                 let input = midir::MidiInput::new("indra").map_err(|e| e.to_string())?;
                 let tx = tx.clone();
-                match input.connect(&port, "indra-in", move |_, message, _| drop(tx.try_send(message.to_vec())), ()) {
+                let stamp = move |_, message: &[u8], _: &mut ()| drop(tx.try_send((Instant::now(), message.to_vec())));
+                match input.connect(&port, "indra-in", stamp, ()) {
                     Ok(c) => {
+                        log::info!("MIDI in: {name}");
                         ports.push(name);
                         connections.push(c);
                     }
@@ -483,8 +488,8 @@ mod port {
             Ok(Self { _connections: connections, bytes, ports })
         }
 
-        /// Every message received since the last call.
-        pub fn drain(&self) -> Vec<Vec<u8>> {
+        /// Every message received since the last call, with when it arrived.
+        pub fn drain(&self) -> Vec<(Instant, Vec<u8>)> {
             self.bytes.try_iter().collect()
         }
     }
@@ -507,7 +512,7 @@ mod port {
         }
 
         /// Nothing ever arrives.
-        pub fn drain(&self) -> Vec<Vec<u8>> {
+        pub fn drain(&self) -> Vec<(std::time::Instant, Vec<u8>)> {
             Vec::new()
         }
     }

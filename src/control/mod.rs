@@ -19,6 +19,7 @@ pub mod listen;
 pub mod midi;
 pub mod midi_commands;
 pub mod midi_out;
+pub mod mtc_in;
 pub mod mtc_out;
 pub mod osc;
 mod osc_guard;

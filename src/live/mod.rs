@@ -4,11 +4,13 @@
 //! the error (file:line:col) is reported once, until the next save fixes it. A lost or stuck GPU
 //! moves the show to a new device built from the last good shaders.
 
+mod chase_seek;
 mod prepare;
 mod recovery;
 mod reload;
 mod watcher;
 
+pub use chase_seek::{BackgroundSeek, HAND_OVER_WITHIN, Sought};
 pub use recovery::{GpuGuard, GpuState, GpuTrouble, recover, roll_back_stall};
 pub use reload::{LiveReload, ReloadReport, RolledBack};
 pub use watcher::{Watcher, read_stable};

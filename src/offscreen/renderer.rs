@@ -117,6 +117,13 @@ impl OffscreenRenderer {
         Ok(message)
     }
 
+    /// Goes on from a scene sought off this thread (as a window chasing timecode does): its
+    /// next frame is the sought one. The scene must be this renderer's, at its size.
+    pub fn take_over(&mut self, sought: crate::live::Sought) {
+        self.player = sought.player;
+        self.runtime = sought.runtime;
+    }
+
     /// Reads back output `n` from now on: 0 is the scene's output (the first window), 1… its
     /// `outputs` (the other windows, warped as they are shown).
     pub fn show_output(&mut self, n: usize) -> Result<(), String> {

@@ -5,6 +5,9 @@ output (what its pads and faders send) and input (the lights it is sent). Comman
 one per line; each answers one line of JSON on stdout:
   send NAME HEX       send the bytes (one or more messages) from NAME's output
   take NAME           every message NAME received since the last take: [[seconds, hex], ...]
+  mtc NAME FPS FRAME  run MTC quarter frames at FPS (24, 25 or 30: no drop-frame) from frame
+                      count FRAME (even) on; answers the wall-clock time FRAME began
+  mtc-stop NAME       stop the MTC (a dropout, or a desk that stops)
   unplug NAME         close NAME's client (its ports vanish, as a USB device's do)
   plug NAME           open it again
   quit
@@ -24,6 +27,8 @@ class Device:
         self.client = None
         self.outgoing = queue.Queue()
         self.received = queue.Queue()
+        # A running MTC: (fps, first quarter, wall-clock time of the first, quarters sent).
+        self.mtc = None
 
     def plug(self):
         client = jack.Client(self.name, no_start_server=True)
@@ -38,6 +43,7 @@ class Device:
                 except queue.Empty:
                     break
                 output.write_midi_event(0, data)
+            self.run_mtc(output)
             # Stamped on the wall clock when the cycle runs (JACK's frame clock runs behind it
             # on a busy machine, where the server waits for late clients).
             now = time.monotonic()
@@ -47,6 +53,16 @@ class Device:
         client.set_process_callback(process)
         client.activate()
         self.client = client
+
+    def run_mtc(self, output):
+        """Sends the quarter frames due by now (each at its time, to the cycle)."""
+        if self.mtc is None:
+            return
+        fps, first, began, sent = self.mtc
+        due = first + int((time.time() - began) * fps * 4) + 1
+        for quarter in range(first + sent, due):
+            output.write_midi_event(0, quarter_frame(quarter, fps))
+        self.mtc = (fps, first, began, max(sent, due - first))
 
     def unplug(self):
         self.client.deactivate()
@@ -74,6 +90,21 @@ class Device:
                 return out
 
 
+def quarter_frame(quarter, fps):
+    """MTC quarter frame number `quarter` (from frame count 0) at a rate without drop-frame."""
+    piece = quarter % 8
+    frame = (quarter - piece) // 4
+    seconds, frames = divmod(frame, fps)
+    minutes, seconds = divmod(seconds, 60)
+    hours, minutes = divmod(minutes, 60)
+    rate_code = {24: 0, 25: 1, 30: 3}[fps]
+    value = [frames, seconds, minutes, hours][piece // 2]
+    nibble = value & 0xF if piece % 2 == 0 else value >> 4
+    if piece == 7:
+        nibble |= rate_code << 1
+    return bytes([0xF1, piece << 4 | nibble])
+
+
 def main():
     devices = {}
     for spec in sys.argv[1:]:
@@ -93,6 +124,14 @@ def main():
             answer = "sent"
         elif command == "take":
             answer = device.take()
+        elif command == "mtc":
+            fps, frame = int(words[2]), int(words[3])
+            began = time.time()
+            device.mtc = (fps, frame * 4, began, 0)
+            answer = began
+        elif command == "mtc-stop":
+            device.mtc = None
+            answer = "stopped"
         elif command == "unplug":
             device.unplug()
             answer = "unplugged"

@@ -28,6 +28,7 @@ mod live_show;
 mod media;
 mod midi_out;
 mod msaa;
+mod mtc_in;
 mod ndi;
 mod osc;
 #[cfg(target_os = "linux")]

@@ -76,6 +76,34 @@ fn every_scene_renders_frame_n_the_same_played_sought_or_split() {
 }
 
 #[test]
+fn a_seek_off_the_render_thread_goes_on_as_the_played_scene() {
+    // What a window chasing timecode swaps in when the code jumps: a fresh cloth built and
+    // stepped on a thread of its own to the code's frame.
+    let scene = load_scene(&common::assets(), "cloth").unwrap();
+    let mut played = renderer(scene.clone());
+    let want = frames(&mut played, 2 * N + 3);
+    // The taker's device: what a seek builds lives on the device it is shown from.
+    let mut taken =
+        OffscreenRenderer::new(common::gpu(), &common::assets(), scene.clone(), Some(SIZE), None, None).unwrap();
+    let mut seek = indra::live::BackgroundSeek::start(taken.gpu(), &common::assets(), scene, SIZE, 2 * N);
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+    let sought = loop {
+        if let Some(result) = seek.try_take() {
+            break result.expect("the seek ends");
+        }
+        assert!(std::time::Instant::now() < deadline, "the seek did not end in 120 s");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    taken.take_over(sought);
+    let next = taken.next_frame();
+    assert!((2 * N - indra::live::HAND_OVER_WITHIN..=2 * N).contains(&next), "handed over at frame {next}");
+    for frame in next..2 * N + 3 {
+        let got = taken.render_next().expect("frame renders").rgba;
+        assert!(got == want[frame as usize], "frame {frame} after the seek differs from the played frame");
+    }
+}
+
+#[test]
 fn seeking_a_simulation_is_not_the_start_frame() {
     // The defect this guards against: a seek that skipped the simulation showed the rest pose.
     let scene = load_scene(&common::assets(), "cloth").unwrap();

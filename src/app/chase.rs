@@ -1,0 +1,129 @@
+//! The window chasing timecode (`run --mtc-in`): each frame, the steps that bring the frame on
+//! screen to the frame the code says — none while it waits for code or stands, a few to catch
+//! up — or, when the code jumps, a seek on a thread of its own while the frame on screen holds;
+//! the sought scene is swapped in when it is ready. Live control goes on throughout, on the
+//! scene that is showing; a jump shows the timeline's frame as a render from 0 shows it.
+
+use std::time::{Duration, Instant, SystemTime};
+
+use super::panel::Overlay;
+use crate::assets::Assets;
+use crate::gpu::Gpu;
+use crate::graph::GraphRuntime;
+use crate::live::BackgroundSeek;
+use crate::scene::Player;
+use crate::timecode::chase::{Chasing, Follow, follow, frame_at};
+
+/// The most steps one displayed frame runs to catch up with the code; further is a seek.
+const MAX_CATCH_UP_STEPS: u32 = 12;
+
+/// Frames the code may be behind the screen before that is a jump back: a live input's timing
+/// wobbles by a frame or two.
+const JITTER_FRAMES: u64 = 2;
+
+/// How long after a seek that failed no other is tried (it would fail each frame).
+const RETRY_AFTER: Duration = Duration::from_secs(2);
+
+/// The window's chase state.
+#[derive(Default)]
+pub(super) struct WindowChase {
+    /// The seek in progress.
+    seek: Option<BackgroundSeek>,
+    /// When the last seek failed.
+    failed: Option<Instant>,
+}
+
+/// What a seek is built with: the window's device, the shaders running, the window's size.
+pub(super) struct SeekFrom<'a> {
+    /// The window's device.
+    pub gpu: &'a Gpu,
+    /// The shaders the show runs now (a live reload's, else the start's).
+    pub assets: &'a Assets,
+    /// The window's size in pixels.
+    pub size: (u32, u32),
+}
+
+impl WindowChase {
+    /// Stops a seek in progress and waits for its thread (at exit).
+    pub(super) fn finish(&mut self) {
+        if let Some(seek) = self.seek.take() {
+            seek.finish();
+        }
+    }
+
+    /// The steps `player` runs now to show the frame `chasing` says; a sought scene that is
+    /// ready replaces `player` and `runtime` first.
+    pub(super) fn steps(
+        &mut self,
+        chasing: Chasing,
+        player: &mut Player,
+        runtime: &mut GraphRuntime,
+        from: SeekFrom<'_>,
+        overlay: &mut Overlay,
+    ) -> u32 {
+        let Some(seconds) = chasing.seconds() else { return 0 };
+        let wanted = frame_at(seconds, f64::from(player.now().dt));
+        if !self.take_sought(wanted, player, runtime, overlay) {
+            return 0;
+        }
+        let next = player.now().frame;
+        let plan = match next.checked_sub(1) {
+            // Nothing stepped yet: a code near the start is stepped to, as a show plays.
+            None if wanted < u64::from(MAX_CATCH_UP_STEPS) => Follow::Step(wanted as u32 + 1),
+            drawn => follow(wanted, drawn, MAX_CATCH_UP_STEPS, JITTER_FRAMES),
+        };
+        let steps = match plan {
+            Follow::Hold => 0,
+            Follow::Step(n) => n,
+            Follow::Seek(frame) => {
+                self.start_seek(frame, next, player, from);
+                0
+            }
+        };
+        let shown = if steps == 0 { player.last_step().frame } else { next + u64::from(steps) - 1 };
+        let unix = SystemTime::now().duration_since(SystemTime::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64());
+        let state = match chasing {
+            Chasing::Locked { .. } => "locked",
+            Chasing::Freewheel { .. } => "freewheel",
+            _ => "stopped",
+        };
+        log::debug!(target: "indra::chase", "unix {unix:.4} code {seconds:.4} s wants {wanted} shows {shown} {state}");
+        steps
+    }
+
+    /// Takes a finished seek's scene in; false while one is still running (the frame holds).
+    fn take_sought(
+        &mut self,
+        wanted: u64,
+        player: &mut Player,
+        runtime: &mut GraphRuntime,
+        overlay: &mut Overlay,
+    ) -> bool {
+        let Some(seek) = self.seek.as_mut() else { return true };
+        seek.want(wanted);
+        match seek.try_take() {
+            None => false,
+            Some(Ok(sought)) => {
+                log::info!("timecode: sought frame {}, the code is at {wanted}", sought.player.now().frame);
+                (*player, *runtime) = (sought.player, sought.runtime);
+                self.seek = None;
+                true
+            }
+            Some(Err(e)) => {
+                overlay.report(format!("timecode: the seek failed ({e}); the show holds its frame"));
+                (self.seek, self.failed) = (None, Some(Instant::now()));
+                true
+            }
+        }
+    }
+
+    /// Starts seeking `frame` off the render thread (the code jumped from around `next`).
+    fn start_seek(&mut self, frame: u64, next: u64, player: &Player, from: SeekFrom<'_>) {
+        if self.failed.is_some_and(|at| at.elapsed() < RETRY_AFTER) {
+            return;
+        }
+        log::info!("timecode: the code jumped to frame {frame} (the show was at {next}): seeking");
+        let scene = player.instance().scene().clone();
+        self.seek = Some(BackgroundSeek::start(from.gpu, from.assets, scene, from.size, frame));
+    }
+}

@@ -1,0 +1,157 @@
+//! Chasing a desk's MTC on the MIDI inputs: quarter frames and full-frame locates, read as they
+//! arrive (the MIDI thread stamps each message), into the chase of [`crate::timecode::chase`].
+//! The window asks where the timeline is at the instant it steps; the answer runs on between
+//! quarter frames at the code's speed, freewheels through a dropout, and stops after it.
+
+use std::time::Instant;
+
+use crate::scene::Scene;
+use crate::timecode::chase::{Chase, ChaseSettings, Chasing};
+use crate::timecode::mtc::{MtcEvent, MtcReader};
+use crate::timecode::{Rate, Timecode};
+
+/// What the command line says over the show's `timeline.chase` (each `None`: the show's, else
+/// the default).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ChaseOverrides {
+    /// The label at the timeline's first frame.
+    pub start: Option<Timecode>,
+    /// Seconds the timeline runs on when the code drops out.
+    pub freewheel: Option<f64>,
+}
+
+impl ChaseOverrides {
+    /// How `scene` chases: these over its show's chase, over the defaults.
+    pub fn settings(&self, scene: &Scene) -> ChaseSettings {
+        let own = scene.show.as_ref().and_then(|show| show.timeline.chase).unwrap_or_default();
+        ChaseSettings { start: self.start.unwrap_or(own.start), freewheel: self.freewheel.unwrap_or(own.freewheel) }
+    }
+}
+
+/// The MTC chase of a running show.
+#[derive(Clone, Debug)]
+pub struct MtcChase {
+    overrides: ChaseOverrides,
+    reader: MtcReader,
+    chase: Chase,
+    /// Local time 0 of the chase's clock.
+    epoch: Instant,
+    /// The last position read, for the status line.
+    last: Option<(f64, Rate)>,
+    /// When the last MTC message came (seconds on the chase's clock).
+    heard_at: f64,
+}
+
+/// Silence between quarter frames (a tenth of a frame apart at most rates) that breaks a run:
+/// the reader counts quarter frames on from the last whole label, so after a dropout it must
+/// read a whole label again rather than go on from where the code was.
+const RUN_BREAK_SECONDS: f64 = 0.1;
+
+impl MtcChase {
+    /// A chase of `scene` as `overrides` say, that has heard nothing.
+    pub fn new(overrides: ChaseOverrides, scene: &Scene) -> Self {
+        let chase = Chase::new(overrides.settings(scene));
+        Self { overrides, reader: MtcReader::new(), chase, epoch: Instant::now(), last: None, heard_at: 0.0 }
+    }
+
+    /// Takes a reloaded show's chase settings; the code is found again from the next message, a
+    /// hundredth of a second away while the desk runs.
+    pub fn set_scene(&mut self, scene: &Scene) {
+        let settings = self.overrides.settings(scene);
+        if settings != self.chase.settings() {
+            self.chase = Chase::new(settings);
+            self.reader = MtcReader::new();
+        }
+    }
+
+    /// Reads one MIDI message that arrived at `at`; true when it was MTC (taken here, not
+    /// mapped).
+    pub fn message(&mut self, at: Instant, bytes: &[u8]) -> bool {
+        if !matches!(bytes, [0xF1, _] | [0xF0, 0x7F, _, 0x01, 0x01, ..]) {
+            return false;
+        }
+        let seconds = at.saturating_duration_since(self.epoch).as_secs_f64();
+        if seconds - self.heard_at > RUN_BREAK_SECONDS {
+            self.reader = MtcReader::new();
+        }
+        self.heard_at = seconds;
+        match self.reader.message(bytes) {
+            Some(MtcEvent::Running { frame, rate }) => {
+                self.chase.heard(frame, rate, seconds);
+                self.last = Some((frame, rate));
+            }
+            Some(MtcEvent::Located { frame, rate }) => {
+                self.chase.located(frame, rate, seconds);
+                self.last = Some((frame as f64, rate));
+            }
+            None => {}
+        }
+        true
+    }
+
+    /// Where the timeline is at `now`.
+    pub fn at(&self, now: Instant) -> Chasing {
+        self.chase.at(now.saturating_duration_since(self.epoch).as_secs_f64())
+    }
+
+    /// One line for the overlay: the last label heard, its rate, and whether the show is
+    /// locked to it.
+    pub fn status(&self, now: Instant) -> String {
+        let Some((frame, rate)) = self.last else { return "MTC: waiting for code".into() };
+        let label = rate.timecode(frame.max(0.0) as u64);
+        let state = match self.at(now) {
+            Chasing::NoCode => "waiting".to_string(),
+            Chasing::Locked { .. } => "locked".to_string(),
+            Chasing::Freewheel { for_seconds, .. } => format!("freewheel {for_seconds:.1} s"),
+            Chasing::Stopped { .. } => "stopped".to_string(),
+        };
+        format!("MTC {label} ({rate}): {state}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::time::Duration;
+
+    use super::*;
+    use crate::timecode::mtc::{full_frame, quarter_frame};
+
+    #[test]
+    fn quarter_frames_lock_the_timeline_to_the_code_and_other_messages_pass() {
+        let start = Timecode::parse("01:00:00:00").unwrap();
+        let scene = crate::scene::load_scene(&crate::assets::Assets::new(None), "kleinian_classic").unwrap();
+        let mut mtc = MtcChase::new(ChaseOverrides { start: Some(start), freewheel: Some(1.0) }, &scene);
+        let t0 = mtc.epoch;
+        assert!(!mtc.message(t0, &[0x90, 60, 100]), "a note is not MTC");
+        assert_eq!(mtc.at(t0), Chasing::NoCode);
+        let rate = Rate::Fps25;
+        // A desk running from 01:00:10:00, a quarter frame every 10 ms.
+        let from = rate.count(Timecode::parse("01:00:10:00").unwrap()).unwrap();
+        let at = |q: u64| t0 + Duration::from_millis(10 * q);
+        for q in 0..16 {
+            assert!(mtc.message(at(q), &quarter_frame(from * 4 + q, rate)));
+        }
+        // The last piece (15) came at 150 ms, when the desk was 3.75 frames on.
+        let seconds = mtc.at(at(15)).seconds().unwrap();
+        assert!((seconds - (10.0 + 3.75 / 25.0)).abs() < 1e-9, "{seconds}");
+        assert!(mtc.status(at(15)).contains("locked") && mtc.status(at(15)).contains("01:00:10:03"));
+        // After a dropout of a second (past the freewheel) the desk goes on 24 frames later, from
+        // a piece 0: those pieces are not counted on from before the dropout; the first whole
+        // label is the position.
+        let later = |q: u64| at(q) + Duration::from_secs(1);
+        for q in 16..23 {
+            mtc.message(later(q), &quarter_frame(from * 4 + 96 + q, rate));
+            let seconds = mtc.at(later(q)).seconds().unwrap();
+            assert!(seconds > 11.0, "{q}: back to {seconds}");
+        }
+        mtc.message(later(23), &quarter_frame(from * 4 + 96 + 23, rate));
+        let seconds = mtc.at(later(23)).seconds().unwrap();
+        assert!((seconds - (10.0 + 29.75 / 25.0)).abs() < 1e-9, "{seconds}");
+        // Silence past the freewheel stops it; a full frame locates.
+        assert!(matches!(mtc.at(later(23) + Duration::from_millis(500)), Chasing::Freewheel { .. }));
+        assert!(matches!(mtc.at(later(23) + Duration::from_secs(2)), Chasing::Stopped { .. }));
+        let back = rate.count(Timecode::parse("01:00:02:00").unwrap()).unwrap();
+        assert!(mtc.message(at(300), &full_frame(back, rate)));
+        assert_eq!(mtc.at(at(400)), Chasing::Stopped { seconds: 2.0 });
+    }
+}
