@@ -51,6 +51,12 @@ impl WindowChase {
         }
     }
 
+    /// Drops a seek in progress: it was built from a scene or on a device that is no longer the
+    /// show's (a reload, a new device). The next frame seeks again if the code is still away.
+    pub(super) fn cancel(&mut self) {
+        self.seek = None;
+    }
+
     /// The steps `player` runs now to show the frame `chasing` says; a sought scene that is
     /// ready replaces `player` and `runtime` first.
     pub(super) fn steps(

@@ -297,8 +297,10 @@ impl Running {
         match crate::live::recover(&trouble, &self.gpu, Some(&self.surface), &mut self.player, live, &self.assets, size)
         {
             Ok((gpu, message)) => {
-                // The take's buffers lived on the old device: it ends here, with what it has.
+                // The take's buffers lived on the old device: it ends here, with what it has. So
+                // did a seek's scene.
                 self.stop_recording();
+                self.chase.cancel();
                 self.surface.configure(&gpu.device, &self.config);
                 for output in &mut self.outputs {
                     output.reconfigure(&gpu);
@@ -480,6 +482,9 @@ impl Running {
         }
         for f in &report.applied {
             log::info!("reloaded {f}");
+        }
+        if !report.applied.is_empty() {
+            self.chase.cancel();
         }
         if !report.fixed.is_empty() {
             self.overlay.clear_errors();
