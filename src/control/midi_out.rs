@@ -13,7 +13,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use super::midi::Binding;
-use super::mtc_out::{MtcFollower, code_seconds};
+use super::mtc_out::code_seconds;
 use crate::params::{ParamType, ParamValue, TempoClock};
 use crate::scene::{MidiCurve, SceneView};
 use crate::timecode::Rate;
@@ -173,7 +173,7 @@ fn run(port: &str, clock: bool, mtc: Option<Rate>, messages: &Receiver<Vec<u8>>,
     let mut probe: Option<midir::MidiOutput> = None;
     let mut last_scan: Option<Instant> = None;
     let mut clock_state = ClockFollower::default();
-    let mut code = mtc.map(MtcFollower::new);
+    let mut code = mtc.map(super::mtc_out::MtcFollower::new);
     while !shared.stop.load(Ordering::Relaxed) {
         if last_scan.is_none_or(|t| t.elapsed() >= Duration::from_secs(1)) {
             last_scan = Some(Instant::now());
