@@ -86,14 +86,9 @@ impl WindowChase {
                 0
             }
         };
-        let shown = if steps == 0 { player.last_step().frame } else { next + u64::from(steps) - 1 };
-        let unix = SystemTime::now().duration_since(SystemTime::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64());
-        let state = match chasing {
-            Chasing::Locked { .. } => "locked",
-            Chasing::Freewheel { .. } => "freewheel",
-            _ => "stopped",
-        };
-        log::debug!(target: "indra::chase", "unix {unix:.4} code {seconds:.4} s wants {wanted} shows {shown} {state}");
+        if log::log_enabled!(target: "indra::chase", log::Level::Debug) {
+            log_frame(chasing, seconds, wanted, player, next, steps);
+        }
         steps
     }
 
@@ -132,4 +127,17 @@ impl WindowChase {
         let scene = player.instance().scene().clone();
         self.seek = Some(BackgroundSeek::start(from.gpu, from.assets, scene, from.size, frame));
     }
+}
+
+/// One frame's chase in the log (`RUST_LOG=indra::chase=debug`): the wall clock, the code's
+/// position, the frame it wants and the frame shown — what the MTC test compares with its desk.
+fn log_frame(chasing: Chasing, seconds: f64, wanted: u64, player: &Player, next: u64, steps: u32) {
+    let shown = if steps == 0 { player.last_step().frame } else { next + u64::from(steps) - 1 };
+    let unix = SystemTime::now().duration_since(SystemTime::UNIX_EPOCH).map_or(0.0, |d| d.as_secs_f64());
+    let state = match chasing {
+        Chasing::Locked { .. } => "locked",
+        Chasing::Freewheel { .. } => "freewheel",
+        _ => "stopped",
+    };
+    log::debug!(target: "indra::chase", "unix {unix:.4} code {seconds:.4} s wants {wanted} shows {shown} {state}");
 }

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use indra::control::audio::AudioFile;
 use indra::scene::Scene;
 use indra::timecode::Timecode;
-use indra::timecode::chase::{Chase, ChaseSettings, frame_at};
+use indra::timecode::chase::{Chase, ChaseOverrides, ChaseSettings, frame_at};
 use indra::timecode::ltc::{LtcDecoder, LtcFrame};
 
 /// The LTC a render chases.
@@ -43,8 +43,7 @@ pub struct LtcArgs {
 impl LtcArgs {
     /// How `scene` chases: these flags over its show's `timeline.chase`, over the defaults.
     pub fn settings(&self, scene: &Scene) -> ChaseSettings {
-        let own = scene.show.as_ref().and_then(|show| show.timeline.chase).unwrap_or_default();
-        ChaseSettings { start: self.ltc_start.unwrap_or(own.start), freewheel: self.freewheel.unwrap_or(own.freewheel) }
+        ChaseOverrides { start: self.ltc_start, freewheel: self.freewheel }.over(scene.chase())
     }
 }
 

@@ -245,7 +245,7 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         mtc_out: args.mtc_out,
         mtc_in: args
             .mtc_in
-            .then_some(indra::control::mtc_in::ChaseOverrides { start: args.chase_start, freewheel: args.freewheel }),
+            .then_some(indra::timecode::chase::ChaseOverrides { start: args.chase_start, freewheel: args.freewheel }),
         record: args.record_controls.clone(),
         presets_dir: args.presets.clone().unwrap_or_else(|| indra::files::user_data("presets")),
         learn_file: args.midi_learn.clone().unwrap_or_else(|| indra::files::user_data("midi-learn.ron")),
@@ -289,12 +289,13 @@ fn parse_web_sessions(text: &str) -> Result<usize, String> {
         .ok_or_else(|| format!("{text}: WebSocket sessions are {} to {}", range.start(), range.end()))
 }
 
-/// A freewheel time: 0 to 3600 seconds, as a show's `timeline.chase` takes it.
+/// A freewheel time, in the range a show's `timeline.chase` takes.
 fn parse_freewheel(text: &str) -> Result<f64, String> {
+    use indra::timecode::chase::MAX_FREEWHEEL;
     text.parse::<f64>()
         .ok()
-        .filter(|s| (0.0..=3600.0).contains(s))
-        .ok_or_else(|| format!("{text}: a freewheel is 0 to 3600 seconds"))
+        .filter(|s| (0.0..=MAX_FREEWHEEL).contains(s))
+        .ok_or_else(|| format!("{text}: a freewheel is 0 to {MAX_FREEWHEEL} seconds"))
 }
 
 /// Prints the audio input devices, one per line.

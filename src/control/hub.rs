@@ -50,7 +50,7 @@ pub struct ControlOptions {
     /// MTC out (on the `midi_out` port) at this rate, for the show's position.
     pub mtc_out: Option<crate::timecode::Rate>,
     /// Chase MTC from the MIDI inputs, with these settings over the show's.
-    pub mtc_in: Option<super::mtc_in::ChaseOverrides>,
+    pub mtc_in: Option<crate::timecode::chase::ChaseOverrides>,
     /// Record the control stream to this file.
     pub record: Option<PathBuf>,
     /// Folder of presets.

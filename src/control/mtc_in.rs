@@ -6,27 +6,9 @@
 use std::time::Instant;
 
 use crate::scene::Scene;
-use crate::timecode::chase::{Chase, ChaseSettings, Chasing};
+use crate::timecode::Rate;
+use crate::timecode::chase::{Chase, ChaseOverrides, Chasing};
 use crate::timecode::mtc::{MtcEvent, MtcReader};
-use crate::timecode::{Rate, Timecode};
-
-/// What the command line says over the show's `timeline.chase` (each `None`: the show's, else
-/// the default).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ChaseOverrides {
-    /// The label at the timeline's first frame.
-    pub start: Option<Timecode>,
-    /// Seconds the timeline runs on when the code drops out.
-    pub freewheel: Option<f64>,
-}
-
-impl ChaseOverrides {
-    /// How `scene` chases: these over its show's chase, over the defaults.
-    pub fn settings(&self, scene: &Scene) -> ChaseSettings {
-        let own = scene.show.as_ref().and_then(|show| show.timeline.chase).unwrap_or_default();
-        ChaseSettings { start: self.start.unwrap_or(own.start), freewheel: self.freewheel.unwrap_or(own.freewheel) }
-    }
-}
 
 /// The MTC chase of a running show.
 #[derive(Clone, Debug)]
@@ -50,14 +32,14 @@ const RUN_BREAK_SECONDS: f64 = 0.1;
 impl MtcChase {
     /// A chase of `scene` as `overrides` say, that has heard nothing.
     pub fn new(overrides: ChaseOverrides, scene: &Scene) -> Self {
-        let chase = Chase::new(overrides.settings(scene));
+        let chase = Chase::new(overrides.over(scene.chase()));
         Self { overrides, reader: MtcReader::new(), chase, epoch: Instant::now(), last: None, heard_at: 0.0 }
     }
 
     /// Takes a reloaded show's chase settings; the code is found again from the next message, a
     /// hundredth of a second away while the desk runs.
     pub fn set_scene(&mut self, scene: &Scene) {
-        let settings = self.overrides.settings(scene);
+        let settings = self.overrides.over(scene.chase());
         if settings != self.chase.settings() {
             self.chase = Chase::new(settings);
             self.reader = MtcReader::new();
@@ -114,6 +96,7 @@ mod tests {
     use std::time::Duration;
 
     use super::*;
+    use crate::timecode::Timecode;
     use crate::timecode::mtc::{full_frame, quarter_frame};
 
     #[test]

@@ -78,8 +78,9 @@ impl BackgroundSeek {
     pub fn try_take(&mut self) -> Option<Result<Sought, String>> {
         match self.done.try_recv() {
             Ok(result) => Some(result),
-            Err(TryRecvError::Empty) if self.thread.is_some() => None,
-            Err(_) => Some(Err("the seek thread ended without a result".into())),
+            Err(TryRecvError::Empty) => None,
+            // The thread could not start, or ended without sending (it panicked).
+            Err(TryRecvError::Disconnected) => Some(Err("the seek thread ended without a result".into())),
         }
     }
 

@@ -193,6 +193,11 @@ impl std::fmt::Debug for SceneNode {
 }
 
 impl Scene {
+    /// The timecode its show's timeline chases, if it says.
+    pub fn chase(&self) -> Option<crate::timecode::chase::ChaseSettings> {
+        self.show.as_ref().and_then(|show| show.timeline.chase)
+    }
+
     /// Whether some node samples sound (the audio analysis runs for it).
     pub fn hears_audio(&self) -> bool {
         self.nodes.iter().any(|n| n.hears_audio)

@@ -24,6 +24,27 @@ impl Default for ChaseSettings {
     }
 }
 
+/// The longest freewheel a show or the command line may ask for, seconds.
+pub const MAX_FREEWHEEL: f64 = 3600.0;
+
+/// Chase settings given on the command line over a show's own (each `None`: the show's, else
+/// the default).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ChaseOverrides {
+    /// The label at the timeline's first frame.
+    pub start: Option<Timecode>,
+    /// Seconds the timeline runs on when the code drops out.
+    pub freewheel: Option<f64>,
+}
+
+impl ChaseOverrides {
+    /// These over `own` (a show's `timeline.chase`), over the defaults.
+    pub fn over(self, own: Option<ChaseSettings>) -> ChaseSettings {
+        let own = own.unwrap_or_default();
+        ChaseSettings { start: self.start.unwrap_or(own.start), freewheel: self.freewheel.unwrap_or(own.freewheel) }
+    }
+}
+
 /// The code last heard.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Heard {

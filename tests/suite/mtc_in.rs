@@ -76,14 +76,15 @@ fn now() -> f64 {
     std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap().as_secs_f64()
 }
 
-/// How far the show's code is from the desk's over a run's lines (past its first 0.2 s, which
-/// read the first whole label): the median and the 90th percentile, in seconds.
+/// A run's locked lines, past its first 0.2 s (which read the first whole label).
+fn locked(lines: &[Line], run: Run) -> Vec<&Line> {
+    lines.iter().filter(|l| l.unix > run.began + 0.2 && l.unix < run.ended && l.state == "locked").collect()
+}
+
+/// How far the show's code is from the desk's over a run's locked lines: the median and the
+/// 90th percentile, in seconds.
 fn errors(lines: &[Line], run: Run) -> (f64, f64, usize) {
-    let mut errors: Vec<f64> = lines
-        .iter()
-        .filter(|l| l.unix > run.began + 0.2 && l.unix < run.ended && l.state == "locked")
-        .map(|l| (l.code - run.seconds(l.unix)).abs())
-        .collect();
+    let mut errors: Vec<f64> = locked(lines, run).iter().map(|l| (l.code - run.seconds(l.unix)).abs()).collect();
     errors.sort_by(f64::total_cmp);
     assert!(errors.len() > 20, "{} locked frames in the run {run:?}", errors.len());
     (errors[errors.len() / 2], errors[errors.len() * 9 / 10], errors.len())
@@ -136,11 +137,7 @@ fn a_show_chases_mtc_through_a_jump_a_dropout_and_a_stop() {
         let (median, p90, count) = errors(&lines, run);
         eprintln!("run {run:?}: {count} frames, code off the desk's by {median:.4} s median, {p90:.4} s p90");
         assert!(median < 0.02 && p90 < 0.04, "code off by {median:.4} s median, {p90:.4} s p90 in {run:?}");
-        let locked: Vec<&Line> = lines
-            .iter()
-            .filter(|l| l.unix > run.began + 0.2 && l.unix < run.ended && l.state == "locked")
-            .skip_while(|l| l.shows != l.wants)
-            .collect();
+        let locked: Vec<&Line> = locked(&lines, run).into_iter().skip_while(|l| l.shows != l.wants).collect();
         let on_it = locked.iter().filter(|l| l.shows == l.wants).count();
         assert!(locked.len() > 20, "the show reached the code's frame late or never in {run:?}");
         assert!(on_it * 10 >= locked.len() * 9, "{on_it} of {} locked frames show the code's frame", locked.len());

@@ -20,7 +20,7 @@ use crate::scene::model::{BoundTrack, SceneNode};
 use crate::scene::schema::TrackFile;
 use crate::scene::validate::bind_track;
 use crate::timecode::Timecode;
-use crate::timecode::chase::ChaseSettings;
+use crate::timecode::chase::{ChaseSettings, MAX_FREEWHEEL};
 
 /// The most lanes a timeline may have.
 pub const MAX_LANES: usize = 1024;
@@ -130,9 +130,10 @@ pub fn build_timeline(file: &TimelineFile, nodes: &[SceneNode], show: &Show, dt:
     if let Some(chase) = &file.chase {
         match Timecode::parse(&chase.start) {
             Err(e) => problems.push(("chase".into(), format!("chase start: {e}"))),
-            Ok(_) if !(0.0..=3600.0).contains(&chase.freewheel) => {
-                problems.push(("freewheel".into(), format!("freewheel {} must be 0 to 3600 seconds", chase.freewheel)))
-            }
+            Ok(_) if !(0.0..=MAX_FREEWHEEL).contains(&chase.freewheel) => problems.push((
+                "freewheel".into(),
+                format!("freewheel {} must be 0 to {MAX_FREEWHEEL} seconds", chase.freewheel),
+            )),
             Ok(start) => timeline.chase = Some(ChaseSettings { start, freewheel: chase.freewheel }),
         }
     }
