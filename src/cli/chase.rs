@@ -91,7 +91,7 @@ impl LtcTrack {
     pub fn frame_at(&mut self, seconds: f64, dt: f64) -> u64 {
         while let Some(frame) = self.frames.get(self.heard).filter(|f| f.end / self.rate <= seconds + 1e-6) {
             self.heard += 1;
-            if let Some(position) = position(frame) {
+            if let Some(position) = frame.position() {
                 self.chase.heard(position, frame.rate, frame.end / self.rate);
             }
         }
@@ -105,7 +105,7 @@ impl LtcTrack {
         let mut probe = Chase::new(settings);
         let mut last = 0;
         for frame in &self.frames {
-            if let Some(position) = position(frame) {
+            if let Some(position) = frame.position() {
                 probe.heard(position, frame.rate, 0.0);
                 last = last.max(probe.at(settings.freewheel).seconds().map_or(0, |s| frame_at(s, dt)));
             }
@@ -117,11 +117,4 @@ impl LtcTrack {
     pub fn frames_read(&self) -> usize {
         self.frames.len()
     }
-}
-
-/// The code's position (a frame count) when `frame` has just been read: forwards a frame ends
-/// where the next begins, backwards where it began.
-fn position(frame: &LtcFrame) -> Option<f64> {
-    let count = frame.rate.count(frame.timecode).ok()? as f64;
-    Some(if frame.reverse { count } else { count + 1.0 })
 }

@@ -10,6 +10,7 @@ use super::{DEFAULT_SCENE, SceneEdits, scene_with_edits, with_scene_folder};
 
 /// `indra run`.
 #[derive(Args, Clone)]
+#[command(group = clap::ArgGroup::new("chase").args(["mtc_in", "ltc_in"]).multiple(false))]
 pub struct RunArgs {
     /// Scene name (from scenes/) or path to a .ron file.
     #[arg(default_value = DEFAULT_SCENE)]
@@ -84,15 +85,23 @@ pub struct RunArgs {
     /// Chase MTC from the MIDI inputs (a desk's quarter frames and locates, at 24, 25, 29.97df
     /// or 30 fps): the timeline shows the frame the code says, holds before any code, runs on
     /// through a dropout for --freewheel seconds, and seeks when the code jumps.
-    #[arg(long, conflicts_with = "no_midi")]
+    #[arg(long, conflicts_with_all = ["no_midi", "ltc_in"])]
     pub mtc_in: bool,
-    /// The code's label at the timeline's first frame for --mtc-in (default: the show's
-    /// `timeline.chase`, else 00:00:00:00).
-    #[arg(long, value_name = "HH:MM:SS:FF", requires = "mtc_in", value_parser = indra::timecode::Timecode::parse)]
+    /// Chase LTC from the audio input (--audio-in; the mix of its channels, or --ltc-channel),
+    /// as --mtc-in chases MTC.
+    #[arg(long, conflicts_with = "no_audio")]
+    pub ltc_in: bool,
+    /// The audio input's channel that carries --ltc-in's code, from 1 (default: the mix of all
+    /// channels, right for an input of the code alone).
+    #[arg(long, value_name = "N", requires = "ltc_in")]
+    pub ltc_channel: Option<u16>,
+    /// The code's label at the timeline's first frame for --mtc-in or --ltc-in (default: the
+    /// show's `timeline.chase`, else 00:00:00:00).
+    #[arg(long, value_name = "HH:MM:SS:FF", requires = "chase", value_parser = indra::timecode::Timecode::parse)]
     pub chase_start: Option<indra::timecode::Timecode>,
-    /// Seconds the timeline runs on when --mtc-in's code drops out, before it holds (default:
+    /// Seconds the timeline runs on when the chased code drops out, before it holds (default:
     /// the show's, else 2).
-    #[arg(long, value_name = "SECONDS", requires = "mtc_in", value_parser = parse_freewheel)]
+    #[arg(long, value_name = "SECONDS", requires = "chase", value_parser = parse_freewheel)]
     pub freewheel: Option<f64>,
     /// Audio input device: the first whose name contains this (default: the default device,
     /// opened when the scene maps audio).
@@ -243,9 +252,7 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         midi_out: args.midi_out.clone(),
         midi_clock: args.midi_clock,
         mtc_out: args.mtc_out,
-        mtc_in: args
-            .mtc_in
-            .then_some(indra::timecode::chase::ChaseOverrides { start: args.chase_start, freewheel: args.freewheel }),
+        chase_in: chase_input(args),
         record: args.record_controls.clone(),
         presets_dir: args.presets.clone().unwrap_or_else(|| indra::files::user_data("presets")),
         learn_file: args.midi_learn.clone().unwrap_or_else(|| indra::files::user_data("midi-learn.ron")),
@@ -287,6 +294,18 @@ fn parse_web_sessions(text: &str) -> Result<usize, String> {
         .ok()
         .filter(|n| range.contains(n))
         .ok_or_else(|| format!("{text}: WebSocket sessions are {} to {}", range.start(), range.end()))
+}
+
+/// The timecode `args` ask the show to chase, if any.
+fn chase_input(args: &RunArgs) -> Option<indra::control::timecode_in::ChaseInput> {
+    use indra::control::timecode_in::{ChaseInput, CodeSource};
+    let source = match (args.mtc_in, args.ltc_in) {
+        (true, _) => CodeSource::Mtc,
+        (_, true) => CodeSource::Ltc { channel: args.ltc_channel },
+        _ => return None,
+    };
+    let overrides = indra::timecode::chase::ChaseOverrides { start: args.chase_start, freewheel: args.freewheel };
+    Some(ChaseInput { source, overrides })
 }
 
 /// A freewheel time, in the range a show's `timeline.chase` takes.

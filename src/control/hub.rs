@@ -18,6 +18,7 @@ use super::presets::{PresetFile, PresetStore};
 use super::record::Recorder;
 use super::site::SiteRules;
 use super::tempo::TempoInput;
+use super::timecode_in::TimecodeIn;
 use super::web::WebOptions;
 use crate::params::{ControlEvent, Remap, ShowCommand, Target};
 use crate::scene::{AudioSource, Scene, SceneView};
@@ -49,8 +50,9 @@ pub struct ControlOptions {
     pub midi_clock: bool,
     /// MTC out (on the `midi_out` port) at this rate, for the show's position.
     pub mtc_out: Option<crate::timecode::Rate>,
-    /// Chase MTC from the MIDI inputs, with these settings over the show's.
-    pub mtc_in: Option<crate::timecode::chase::ChaseOverrides>,
+    /// Chase a timecode (MTC from the MIDI inputs or LTC from the audio input), with these
+    /// settings over the show's.
+    pub chase_in: Option<super::timecode_in::ChaseInput>,
     /// Record the control stream to this file.
     pub record: Option<PathBuf>,
     /// Folder of presets.
@@ -84,7 +86,7 @@ impl Default for ControlOptions {
             midi_out: None,
             midi_clock: false,
             mtc_out: None,
-            mtc_in: None,
+            chase_in: None,
             record: None,
             presets_dir: "presets".into(),
             learn_file: "midi-learn.ron".into(),
@@ -111,8 +113,8 @@ pub struct ControlHub {
     pub web_urls: Vec<String>,
     midi: Option<MidiInput>,
     parser: MidiParser,
-    /// The MTC the timeline chases, when asked for.
-    mtc: Option<super::mtc_in::MtcChase>,
+    /// The timecode the timeline chases, when asked for.
+    chase: Option<TimecodeIn>,
     /// Pad controllers with profiles, when MIDI is on.
     controllers: Option<Controllers>,
     /// MIDI out (mirrored mappings, clock), when asked for.
@@ -182,7 +184,7 @@ impl ControlHub {
         let web_urls = match (&options.web, &oscquery) {
             (Some(web), Some(server)) => {
                 let urls = super::web::urls(server.local_addr(), &web.token);
-                announce_surface(&urls, web.read_only, !server.local_addr().ip().is_loopback());
+                super::web::announce(&urls, web.read_only, !server.local_addr().ip().is_loopback());
                 urls
             }
             _ => Vec::new(),
@@ -214,7 +216,8 @@ impl ControlHub {
         let (audio_learn, problem) = AudioLearn::load(options.audio_learn_file.clone());
         notices.extend(problem);
         let audio_mapper = AudioMapper::with_learned(scene, audio_learn.bound(scene));
-        let audio = open_audio(options.audio_in.as_ref(), !audio_mapper.is_empty(), &mut notices);
+        let code = options.chase_in.and_then(|c| c.ltc_channel());
+        let audio = open_audio(options.audio_in.as_ref(), !audio_mapper.is_empty(), code, &mut notices);
         let dmx = options.dmx_in.as_deref().and_then(|path| {
             let started = super::dmx_in::DmxInFile::load(path).and_then(|file| {
                 let learned = options.learn_file.with_file_name("dmx-learn.ron");
@@ -239,7 +242,7 @@ impl ControlHub {
             web_urls,
             midi,
             parser: MidiParser::default(),
-            mtc: options.mtc_in.map(|o| super::mtc_in::MtcChase::new(o, scene)),
+            chase: options.chase_in.map(|c| TimecodeIn::new(c, scene)),
             controllers,
             midi_out,
             mapper,
@@ -269,8 +272,8 @@ impl ControlHub {
     pub fn set_scene(&mut self, scene: &Scene, remap: Option<&Remap>) {
         self.router = OscRouter::new(scene);
         self.rebuild_audio(scene);
-        if let Some(mtc) = self.mtc.as_mut() {
-            mtc.set_scene(scene);
+        if let Some(chase) = self.chase.as_mut() {
+            chase.set_scene(scene);
         }
         if let Some(dmx) = self.dmx.as_mut() {
             dmx.set_scene(scene, &mut self.notices);
@@ -315,7 +318,7 @@ impl ControlHub {
         }
         let messages = self.midi.as_ref().map(MidiInput::drain).unwrap_or_default();
         for (at, bytes) in messages {
-            if !self.mtc.as_mut().is_some_and(|mtc| mtc.message(at, &bytes)) {
+            if !self.chase.as_mut().is_some_and(|chase| chase.message(at, &bytes)) {
                 events.extend(self.midi_bytes(&bytes, scene, seconds));
             }
         }
@@ -325,6 +328,11 @@ impl ControlHub {
             for e in polled.unused {
                 events.extend(self.midi_event(e, scene, seconds));
             }
+        }
+        if let Some(chase) = self.chase.as_mut()
+            && let Some((samples, rate, first)) = self.audio.as_mut().and_then(LiveSound::code)
+        {
+            chase.audio(&samples, rate, first);
         }
         if let Some(sound) = self.audio.as_mut()
             && let Some((frame, dt)) = sound.analyse()
@@ -352,7 +360,7 @@ impl ControlHub {
     fn rebuild_audio(&mut self, scene: &Scene) {
         self.audio_mapper = AudioMapper::with_learned(scene, self.audio_learn.bound(scene));
         if self.audio.is_none() && !self.audio_mapper.is_empty() && self.audio_wanted == Some(None) {
-            self.audio = open_audio(self.audio_wanted.as_ref(), true, &mut self.notices);
+            self.audio = open_audio(self.audio_wanted.as_ref(), true, None, &mut self.notices);
         }
     }
 
@@ -542,7 +550,7 @@ impl ControlHub {
 
     /// Where the chased timecode puts the timeline at `now`; `None` when the show does not chase.
     pub fn timecode(&self, now: std::time::Instant) -> Option<crate::timecode::chase::Chasing> {
-        self.mtc.as_ref().map(|mtc| mtc.at(now))
+        self.chase.as_ref().map(|chase| chase.at(now))
     }
 
     /// One line of input counters for the overlay.
@@ -562,7 +570,7 @@ impl ControlHub {
         }
         parts.extend(self.controllers.as_ref().and_then(Controllers::status));
         parts.extend(self.midi_out.as_ref().map(MidiOut::status));
-        parts.extend(self.mtc.as_ref().map(|mtc| mtc.status(std::time::Instant::now())));
+        parts.extend(self.chase.as_ref().map(|chase| chase.status(std::time::Instant::now())));
         if let Some(dropped) = self.oscquery.as_ref().map(OscQueryServer::dropped).filter(|&d| d > 0) {
             parts.push(format!("OSCQuery LISTEN: {dropped} changes dropped (a controller fell behind)"));
         }
@@ -579,18 +587,5 @@ impl ControlHub {
     fn notice(&mut self, message: String) {
         log::warn!("{message}");
         self.notices.push(message);
-    }
-}
-
-/// Tells the performer where the browser surface is: each URL, and a QR code of the first for a
-/// phone's camera when the surface is `networked` (not on loopback).
-fn announce_surface(urls: &[String], read_only: bool, networked: bool) {
-    let mode = if read_only { " (read-only)" } else { "" };
-    for url in urls {
-        log::info!("control surface{mode} on {url}");
-    }
-    let Some(first) = urls.first().filter(|_| networked) else { return };
-    if let Some(code) = super::web::qr::terminal(first) {
-        log::info!("scan to open the control surface:\n{code}");
     }
 }

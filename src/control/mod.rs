@@ -19,7 +19,6 @@ pub mod listen;
 pub mod midi;
 pub mod midi_commands;
 pub mod midi_out;
-pub mod mtc_in;
 pub mod mtc_out;
 pub mod osc;
 mod osc_guard;
@@ -29,6 +28,7 @@ pub mod presets;
 pub mod record;
 pub mod site;
 pub mod tempo;
+pub mod timecode_in;
 pub mod web;
 
 pub use address::{AddressMap, Route};

@@ -33,6 +33,16 @@ pub struct LtcFrame {
     pub reverse: bool,
 }
 
+impl LtcFrame {
+    /// The code's position (a frame count, fractional) when this frame has just been read:
+    /// forwards a frame ends where the next begins, backwards where it began. `None` for a label
+    /// that does not exist at its rate (a dropped drop-frame label).
+    pub fn position(&self) -> Option<f64> {
+        let count = self.rate.count(self.timecode).ok()? as f64;
+        Some(if self.reverse { count } else { count + 1.0 })
+    }
+}
+
 /// Reads LTC from audio samples, any level or polarity, at 24 to 30 frames a second.
 #[derive(Clone, Debug)]
 pub struct LtcDecoder {
@@ -80,6 +90,11 @@ impl LtcDecoder {
             position: 0,
             previous: 0.0,
         }
+    }
+
+    /// Samples read so far: the position the next sample has in [`LtcFrame::end`]'s count.
+    pub fn position(&self) -> u64 {
+        self.position
     }
 
     /// Reads `samples` (one channel), appending the frames completed in them to `frames`.

@@ -8,11 +8,18 @@ one per line; each answers one line of JSON on stdout:
   mtc NAME FPS FRAME  run MTC quarter frames at FPS (24, 25 or 30: no drop-frame) from frame
                       count FRAME (even) on; answers the wall-clock time FRAME began
   mtc-stop NAME       stop the MTC (a dropout, or a desk that stops)
+  play NAME FILE PORTS  play FILE (unsigned 8-bit mono samples at the server's rate, as
+                      tests/timecode/ltcgen.c writes LTC) from an audio output of NAME's,
+                      connected to every audio input whose name matches the regex PORTS;
+                      silence after its end
+  played NAME         where the playing file was at each cycle since the last ask:
+                      [[wall-clock seconds, sample index], ...]
   unplug NAME         close NAME's client (its ports vanish, as a USB device's do)
   plug NAME           open it again
   quit
 """
 
+import array
 import json
 import queue
 import sys
@@ -29,6 +36,10 @@ class Device:
         self.received = queue.Queue()
         # A running MTC: (fps, first quarter, wall-clock time of the first, quarters sent).
         self.mtc = None
+        # A playing file: (samples as floats, next index), its audio port, and the cycles' stamps.
+        self.playing = None
+        self.audio = None
+        self.cycles = queue.Queue()
 
     def plug(self):
         client = jack.Client(self.name, no_start_server=True)
@@ -44,6 +55,7 @@ class Device:
                     break
                 output.write_midi_event(0, data)
             self.run_mtc(output)
+            self.play(frames)
             # Stamped on the wall clock when the cycle runs (JACK's frame clock runs behind it
             # on a busy machine, where the server waits for late clients).
             now = time.monotonic()
@@ -63,6 +75,30 @@ class Device:
         for quarter in range(first + sent, due):
             output.write_midi_event(0, quarter_frame(quarter, fps))
         self.mtc = (fps, first, began, max(sent, due - first))
+
+    def play(self, frames):
+        """Writes this cycle's samples of the playing file (silence past its end)."""
+        if self.audio is None:
+            return
+        buffer = self.audio.get_buffer()
+        buffer[:] = bytes(len(buffer))
+        if self.playing is None:
+            return
+        samples, at = self.playing
+        chunk = samples[at:at + frames].tobytes()
+        buffer[:len(chunk)] = chunk
+        self.playing = (samples, at + frames)
+        # Stamped on the wall clock as the MTC is: the cycle's first sample goes out now.
+        self.cycles.put((time.time(), at))
+
+    def start_playing(self, path, ports):
+        with open(path, "rb") as f:
+            samples = array.array("f", ((b - 128) / 160 for b in f.read()))
+        if self.audio is None:
+            self.audio = self.client.outports.register("audio")
+        for port in self.client.get_ports(ports, is_audio=True, is_input=True):
+            self.client.connect(self.audio, port)
+        self.playing = (samples, 0)
 
     def unplug(self):
         self.client.deactivate()
@@ -129,6 +165,13 @@ def main():
             began = time.time()
             device.mtc = (fps, frame * 4, began, 0)
             answer = began
+        elif command == "play":
+            device.start_playing(words[2], words[3])
+            answer = "playing"
+        elif command == "played":
+            answer = []
+            while not device.cycles.empty():
+                answer.append(device.cycles.get_nowait())
         elif command == "mtc-stop":
             device.mtc = None
             answer = "stopped"

@@ -1,5 +1,5 @@
 //! Pad controllers end to end on a real MIDI system: JACK (`jackd` with its dummy driver, no
-//! sound card needed) carries the messages between a live show — built with `midi-jack`, midir's
+//! sound card needed) carries the messages between a live show — built with `jack`, midir's
 //! JACK backend — and simulated controllers, JACK clients from PyPI's JACK-Client
 //! (`tests/midi/controllers.py`) that name their ports as the real devices do. What a pad does
 //! is read back over OSCQuery; what the show lights is what each client received. Without
@@ -15,7 +15,7 @@ use crate::live_show::{Show, VirtualDisplay, scratch_dir};
 use crate::osc::http_get;
 
 /// Says why a peer is missing; fails on CI.
-fn skip(problem: &str) {
+pub(crate) fn skip(problem: &str) {
     assert!(std::env::var_os("CI").is_none(), "CI runs the controller tests: {problem}");
     eprintln!("skipped: {problem}");
 }
@@ -34,7 +34,7 @@ static TURN: std::sync::Mutex<()> = std::sync::Mutex::new(());
 impl Jack {
     pub(crate) fn start() -> Option<Self> {
         if !cfg!(feature = "midi-jack") {
-            skip("this test build has no JACK MIDI (tools/test builds with --features midi-jack)");
+            skip("this test build has no JACK MIDI (tools/test builds with --features jack)");
             return None;
         }
         // A server per test: tests run in parallel, and one show's controllers must not see

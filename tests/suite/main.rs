@@ -6,6 +6,7 @@
 mod architecture;
 mod audio;
 mod browser;
+mod chase_in;
 mod checkpoints;
 #[path = "../support/chromium.rs"]
 mod chromium;
@@ -28,7 +29,6 @@ mod live_show;
 mod media;
 mod midi_out;
 mod msaa;
-mod mtc_in;
 mod ndi;
 mod osc;
 #[cfg(target_os = "linux")]

@@ -47,7 +47,7 @@ fn libltc() -> Option<(PathBuf, PathBuf)> {
 }
 
 /// libltc's generator.
-fn ltcgen() -> Option<PathBuf> {
+pub(crate) fn ltcgen() -> Option<PathBuf> {
     libltc().map(|(generator, _)| generator)
 }
 

@@ -1,26 +1,69 @@
-//! Chasing a desk's MTC on the MIDI inputs: quarter frames and full-frame locates, read as they
-//! arrive (the MIDI thread stamps each message), into the chase of [`crate::timecode::chase`].
-//! The window asks where the timeline is at the instant it steps; the answer runs on between
-//! quarter frames at the code's speed, freewheels through a dropout, and stops after it.
+//! Chasing a sound desk's timecode live: MTC on the MIDI inputs (quarter frames and full-frame
+//! locates, stamped by the MIDI thread as they arrive) or LTC on the audio input (stamped by the
+//! audio callback with the time its first sample was captured), into the chase of
+//! [`crate::timecode::chase`]. The window asks where the timeline is at the instant it steps; the
+//! answer runs on between code frames at the code's speed, freewheels through a dropout, and
+//! stops after it.
 
 use std::time::Instant;
 
 use crate::scene::Scene;
 use crate::timecode::Rate;
 use crate::timecode::chase::{Chase, ChaseOverrides, Chasing};
+use crate::timecode::ltc::LtcDecoder;
 use crate::timecode::mtc::{MtcEvent, MtcReader};
 
-/// The MTC chase of a running show.
+/// Where the code comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CodeSource {
+    /// MTC on the MIDI inputs.
+    Mtc,
+    /// LTC on the audio input: one channel (from 1), or the mix of all.
+    Ltc {
+        /// The channel that carries the code; `None`: the mix.
+        channel: Option<u16>,
+    },
+}
+
+/// How a running show chases: the source and the settings given over the show's own.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChaseInput {
+    /// Where the code comes from.
+    pub source: CodeSource,
+    /// The command line's start and freewheel, over the show's.
+    pub overrides: ChaseOverrides,
+}
+
+impl ChaseInput {
+    /// The audio input's channel an LTC chase reads (from 1, or `None` for the mix); `None` for
+    /// an MTC chase.
+    pub fn ltc_channel(&self) -> Option<Option<u16>> {
+        match self.source {
+            CodeSource::Ltc { channel } => Some(channel),
+            CodeSource::Mtc => None,
+        }
+    }
+}
+
+/// What reads the code.
 #[derive(Clone, Debug)]
-pub struct MtcChase {
-    overrides: ChaseOverrides,
-    reader: MtcReader,
+enum Reader {
+    Mtc(MtcReader),
+    /// The decoder, made at the input's sample rate when the first samples come.
+    Ltc(Option<Box<LtcDecoder>>),
+}
+
+/// The timecode chase of a running show.
+#[derive(Clone, Debug)]
+pub struct TimecodeIn {
+    input: ChaseInput,
+    reader: Reader,
     chase: Chase,
     /// Local time 0 of the chase's clock.
     epoch: Instant,
     /// The last position read, for the status line.
     last: Option<(f64, Rate)>,
-    /// When the last MTC message came (seconds on the chase's clock).
+    /// When the code was last heard (seconds on the chase's clock).
     heard_at: f64,
 }
 
@@ -29,35 +72,49 @@ pub struct MtcChase {
 /// read a whole label again rather than go on from where the code was.
 const RUN_BREAK_SECONDS: f64 = 0.1;
 
-impl MtcChase {
-    /// A chase of `scene` as `overrides` say, that has heard nothing.
-    pub fn new(overrides: ChaseOverrides, scene: &Scene) -> Self {
-        let chase = Chase::new(overrides.over(scene.chase()));
-        Self { overrides, reader: MtcReader::new(), chase, epoch: Instant::now(), last: None, heard_at: 0.0 }
+impl TimecodeIn {
+    /// A chase of `scene` as `input` says, that has heard nothing.
+    pub fn new(input: ChaseInput, scene: &Scene) -> Self {
+        let chase = Chase::new(input.overrides.over(scene.chase()));
+        let reader = Self::reader(input.source);
+        Self { input, reader, chase, epoch: Instant::now(), last: None, heard_at: 0.0 }
     }
 
-    /// Takes a reloaded show's chase settings; the code is found again from the next message, a
-    /// hundredth of a second away while the desk runs.
-    pub fn set_scene(&mut self, scene: &Scene) {
-        let settings = self.overrides.over(scene.chase());
-        if settings != self.chase.settings() {
-            self.chase = Chase::new(settings);
-            self.reader = MtcReader::new();
+    fn reader(source: CodeSource) -> Reader {
+        match source {
+            CodeSource::Mtc => Reader::Mtc(MtcReader::new()),
+            CodeSource::Ltc { .. } => Reader::Ltc(None),
         }
     }
 
-    /// Reads one MIDI message that arrived at `at`; true when it was MTC (taken here, not
-    /// mapped).
+    /// Where the code comes from.
+    pub fn source(&self) -> CodeSource {
+        self.input.source
+    }
+
+    /// Takes a reloaded show's chase settings; the code is found again from the next frame of
+    /// it, a few hundredths of a second away while the desk runs.
+    pub fn set_scene(&mut self, scene: &Scene) {
+        let settings = self.input.overrides.over(scene.chase());
+        if settings != self.chase.settings() {
+            self.chase = Chase::new(settings);
+            self.reader = Self::reader(self.input.source);
+        }
+    }
+
+    /// Reads one MIDI message that arrived at `at`; true when it was MTC taken by an MTC chase
+    /// (not to be mapped).
     pub fn message(&mut self, at: Instant, bytes: &[u8]) -> bool {
+        let Reader::Mtc(reader) = &mut self.reader else { return false };
         if !matches!(bytes, [0xF1, _] | [0xF0, 0x7F, _, 0x01, 0x01, ..]) {
             return false;
         }
         let seconds = at.saturating_duration_since(self.epoch).as_secs_f64();
         if seconds - self.heard_at > RUN_BREAK_SECONDS {
-            self.reader = MtcReader::new();
+            *reader = MtcReader::new();
         }
         self.heard_at = seconds;
-        match self.reader.message(bytes) {
+        match reader.message(bytes) {
             Some(MtcEvent::Running { frame, rate }) => {
                 self.chase.heard(frame, rate, seconds);
                 self.last = Some((frame, rate));
@@ -71,15 +128,37 @@ impl MtcChase {
         true
     }
 
+    /// Reads audio for an LTC chase: `samples` at `rate` a second, the first captured at
+    /// `first`. Each code frame read counts at the time its last bit ended.
+    pub fn audio(&mut self, samples: &[f32], rate: u32, first: Instant) {
+        let Reader::Ltc(decoder) = &mut self.reader else { return };
+        let decoder = decoder.get_or_insert_with(|| Box::new(LtcDecoder::new(rate)));
+        let start = decoder.position() as f64;
+        let first = first.saturating_duration_since(self.epoch).as_secs_f64();
+        let mut frames = Vec::new();
+        decoder.write(samples, &mut frames);
+        for frame in frames {
+            let Some(position) = frame.position() else { continue };
+            let at = first + (frame.end - start) / f64::from(rate);
+            self.chase.heard(position, frame.rate, at);
+            self.last = Some((position, frame.rate));
+            self.heard_at = at;
+        }
+    }
+
     /// Where the timeline is at `now`.
     pub fn at(&self, now: Instant) -> Chasing {
         self.chase.at(now.saturating_duration_since(self.epoch).as_secs_f64())
     }
 
-    /// One line for the overlay: the last label heard, its rate, and whether the show is
-    /// locked to it.
+    /// One line for the overlay: the source, the last label heard, its rate, and whether the
+    /// show is locked to it.
     pub fn status(&self, now: Instant) -> String {
-        let Some((frame, rate)) = self.last else { return "MTC: waiting for code".into() };
+        let source = match self.input.source {
+            CodeSource::Mtc => "MTC",
+            CodeSource::Ltc { .. } => "LTC",
+        };
+        let Some((frame, rate)) = self.last else { return format!("{source}: waiting for code") };
         let label = rate.timecode(frame.max(0.0) as u64);
         let state = match self.at(now) {
             Chasing::NoCode => "waiting".to_string(),
@@ -87,7 +166,7 @@ impl MtcChase {
             Chasing::Freewheel { for_seconds, .. } => format!("freewheel {for_seconds:.1} s"),
             Chasing::Stopped { .. } => "stopped".to_string(),
         };
-        format!("MTC {label} ({rate}): {state}")
+        format!("{source} {label} ({rate}): {state}")
     }
 }
 
@@ -103,7 +182,8 @@ mod tests {
     fn quarter_frames_lock_the_timeline_to_the_code_and_other_messages_pass() {
         let start = Timecode::parse("01:00:00:00").unwrap();
         let scene = crate::scene::load_scene(&crate::assets::Assets::new(None), "kleinian_classic").unwrap();
-        let mut mtc = MtcChase::new(ChaseOverrides { start: Some(start), freewheel: Some(1.0) }, &scene);
+        let overrides = ChaseOverrides { start: Some(start), freewheel: Some(1.0) };
+        let mut mtc = TimecodeIn::new(ChaseInput { source: CodeSource::Mtc, overrides }, &scene);
         let t0 = mtc.epoch;
         assert!(!mtc.message(t0, &[0x90, 60, 100]), "a note is not MTC");
         assert_eq!(mtc.at(t0), Chasing::NoCode);
