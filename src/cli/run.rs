@@ -82,6 +82,14 @@ pub struct RunArgs {
     /// its first frame labelled as its timeline's chase start says (else 00:00:00:00).
     #[arg(long, value_name = "RATE", requires = "midi_out")]
     pub mtc_out: Option<indra::timecode::Rate>,
+    /// Send LTC at this rate (24, 25, 29.97df or 30) on the audio output's first channel (the
+    /// default output, or --audio-out): the show's position, labelled as for --mtc-out.
+    #[arg(long, value_name = "RATE")]
+    pub ltc_out: Option<indra::timecode::Rate>,
+    /// Audio output for --ltc-out: the first whose name contains this (default: the default
+    /// output).
+    #[arg(long, value_name = "NAME", requires = "ltc_out")]
+    pub audio_out: Option<String>,
     /// Chase MTC from the MIDI inputs (a desk's quarter frames and locates, at 24, 25, 29.97df
     /// or 30 fps): the timeline shows the frame the code says, holds before any code, runs on
     /// through a dropout for --freewheel seconds, and seeks when the code jumps.
@@ -252,6 +260,8 @@ pub fn run(assets: &Assets, gpu: &GpuOptions, args: &RunArgs) -> Result<(), Stri
         midi_out: args.midi_out.clone(),
         midi_clock: args.midi_clock,
         mtc_out: args.mtc_out,
+        ltc_out: args.ltc_out,
+        audio_out: args.audio_out.clone(),
         chase_in: chase_input(args),
         record: args.record_controls.clone(),
         presets_dir: args.presets.clone().unwrap_or_else(|| indra::files::user_data("presets")),

@@ -9,6 +9,7 @@ use super::audio::sound::{LiveSound, open_audio};
 use super::audio::{AudioFrame, AudioLearn, AudioMapper};
 use super::controller::Controllers;
 use super::feedback::{OscFeedback, ParamChanges};
+use super::ltc_out::LtcOut;
 use super::midi::{LearnStore, MidiEvent, MidiInput, MidiMapper, MidiParser};
 use super::midi_out::MidiOut;
 use super::osc::OscReceiver;
@@ -50,6 +51,10 @@ pub struct ControlOptions {
     pub midi_clock: bool,
     /// MTC out (on the `midi_out` port) at this rate, for the show's position.
     pub mtc_out: Option<crate::timecode::Rate>,
+    /// LTC out at this rate on the audio output (`audio_out`'s, else the default).
+    pub ltc_out: Option<crate::timecode::Rate>,
+    /// The first audio output whose name contains this, for `ltc_out`.
+    pub audio_out: Option<String>,
     /// Chase a timecode (MTC from the MIDI inputs or LTC from the audio input), with these
     /// settings over the show's.
     pub chase_in: Option<super::timecode_in::ChaseInput>,
@@ -86,6 +91,8 @@ impl Default for ControlOptions {
             midi_out: None,
             midi_clock: false,
             mtc_out: None,
+            ltc_out: None,
+            audio_out: None,
             chase_in: None,
             record: None,
             presets_dir: "presets".into(),
@@ -117,6 +124,8 @@ pub struct ControlHub {
     chase: Option<TimecodeIn>,
     /// Pad controllers with profiles, when MIDI is on.
     controllers: Option<Controllers>,
+    /// LTC out, when asked for.
+    ltc_out: Option<LtcOut>,
     /// MIDI out (mirrored mappings, clock), when asked for.
     midi_out: Option<MidiOut>,
     /// MIDI mappings, learn state and clock.
@@ -181,33 +190,27 @@ impl ControlHub {
         let oscquery = query_addr.and_then(|a| {
             OscQueryServer::start_with(a, osc_port, surface, &options.sites).map_err(|e| report(Err(e))).ok()
         });
-        let web_urls = match (&options.web, &oscquery) {
-            (Some(web), Some(server)) => {
-                let urls = super::web::urls(server.local_addr(), &web.token);
-                super::web::announce(&urls, web.read_only, !server.local_addr().ip().is_loopback());
-                urls
-            }
-            _ => Vec::new(),
-        };
+        let served = options.web.as_ref().zip(oscquery.as_ref());
+        let web_urls = served.map(|(web, server)| super::web::announce(server.local_addr(), web)).unwrap_or_default();
         let controllers =
             options.midi.then(|| Controllers::start(options.controller.as_deref(), &options.controllers_dir));
         let controllers = controllers.and_then(|c| {
             // A profile named on the command line that cannot be read is the performer's to know.
             c.map_err(|e| if options.controller.is_some() { report(Err(e)) } else { log::info!("{e}") }).ok()
         });
-        let midi = if options.midi {
-            // Ports a controller profile serves are the controller thread's; the lights it sends
-            // (its own client's ports) are not input.
-            let exclude = |name: &str| {
-                name.contains(super::controller::port::CLIENT) || controllers.as_ref().is_some_and(|c| c.serves(name))
-            };
-            MidiInput::open(options.midi_filter.as_deref(), &exclude).map_err(|e| log::info!("{e}")).ok()
-        } else {
-            None
+        // Ports a controller profile serves are the controller thread's; the lights it sends (its
+        // own client's ports) are not input.
+        let exclude = |name: &str| {
+            name.contains(super::controller::port::CLIENT) || controllers.as_ref().is_some_and(|c| c.serves(name))
         };
+        let midi = options.midi.then(|| MidiInput::open(options.midi_filter.as_deref(), &exclude));
+        let midi = midi.and_then(|m| m.map_err(|e| log::info!("{e}")).ok());
         let midi_out = options.midi_out.as_deref().and_then(|port| {
             MidiOut::start(port, options.midi_clock, options.mtc_out).map_err(|e| report(Err(e))).ok()
         });
+        let ltc_out = options
+            .ltc_out
+            .and_then(|rate| LtcOut::open(options.audio_out.as_deref(), rate).map_err(|e| report(Err(e))).ok());
         let recorder = options.record.as_deref().and_then(|p| Recorder::create(p).map_err(|e| report(Err(e))).ok());
         let learn = LearnStore { path: options.learn_file.clone() };
         let mapper = MidiMapper::new(scene, &learn.load());
@@ -245,6 +248,7 @@ impl ControlHub {
             chase: options.chase_in.map(|c| TimecodeIn::new(c, scene)),
             controllers,
             midi_out,
+            ltc_out,
             mapper,
             learn,
             presets,
@@ -545,6 +549,9 @@ impl ControlHub {
         if let Some(out) = self.midi_out.as_mut() {
             out.after_frame(self.mapper.bindings(), &instance, seconds);
         }
+        if let Some(out) = self.ltc_out.as_ref() {
+            out.report(super::mtc_out::code_seconds(&instance, seconds, out.rate()));
+        }
         self.frame_count += 1;
     }
 
@@ -570,6 +577,7 @@ impl ControlHub {
         }
         parts.extend(self.controllers.as_ref().and_then(Controllers::status));
         parts.extend(self.midi_out.as_ref().map(MidiOut::status));
+        parts.extend(self.ltc_out.as_ref().map(LtcOut::status));
         parts.extend(self.chase.as_ref().map(|chase| chase.status(std::time::Instant::now())));
         if let Some(dropped) = self.oscquery.as_ref().map(OscQueryServer::dropped).filter(|&d| d > 0) {
             parts.push(format!("OSCQuery LISTEN: {dropped} changes dropped (a controller fell behind)"));

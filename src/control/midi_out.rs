@@ -133,10 +133,7 @@ impl MidiOut {
         if let Some(rate) = self.mtc
             && let Ok(mut position) = self.shared.position.try_lock()
         {
-            // The timeline's first frame carries its chase start's label, when it has one.
-            let start = view.show.and_then(|(show, _)| show.timeline.chase).map(|c| c.start);
-            let start = start.and_then(|label| rate.count(label).ok()).unwrap_or(0);
-            *position = Some((code_seconds(seconds, start, rate), Instant::now()));
+            *position = Some((code_seconds(view, seconds, rate), Instant::now()));
         }
     }
 

@@ -16,6 +16,7 @@ pub mod hub;
 #[cfg(feature = "link")]
 pub mod link;
 pub mod listen;
+pub mod ltc_out;
 pub mod midi;
 pub mod midi_commands;
 pub mod midi_out;

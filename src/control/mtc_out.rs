@@ -7,6 +7,7 @@
 
 use std::time::{Duration, Instant};
 
+use crate::scene::SceneView;
 use crate::timecode::Rate;
 use crate::timecode::mtc::{full_frame, quarter_frame};
 
@@ -77,9 +78,11 @@ impl MtcFollower {
     }
 }
 
-/// The code time of the show's `seconds` on a timeline whose first frame is labelled `start`
-/// (a frame count at `rate`).
-pub fn code_seconds(seconds: f64, start: u64, rate: Rate) -> f64 {
+/// The code time at `rate` of the show's `seconds`: its timeline's first frame carries its chase
+/// start's label, when it has one (else 00:00:00:00). What MTC and LTC out send.
+pub fn code_seconds(view: &SceneView<'_>, seconds: f64, rate: Rate) -> f64 {
+    let start = view.show.and_then(|(show, _)| show.timeline.chase).map(|c| c.start);
+    let start = start.and_then(|label| rate.count(label).ok()).unwrap_or(0);
     start as f64 / rate.fps() + seconds
 }
 

@@ -238,6 +238,8 @@ pub fn frame_bits(timecode: Timecode, rate: Rate, user_bits: u32) -> u128 {
 pub struct LtcEncoder {
     /// Samples in half a bit cell.
     half_cell: f64,
+    /// Samples in half a bit cell at normal speed.
+    normal_half_cell: f64,
     rate: Rate,
     level: f32,
     /// The signal's side now.
@@ -256,6 +258,7 @@ impl LtcEncoder {
         let half_cell = f64::from(sample_rate) / (rate.fps() * BITS as f64 * 2.0);
         LtcEncoder {
             half_cell,
+            normal_half_cell: half_cell,
             rate,
             level,
             high: false,
@@ -263,6 +266,12 @@ impl LtcEncoder {
             written: 0,
             pending: std::collections::VecDeque::new(),
         }
+    }
+
+    /// Plays the frames that follow at `speed` times the code's rate (1: normal), as a tape
+    /// runs a little fast or slow; readers follow a code's speed.
+    pub fn set_speed(&mut self, speed: f64) {
+        self.half_cell = self.normal_half_cell / speed;
     }
 
     /// Appends the samples of the frame labelled `timecode` to `out`. A frame is

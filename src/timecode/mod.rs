@@ -7,6 +7,7 @@
 
 pub mod chase;
 pub mod ltc;
+pub mod ltc_follow;
 pub mod mtc;
 
 use serde::{Deserialize, Serialize};

@@ -14,6 +14,11 @@ one per line; each answers one line of JSON on stdout:
                       silence after its end
   played NAME         where the playing file was at each cycle since the last ask:
                       [[wall-clock seconds, sample index], ...]
+  record NAME PORTS   record an audio input of NAME's, connected from every audio output
+                      whose name matches the regex PORTS
+  recorded NAME FILE  write what was recorded to FILE (signed 16-bit mono samples, as
+                      tests/timecode/ltcread.c reads them) and answer where each cycle began:
+                      [[monotonic seconds, as MIDI arrivals are stamped, sample index], ...]
   unplug NAME         close NAME's client (its ports vanish, as a USB device's do)
   plug NAME           open it again
   quit
@@ -40,6 +45,9 @@ class Device:
         self.playing = None
         self.audio = None
         self.cycles = queue.Queue()
+        # A recording: its audio port, the samples (floats), and each cycle's stamp.
+        self.recorder = None
+        self.recording = None
 
     def plug(self):
         client = jack.Client(self.name, no_start_server=True)
@@ -59,6 +67,7 @@ class Device:
             # Stamped on the wall clock when the cycle runs (JACK's frame clock runs behind it
             # on a busy machine, where the server waits for late clients).
             now = time.monotonic()
+            self.record(now)
             for _, data in inport.incoming_midi_events():
                 self.received.put((now, bytes(data).hex()))
 
@@ -90,6 +99,31 @@ class Device:
         self.playing = (samples, at + frames)
         # Stamped on the wall clock as the MTC is: the cycle's first sample goes out now.
         self.cycles.put((time.time(), at))
+
+    def record(self, now):
+        """Keeps this cycle's samples of the recorded input, stamped."""
+        if self.recording is None:
+            return
+        samples, stamps = self.recording
+        stamps.append((now, len(samples) // 4))
+        samples.extend(self.recorder.get_buffer())
+
+    def start_recording(self, ports):
+        if self.recorder is None:
+            self.recorder = self.client.inports.register("record")
+        for port in self.client.get_ports(ports, is_audio=True, is_output=True):
+            self.client.connect(port, self.recorder)
+        self.recording = (bytearray(), [])
+
+    def write_recording(self, path):
+        samples, stamps = self.recording
+        self.recording = None
+        floats = array.array("f")
+        floats.frombytes(bytes(samples))
+        pcm = array.array("h", (max(-32767, min(32767, int(x * 32767))) for x in floats))
+        with open(path, "wb") as f:
+            f.write(pcm.tobytes())
+        return stamps
 
     def start_playing(self, path, ports):
         with open(path, "rb") as f:
@@ -172,6 +206,11 @@ def main():
             answer = []
             while not device.cycles.empty():
                 answer.append(device.cycles.get_nowait())
+        elif command == "record":
+            device.start_recording(words[2])
+            answer = "recording"
+        elif command == "recorded":
+            answer = device.write_recording(words[2])
         elif command == "mtc-stop":
             device.mtc = None
             answer = "stopped"

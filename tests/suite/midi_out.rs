@@ -1,7 +1,8 @@
 //! MIDI out on a real port (JACK's dummy driver, as the controller tests): a desk — a JACK
 //! client from PyPI's JACK-Client — receives every MIDI-mapped parameter as its control change
 //! when the value changes from any source (OSC here, and the desk's own fader), 14-bit mappings
-//! as MSB/LSB pairs, and MIDI clock at the show's tempo.
+//! as MSB/LSB pairs, and MIDI clock at the show's tempo; and the show as the timecode master,
+//! MTC on the MIDI port and LTC on a JACK audio output.
 
 use std::net::UdpSocket;
 use std::time::Duration;
@@ -109,11 +110,16 @@ fn quarter_frame_labels(messages: &[(f64, Vec<u8>)]) -> Vec<(f64, u64, u8)> {
 }
 
 #[test]
-fn the_show_is_the_timecode_master_over_mtc() {
-    let Some(desk) = play_to_desk("mtc-out", TIMELINE_SHOW, &["--midi-out", "desk in", "--mtc-out", "25"]) else {
-        return;
-    };
+fn the_show_is_the_timecode_master_over_mtc_and_ltc() {
+    if !cfg!(feature = "jack") {
+        return crate::controllers::skip("this test build has no JACK audio (tools/test builds with --features jack)");
+    }
+    let Some(ltcread) = crate::timecode::ltcread() else { return };
+    let args = ["--midi-out", "desk in", "--mtc-out", "25", "--ltc-out", "25"];
+    let Some(desk) = play_to_desk("mtc-out", TIMELINE_SHOW, &args) else { return };
     let Desk { mut show, mut devices, .. } = desk;
+    show.wait_for("LTC out at 25 fps");
+    assert_eq!(devices.command("record desk cpal_client_.*_out:out_0"), "recording");
     // The code starts with a full frame locating the desk in the timeline's first hour.
     let deadline = std::time::Instant::now() + Duration::from_secs(30);
     let mut seen = Vec::new();
@@ -143,4 +149,49 @@ fn the_show_is_the_timecode_master_over_mtc() {
     assert!((fps / 25.0 - 1.0).abs() < 0.08, "{fps:.2} frames a second");
     assert!(first.1 >= 3600 * 25 && first.1 < 3600 * 25 + 60 * 25, "code {} is in the show's first minute", first.1);
     assert!(show.child.try_wait().unwrap().is_none(), "the show is still running");
+
+    // The LTC it sent meanwhile on its audio output, read by libltc: frame after frame at
+    // 25 fps, each label where the MTC (its own follower of the show's position) put the show
+    // when the frame began.
+    let recording = scratch_dir("ltc-out").join("ltc.s16");
+    let cycles = devices.command(&format!("recorded desk {}", recording.display()));
+    let cycles: Vec<(f64, u64)> =
+        cycles.as_array().unwrap().iter().map(|c| (c[0].as_f64().unwrap(), c[1].as_u64().unwrap())).collect();
+    let read = std::process::Command::new(ltcread)
+        .args(["48000", "25"])
+        .stdin(std::fs::File::open(&recording).unwrap())
+        .output()
+        .unwrap();
+    let frames: Vec<(u64, u64)> = String::from_utf8(read.stdout)
+        .unwrap()
+        .lines()
+        .map(|line| {
+            let w: Vec<&str> = line.split(' ').collect();
+            let label = indra::timecode::Timecode::parse(w[0]).unwrap();
+            (indra::timecode::Rate::Fps25.count(label).unwrap(), w[1].parse().unwrap())
+        })
+        .collect();
+    assert!(frames.len() >= 70, "{} LTC frames read in over 3 s", frames.len());
+    let steps = frames.windows(2).filter(|w| w[1].0 != w[0].0 + 1).count();
+    assert!(steps <= locates, "{steps} breaks in the LTC labels with {locates} MTC locates");
+    // When sample `s` of the recording came: the cycle it was in, on the cycle's clock.
+    let time_of = |s: u64| {
+        let i = cycles.partition_point(|&(_, first)| first <= s).max(1) - 1;
+        cycles[i].0 + (s - cycles[i].1) as f64 / 48_000.0
+    };
+    // The MTC's position then: a label's last quarter frame comes 1.75 frames into it.
+    let mtc_at = |t: f64| {
+        let i = labels.partition_point(|l| l.0 <= t).max(1) - 1;
+        labels[i].1 as f64 + 1.75 + (t - labels[i].0) * 25.0
+    };
+    let mut gaps: Vec<f64> = (frames.iter())
+        .map(|&(label, start)| (time_of(start), label))
+        .filter(|&(t, _)| t > labels[0].0 && t < labels[labels.len() - 1].0)
+        .map(|(t, label)| label as f64 - mtc_at(t))
+        .collect();
+    gaps.sort_by(f64::total_cmp);
+    assert!(gaps.len() >= 50, "{} LTC frames beside the MTC", gaps.len());
+    let (median, p90) = (gaps[gaps.len() / 2], gaps[gaps.len() * 9 / 10].abs().max(gaps[gaps.len() / 10].abs()));
+    eprintln!("LTC against MTC: {median:+.2} frames median, {p90:.2} at the 10th/90th percentile");
+    assert!(median.abs() < 0.5 && p90 < 0.75, "LTC off the MTC by {median:+.2} frames median, {p90:.2} p10/p90");
 }

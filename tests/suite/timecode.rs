@@ -46,6 +46,11 @@ fn libltc() -> Option<(PathBuf, PathBuf)> {
     }
 }
 
+/// libltc's reader.
+pub(crate) fn ltcread() -> Option<PathBuf> {
+    libltc().map(|(_, reader)| reader)
+}
+
 /// libltc's generator.
 pub(crate) fn ltcgen() -> Option<PathBuf> {
     libltc().map(|(generator, _)| generator)

@@ -41,7 +41,7 @@ pub fn list_devices() -> Result<Vec<String>, String> {
 }
 
 /// The sound system: JACK in builds with the `jack` feature, else the platform's default.
-fn host() -> Result<cpal::Host, String> {
+pub fn host() -> Result<cpal::Host, String> {
     #[cfg(feature = "jack")]
     return cpal::host_from_id(cpal::HostId::Jack).map_err(|e| format!("no JACK server for audio input: {e}"));
     #[cfg(not(feature = "jack"))]

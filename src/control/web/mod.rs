@@ -140,17 +140,21 @@ pub fn urls(local: SocketAddr, token: &AccessToken) -> Vec<String> {
     found.into_iter().map(url).collect()
 }
 
-/// Tells the performer where the browser surface is: each URL, and a QR code of the first for a
-/// phone's camera when the surface is `networked` (not on loopback).
-pub fn announce(urls: &[String], read_only: bool, networked: bool) {
-    let mode = if read_only { " (read-only)" } else { "" };
-    for url in urls {
+/// The surface's URLs when served at `local` (each with the token), told to the performer: each
+/// URL, and a QR code of the first for a phone's camera when the surface is on the network (not
+/// on loopback).
+pub fn announce(local: SocketAddr, web: &WebOptions) -> Vec<String> {
+    let urls = urls(local, &web.token);
+    let mode = if web.read_only { " (read-only)" } else { "" };
+    for url in &urls {
         log::info!("control surface{mode} on {url}");
     }
-    let Some(first) = urls.first().filter(|_| networked) else { return };
-    if let Some(code) = qr::terminal(first) {
+    if let Some(first) = urls.first().filter(|_| !local.ip().is_loopback())
+        && let Some(code) = qr::terminal(first)
+    {
         log::info!("scan to open the control surface:\n{code}");
     }
+    urls
 }
 
 #[cfg(test)]
