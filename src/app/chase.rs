@@ -10,7 +10,7 @@ use super::panel::Overlay;
 use crate::assets::Assets;
 use crate::gpu::Gpu;
 use crate::graph::GraphRuntime;
-use crate::live::BackgroundSeek;
+use crate::live::{BackgroundSeek, SeekCheckpoints};
 use crate::scene::Player;
 use crate::timecode::chase::{Chasing, Follow, follow, frame_at};
 
@@ -29,6 +29,8 @@ const RETRY_AFTER: Duration = Duration::from_secs(2);
 pub(super) struct WindowChase {
     /// The seek in progress.
     seek: Option<BackgroundSeek>,
+    /// The checkpoints seeks keep on their way, for the next.
+    checkpoints: SeekCheckpoints,
     /// When the last seek failed.
     failed: Option<Instant>,
 }
@@ -105,7 +107,8 @@ impl WindowChase {
         match seek.try_take() {
             None => false,
             Some(Ok(sought)) => {
-                log::info!("timecode: sought frame {}, the code is at {wanted}", sought.player.now().frame);
+                let (frame, from) = (sought.player.now().frame, sought.from);
+                log::info!("timecode: sought frame {frame} from frame {from}, the code is at {wanted}");
                 (*player, *runtime) = (sought.player, sought.runtime);
                 self.seek = None;
                 true
@@ -125,7 +128,7 @@ impl WindowChase {
         }
         log::info!("timecode: the code jumped to frame {frame} (the show was at {next}): seeking");
         let scene = player.instance().scene().clone();
-        self.seek = Some(BackgroundSeek::start(from.gpu, from.assets, scene, from.size, frame));
+        self.seek = Some(BackgroundSeek::start(from.gpu, from.assets, scene, from.size, frame, &self.checkpoints));
     }
 }
 

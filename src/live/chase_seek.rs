@@ -6,7 +6,9 @@
 //!
 //! The code runs on while the seek works: the thread keeps stepping until it is within a few
 //! frames of where the code is now (the render thread tells it each frame), so the window takes
-//! over with steps of its own rather than a second seek.
+//! over with steps of its own rather than a second seek. On its way it keeps checkpoints in
+//! memory ([`SeekCheckpoints`]), and starts from the latest one before the code when there is
+//! one, so a second jump deep into a long show does not step from frame 0 again.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -15,10 +17,13 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use crate::assets::Assets;
+use crate::checkpoint::Checkpoint;
 use crate::gpu::Gpu;
 use crate::graph::GraphRuntime;
 use crate::scene::{Player, Scene, SceneInstance};
 use crate::time::FixedClock;
+
+use super::SeekCheckpoints;
 
 /// Steps the seek runs between looks at where the code is (and at a cancel).
 const STEPS_PER_LOOK: u64 = 32;
@@ -37,6 +42,8 @@ pub struct Sought {
     pub player: Player,
     /// The graph runtime its frames were recorded with (its pool is sized for the window).
     pub runtime: GraphRuntime,
+    /// The frame it stepped from: 0, or a checkpoint's.
+    pub from: u64,
 }
 
 /// A seek in progress on its own thread.
@@ -50,17 +57,25 @@ pub struct BackgroundSeek {
 
 impl BackgroundSeek {
     /// Starts building `scene` with `assets` for a window of `size` and stepping it until its
-    /// next step is within [`HAND_OVER_WITHIN`] frames of `frame` (which [`Self::want`] moves).
-    pub fn start(gpu: &Gpu, assets: &Assets, scene: Scene, size: (u32, u32), frame: u64) -> Self {
+    /// next step is within [`HAND_OVER_WITHIN`] frames of `frame` (which [`Self::want`] moves),
+    /// from the latest of `checkpoints` before it, keeping more on the way.
+    pub fn start(
+        gpu: &Gpu,
+        assets: &Assets,
+        scene: Scene,
+        size: (u32, u32),
+        frame: u64,
+        checkpoints: &SeekCheckpoints,
+    ) -> Self {
         let wanted = Arc::new(AtomicU64::new(frame));
         let cancel = Arc::new(AtomicBool::new(false));
         let (send, done) = sync_channel(1);
         let (gpu, assets) = (gpu.clone(), assets.clone());
-        let (want, stop) = (wanted.clone(), cancel.clone());
+        let (want, stop, kept) = (wanted.clone(), cancel.clone(), checkpoints.clone());
         let thread = std::thread::Builder::new()
             .name("indra-chase-seek".into())
             .spawn(move || {
-                let result = seek(&gpu, &assets, scene, size, &want, &stop);
+                let result = seek(&gpu, &assets, scene, size, &want, &stop, &kept);
                 // The window may have gone on without this seek: nobody to tell then.
                 let _ = send.send(result);
             })
@@ -108,6 +123,7 @@ fn seek(
     size: (u32, u32),
     wanted: &AtomicU64,
     cancel: &AtomicBool,
+    checkpoints: &SeekCheckpoints,
 ) -> Result<Sought, String> {
     let clock = FixedClock::new(scene.dt, scene.seed);
     let mut instance = SceneInstance::new(gpu, assets, scene, size).map_err(|e| e.to_string())?;
@@ -115,6 +131,15 @@ fn seek(
     // As the window's instance did at start: a show's clips draw a throwaway frame each.
     instance.warm_up(&mut runtime).map_err(|e| format!("preparing the clips: {e}"))?;
     let mut player = Player::new(instance, clock);
+    let pinned = player.checkpoint_header(gpu, size, "");
+    let mut from = 0;
+    if let Some(checkpoint) = checkpoints.nearest(&pinned, wanted.load(Ordering::Relaxed)) {
+        if let Err(e) = player.load_state(gpu, &checkpoint) {
+            checkpoints.forget();
+            return Err(format!("the seek's checkpoint: {e}"));
+        }
+        from = checkpoint.header.frame;
+    }
     let (mut checked, mut gap) = (Instant::now(), u64::MAX);
     loop {
         if cancel.load(Ordering::Relaxed) {
@@ -124,16 +149,22 @@ fn seek(
         let goal = wanted.load(Ordering::Relaxed);
         let behind = goal.saturating_sub(next);
         if behind <= HAND_OVER_WITHIN {
-            return Ok(Sought { player, runtime });
+            return Ok(Sought { player, runtime, from });
         }
         if checked.elapsed() > GAIN_CHECK {
             if behind >= gap {
                 log::warn!("a seek steps slower than the code runs: showing frame {next}, {behind} behind");
-                return Ok(Sought { player, runtime });
+                return Ok(Sought { player, runtime, from });
             }
             (checked, gap) = (Instant::now(), behind);
         }
-        let to = goal.min(next + STEPS_PER_LOOK);
+        let stop = checkpoints.next_stop(&pinned, next);
+        let to = goal.min(next + STEPS_PER_LOOK).min(stop);
         player.seek(gpu, &mut runtime, size, to).map_err(|e| e.to_string())?;
+        if to == stop {
+            let _ = gpu.device.poll(wgpu::PollType::wait_indefinitely());
+            let sections = player.save_state(gpu).map_err(|e| format!("a checkpoint of the seek: {e}"))?;
+            checkpoints.keep(Checkpoint { header: player.checkpoint_header(gpu, size, ""), sections });
+        }
     }
 }

@@ -8,9 +8,11 @@ mod chase_seek;
 mod prepare;
 mod recovery;
 mod reload;
+mod seek_checkpoints;
 mod watcher;
 
 pub use chase_seek::{BackgroundSeek, HAND_OVER_WITHIN, Sought};
 pub use recovery::{GpuGuard, GpuState, GpuTrouble, recover, roll_back_stall};
 pub use reload::{LiveReload, ReloadReport, RolledBack};
+pub use seek_checkpoints::SeekCheckpoints;
 pub use watcher::{Watcher, read_stable};

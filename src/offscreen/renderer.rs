@@ -158,27 +158,10 @@ impl OffscreenRenderer {
         self.player.seek(&self.gpu, &mut self.runtime, self.size, frame)
     }
 
-    /// What a checkpoint of this render pins, at the next frame: the scene (its validated form,
-    /// edits included, but not the folder it was read from), `controls` (a hash of the
-    /// scheduled events), size, step, seed, adapter and driver.
+    /// What a checkpoint of this render pins, at the next frame (see
+    /// [`Player::checkpoint_header`]).
     pub fn checkpoint_header(&self, controls: &str) -> Header {
-        let mut scene = self.player.instance().scene().clone();
-        scene.origin.clear();
-        let info = self.gpu.adapter.get_info();
-        let now = self.player.now();
-        Header {
-            format: crate::checkpoint::FORMAT,
-            indra: env!("CARGO_PKG_VERSION").to_string(),
-            scene: scene.name.clone(),
-            scene_hash: crate::checkpoint::sha256_hex(format!("{scene:?}").as_bytes()),
-            controls_hash: crate::checkpoint::sha256_hex(controls.as_bytes()),
-            adapter: format!("{} ({:?})", info.name, info.backend),
-            driver: format!("{} {}", info.driver, info.driver_info).trim().to_string(),
-            frame: now.frame,
-            size: self.size,
-            dt_bits: now.dt.to_bits(),
-            seed: now.seed,
-        }
+        self.player.checkpoint_header(&self.gpu, self.size, controls)
     }
 
     /// A checkpoint of the state before the next frame (waits for the GPU); `controls` as for

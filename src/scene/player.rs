@@ -10,7 +10,7 @@
 use std::collections::BTreeMap;
 
 use super::instance::SceneInstance;
-use crate::checkpoint::{Checkpoint, CheckpointError};
+use crate::checkpoint::{Checkpoint, CheckpointError, Header};
 use crate::gpu::Gpu;
 use crate::graph::{FrameGraph, FrameOutput, GraphError, GraphRuntime};
 use crate::params::{ControlEvent, Remap};
@@ -128,6 +128,29 @@ impl Player {
             }
         }
         Ok(())
+    }
+
+    /// What a checkpoint of this player pins, at the next step: the scene (its validated form,
+    /// edits included, but not the folder it was read from), `controls` (a hash of the
+    /// scheduled events), the output size, step, seed, and `gpu`'s adapter and driver.
+    pub fn checkpoint_header(&self, gpu: &Gpu, size: (u32, u32), controls: &str) -> Header {
+        let mut scene = self.instance.scene().clone();
+        scene.origin.clear();
+        let info = gpu.adapter.get_info();
+        let now = self.now();
+        Header {
+            format: crate::checkpoint::FORMAT,
+            indra: env!("CARGO_PKG_VERSION").to_string(),
+            scene: scene.name.clone(),
+            scene_hash: crate::checkpoint::sha256_hex(format!("{scene:?}").as_bytes()),
+            controls_hash: crate::checkpoint::sha256_hex(controls.as_bytes()),
+            adapter: format!("{} ({:?})", info.name, info.backend),
+            driver: format!("{} {}", info.driver, info.driver_info).trim().to_string(),
+            frame: now.frame,
+            size,
+            dt_bits: now.dt.to_bits(),
+            seed: now.seed,
+        }
     }
 
     /// The checkpoint sections of the state before the next step (see

@@ -75,17 +75,15 @@ fn every_scene_renders_frame_n_the_same_played_sought_or_split() {
     eprintln!("seek = play for {} scenes: {}", checked.len(), checked.join(", "));
 }
 
-#[test]
-fn a_seek_off_the_render_thread_goes_on_as_the_played_scene() {
-    // What a window chasing timecode swaps in when the code jumps: a fresh cloth built and
-    // stepped on a thread of its own to the code's frame.
-    let scene = load_scene(&common::assets(), "cloth").unwrap();
-    let mut played = renderer(scene.clone());
-    let want = frames(&mut played, 2 * N + 3);
-    // The taker's device: what a seek builds lives on the device it is shown from.
-    let mut taken =
-        OffscreenRenderer::new(common::gpu(), &common::assets(), scene.clone(), Some(SIZE), None, None).unwrap();
-    let mut seek = indra::live::BackgroundSeek::start(taken.gpu(), &common::assets(), scene, SIZE, 2 * N);
+/// Runs a background seek of `scene` to `frame` on `taken`'s device, keeping checkpoints in
+/// `kept`, and swaps it into `taken`; the frame it stepped from.
+fn seek_in_background(
+    taken: &mut OffscreenRenderer,
+    scene: Scene,
+    frame: u64,
+    kept: &indra::live::SeekCheckpoints,
+) -> u64 {
+    let mut seek = indra::live::BackgroundSeek::start(taken.gpu(), &common::assets(), scene, SIZE, frame, kept);
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
     let sought = loop {
         if let Some(result) = seek.try_take() {
@@ -94,12 +92,36 @@ fn a_seek_off_the_render_thread_goes_on_as_the_played_scene() {
         assert!(std::time::Instant::now() < deadline, "the seek did not end in 120 s");
         std::thread::sleep(std::time::Duration::from_millis(20));
     };
+    let from = sought.from;
     taken.take_over(sought);
     let next = taken.next_frame();
-    assert!((2 * N - indra::live::HAND_OVER_WITHIN..=2 * N).contains(&next), "handed over at frame {next}");
-    for frame in next..2 * N + 3 {
-        let got = taken.render_next().expect("frame renders").rgba;
-        assert!(got == want[frame as usize], "frame {frame} after the seek differs from the played frame");
+    assert!((frame - indra::live::HAND_OVER_WITHIN..=frame).contains(&next), "handed over at frame {next}");
+    from
+}
+
+#[test]
+fn a_seek_off_the_render_thread_goes_on_as_the_played_scene_and_the_next_starts_from_its_checkpoint() {
+    // What a window chasing timecode swaps in when the code jumps: a fresh cloth built and
+    // stepped on a thread of its own to the code's frame, keeping a checkpoint every 8 frames
+    // on its way; a second jump starts from the latest of them.
+    let scene = load_scene(&common::assets(), "cloth").unwrap();
+    let mut played = renderer(scene.clone());
+    let want = frames(&mut played, 2 * N + 8);
+    let kept = indra::live::SeekCheckpoints::new(8, 1 << 30);
+    for (jump, shown, from) in [(2 * N, 2 * N + 3, 0), (2 * N + 5, 2 * N + 8, 2 * N)] {
+        // The taker's device: what a seek builds lives on the device it is shown from.
+        let mut taken =
+            OffscreenRenderer::new(common::gpu(), &common::assets(), scene.clone(), Some(SIZE), None, None).unwrap();
+        assert_eq!(seek_in_background(&mut taken, scene.clone(), jump, &kept), from, "the seek to {jump} began there");
+        for frame in taken.next_frame()..shown {
+            let got = taken.render_next().expect("frame renders").rgba;
+            assert!(
+                got == want[frame as usize],
+                "frame {frame} after the seek to {jump} differs from the played frame"
+            );
+        }
+        // The first seek kept frames 8, 16 and 24; the second, from 24, none.
+        assert_eq!(kept.held().0, vec![8, 16, 24], "after the seek to {jump}");
     }
 }
 
