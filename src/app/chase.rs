@@ -2,7 +2,8 @@
 //! screen to the frame the code says — none while it waits for code or stands, a few to catch
 //! up — or, when the code jumps, a seek on a thread of its own while the frame on screen holds;
 //! the sought scene is swapped in when it is ready. Live control goes on throughout, on the
-//! scene that is showing; a jump shows the timeline's frame as a render from 0 shows it.
+//! scene that is showing; a jump shows the timeline's frame as a render from 0 shows it. A show
+//! that runs free seeks the same way where the performer puts it (the lane view's ruler).
 
 use std::time::{Duration, Instant, SystemTime};
 
@@ -33,6 +34,8 @@ pub(super) struct WindowChase {
     checkpoints: SeekCheckpoints,
     /// When the last seek failed.
     failed: Option<Instant>,
+    /// The frame a performer put the free-running show at, while it is sought.
+    placed: Option<u64>,
 }
 
 /// What a seek is built with: the window's device, the shaders running, the window's size.
@@ -56,7 +59,35 @@ impl WindowChase {
     /// Drops a seek in progress: it was built from a scene or on a device that is no longer the
     /// show's (a reload, a new device). The next frame seeks again if the code is still away.
     pub(super) fn cancel(&mut self) {
-        self.seek = None;
+        (self.seek, self.placed) = (None, None);
+    }
+
+    /// Puts the free-running show at `frame` (the performer dropped the play position there):
+    /// sought off the render thread while the frame on screen holds, as a jump in the code is.
+    pub(super) fn place(&mut self, frame: u64, player: &Player, from: SeekFrom<'_>) {
+        log::info!("the show is put at frame {frame} (it was at {}): seeking", player.now().frame);
+        self.failed = None;
+        self.placed = Some(frame);
+        self.start_seek(frame, player, from);
+    }
+
+    /// The steps a free-running show runs for `elapsed` seconds; none while a seek the performer
+    /// asked for runs, then the few from where the sought scene stopped to the frame asked for.
+    pub(super) fn free_steps(
+        &mut self,
+        elapsed: f64,
+        player: &mut Player,
+        runtime: &mut GraphRuntime,
+        overlay: &mut Overlay,
+    ) -> u32 {
+        let steps = player.accumulate(elapsed);
+        let Some(frame) = self.placed else { return steps };
+        if !self.take_sought(frame, player, runtime, overlay) {
+            return 0;
+        }
+        self.placed = None;
+        // The sought scene stops a step or two short; the frame asked for is the one shown.
+        (frame + 1).saturating_sub(player.now().frame).min(u64::from(MAX_CATCH_UP_STEPS)) as u32
     }
 
     /// The steps `player` runs now to show the frame `chasing` says; a sought scene that is
@@ -84,7 +115,10 @@ impl WindowChase {
             Follow::Hold => 0,
             Follow::Step(n) => n,
             Follow::Seek(frame) => {
-                self.start_seek(frame, next, player, from);
+                if self.failed.is_none_or(|at| at.elapsed() >= RETRY_AFTER) {
+                    log::info!("timecode: the code jumped to frame {frame} (the show was at {next}): seeking");
+                    self.start_seek(frame, player, from);
+                }
                 0
             }
         };
@@ -121,12 +155,8 @@ impl WindowChase {
         }
     }
 
-    /// Starts seeking `frame` off the render thread (the code jumped from around `next`).
-    fn start_seek(&mut self, frame: u64, next: u64, player: &Player, from: SeekFrom<'_>) {
-        if self.failed.is_some_and(|at| at.elapsed() < RETRY_AFTER) {
-            return;
-        }
-        log::info!("timecode: the code jumped to frame {frame} (the show was at {next}): seeking");
+    /// Starts seeking `frame` off the render thread.
+    fn start_seek(&mut self, frame: u64, player: &Player, from: SeekFrom<'_>) {
         let scene = player.instance().scene().clone();
         self.seek = Some(BackgroundSeek::start(from.gpu, from.assets, scene, from.size, frame, &self.checkpoints));
     }

@@ -7,6 +7,7 @@ mod chain_edits;
 mod chase;
 mod effects_panel;
 mod input;
+mod lane_view;
 mod lights_panel;
 mod outputs;
 mod panel;

@@ -46,6 +46,8 @@ pub struct Overlay {
     pub record_clicked: bool,
     /// How the last take ended.
     pub last_take: Option<String>,
+    /// The show's timeline under the clip grid.
+    pub lanes: super::lane_view::LaneView,
 }
 
 impl Default for Overlay {
@@ -63,6 +65,7 @@ impl Default for Overlay {
             sending: Vec::new(),
             record_clicked: false,
             last_take: None,
+            lanes: Default::default(),
         }
     }
 }
@@ -192,6 +195,7 @@ pub fn draw_ui(
                 ui.small(hub.status());
                 super::web_panel::web_panel(ui, &hub.web_urls);
                 events.extend(super::show_panel::show_panel(ui, instance, hub));
+                events.extend(overlay.lanes.draw(ui, instance, time));
                 events.extend(super::effects_panel::effects_panel(ui, instance, hub));
                 if let Some((lights, _)) = lights.as_mut()
                     && let Some(message) = super::lights_panel::lights_panel(ui, lights)
@@ -409,7 +413,12 @@ mod tests {
         let fonts = panel_fonts();
         let family = &fonts.families[&egui::FontFamily::Proportional];
         // The panel's labels, the recording line and the status lines come from these files.
-        let sources = [include_str!("panel.rs"), include_str!("window.rs"), include_str!("../control/hub.rs")];
+        let sources = [
+            include_str!("panel.rs"),
+            include_str!("window.rs"),
+            include_str!("lane_view.rs"),
+            include_str!("../control/hub.rs"),
+        ];
         let mut symbols: Vec<char> = sources.iter().flat_map(|s| s.chars()).filter(|c| !c.is_ascii()).collect();
         symbols.sort_unstable();
         symbols.dedup();

@@ -128,14 +128,21 @@ impl Running {
             return;
         }
         let now = Instant::now();
-        let steps = match self.hub.timecode(now) {
-            Some(chasing) => {
-                let assets = self.live.as_ref().map_or(&self.assets, |live| live.running_assets());
-                let size = (self.config.width, self.config.height);
-                let from = super::chase::SeekFrom { gpu: &self.gpu, assets, size };
-                self.chase.steps(chasing, &mut self.player, &mut self.runtime, from, &mut self.overlay)
+        let assets = self.live.as_ref().map_or(&self.assets, |live| live.running_assets());
+        let from = super::chase::SeekFrom { gpu: &self.gpu, assets, size: (self.config.width, self.config.height) };
+        let timecode = self.hub.timecode(now);
+        self.overlay.lanes.chasing = timecode.is_some();
+        let steps = match timecode {
+            Some(chasing) => self.chase.steps(chasing, &mut self.player, &mut self.runtime, from, &mut self.overlay),
+            None => {
+                // The performer dropped the play position on the lane view's ruler.
+                if let Some(seconds) = self.overlay.lanes.place.take() {
+                    let frame = crate::timecode::chase::frame_at(seconds, f64::from(self.player.now().dt));
+                    self.chase.place(frame, &self.player, from);
+                }
+                let elapsed = (now - self.last).as_secs_f64();
+                self.chase.free_steps(elapsed, &mut self.player, &mut self.runtime, &mut self.overlay)
             }
-            None => self.player.accumulate((now - self.last).as_secs_f64()),
         };
         self.last = now;
         self.reload();
@@ -144,6 +151,7 @@ impl Running {
         self.edit_chains(&mut events);
         self.hub.record(self.player.now().frame, &events, self.player.instance().scene());
         self.player.apply(&events);
+        self.overlay.lanes.record(self.player.instance(), self.player.now().frame);
         self.act_on_record_requests();
         for _ in 0..steps {
             self.player.step();

@@ -146,6 +146,7 @@ fn to_recorded(event: &ControlEvent, scene: &Scene) -> Option<ControlEvent<Named
         ControlEvent::Phase { phase, quantum } => ControlEvent::Phase { phase: *phase, quantum: *quantum },
         ControlEvent::Show(command) => ControlEvent::Show(*command),
         ControlEvent::Audio(snapshot) => ControlEvent::Audio(snapshot.clone()),
+        ControlEvent::Lane(lane) => ControlEvent::Lane(lane.clone()),
     })
 }
 
@@ -240,6 +241,8 @@ fn from_recorded(event: &ControlEvent<Named>, scene: &Scene) -> Result<ControlEv
             }
             ControlEvent::Audio(snapshot.clone())
         }
+        // Targets and values are checked where the show applies the lane, as a file's are.
+        ControlEvent::Lane(lane) => ControlEvent::Lane(lane.clone()),
     })
 }
 

@@ -76,6 +76,24 @@ pub enum ControlEvent<A: Addressing = Indexed> {
     Show(ShowCommand),
     /// What the audio analysis heard this frame, for nodes that sample sound as a texture.
     Audio(AudioSnapshot),
+    /// A show's timeline lane set to these keys (the panel's lane view, a recorded fader move).
+    Lane(LaneKeys),
+}
+
+/// A timeline lane as the lane view leaves it: named by its target and with values as a show
+/// file writes them, so one event serves the running show, a recording and the saved file.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct LaneKeys {
+    /// The parameter, as a lane's `target` is written (`layer/1.opacity`, `<clip>/<node>.<param>.x`).
+    pub target: String,
+    /// (seconds, or beats, value) pairs; none removes the lane.
+    pub keys: Vec<(f32, super::RawValue)>,
+    /// Between keys.
+    pub interpolation: super::Interpolation,
+    /// After the last key.
+    pub repeat: super::LoopMode,
+    /// Whether key times are beats of the show's tempo.
+    pub beats: bool,
 }
 
 /// A frame of sound as shaders sample it (ISF `audio` and `audioFFT` inputs).
@@ -151,7 +169,8 @@ impl ControlEvent {
             ControlEvent::Tempo { .. }
             | ControlEvent::Phase { .. }
             | ControlEvent::Show(_)
-            | ControlEvent::Audio(_) => Some(self.clone()),
+            | ControlEvent::Audio(_)
+            | ControlEvent::Lane(_) => Some(self.clone()),
         }
     }
 }

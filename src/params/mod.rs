@@ -14,7 +14,7 @@ mod value;
 mod write;
 
 pub use address::{
-    Addressing, AudioSnapshot, ControlEvent, EffectEdit, Indexed, NodeValues, Remap, ShowCommand, Target,
+    Addressing, AudioSnapshot, ControlEvent, EffectEdit, Indexed, LaneKeys, NodeValues, Remap, ShowCommand, Target,
 };
 pub use lfo::{Lfo, LfoRate, LfoShape, TempoClock};
 pub use morph::Morph;

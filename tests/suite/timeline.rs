@@ -5,7 +5,7 @@
 
 use crate::common::{assets, gpu};
 use indra::offscreen::OffscreenRenderer;
-use indra::params::ParamValue;
+use indra::params::{ControlEvent, LaneKeys, ParamValue};
 use indra::scene::Scene;
 use indra::scene::show::parse_show;
 
@@ -197,4 +197,133 @@ fn a_lane_is_read_back_over_oscquery_and_a_fader_move_over_it_replays_on_its_fra
         let want = if frame < moved { lane } else { 0.5 };
         assert_eq!(got, want, "frame {frame} (the move at {moved})");
     }
+}
+
+/// The master's level each step and every 20th frame's pixels, for `frames` steps of `scene`
+/// with `events` applied before the steps they name.
+fn levels(scene: Scene, frames: u64, events: &[(u64, ControlEvent)]) -> (Vec<f32>, Vec<Vec<u8>>) {
+    let master = scene.node_index("master").unwrap();
+    let mut r = OffscreenRenderer::new(gpu(), &assets(), scene, Some((16, 16)), None, None).unwrap();
+    for (frame, event) in events {
+        r.schedule(*frame, vec![event.clone()]);
+    }
+    let (mut levels, mut images) = (Vec::new(), Vec::new());
+    for frame in 0..frames {
+        if frame % 20 == 0 {
+            images.push(r.render_next().unwrap().rgba);
+        } else {
+            r.render_only().unwrap();
+        }
+        levels.push(float(r.instance_mut().params(master).get("level")));
+    }
+    (levels, images)
+}
+
+#[test]
+fn a_fader_move_recorded_into_a_lane_replays_at_every_step_and_from_the_saved_file() {
+    use indra::params::{ParamWrite, Source};
+    use indra::scene::show::{LaneTake, lane_file::with_lanes, raw_keys, scalar_keys};
+    let scene = show_from(TIMED);
+    let master = scene.node_index("master").unwrap();
+    let level = scene.nodes[master].params.index("level").unwrap();
+    let lane = scene.tracks.iter().find(|t| t.show_clock && t.target == "master.level").unwrap().clone();
+    // The performance, as the window plays it (two steps a displayed frame): the lane plays, the
+    // performer moves the master from frame 60 on over the lane's step at 120, and disarms the
+    // take at 180, which hands the master back to the lane with the take in it.
+    let fader = |frame: u64| 0.3 + 0.004 * (frame / 2 % 40) as f32;
+    let mut r = OffscreenRenderer::new(gpu(), &assets(), scene.clone(), Some((16, 16)), None, None).unwrap();
+    let mut take = LaneTake::new(1.0 / 60.0);
+    let (mut performed, mut images, mut edit) = (Vec::new(), Vec::new(), None);
+    for frame in 0..300u64 {
+        let instance = r.instance_mut();
+        if frame % 2 == 0 && (60..180).contains(&frame) {
+            let value = ParamValue::Float(fader(frame));
+            instance.apply(&[ControlEvent::Write(ParamWrite {
+                node: master,
+                param: level,
+                component: None,
+                value,
+                source: Source::Ui,
+            })]);
+        }
+        if frame == 180 {
+            take.end(179);
+            let old = scalar_keys(&lane.track).unwrap();
+            let keys = take.keys(&old, |t| lane.track.sample(t).components()[0], lane.track.interpolation);
+            let event = ControlEvent::Lane(LaneKeys {
+                target: lane.target.clone(),
+                keys: raw_keys(&keys),
+                interpolation: lane.track.interpolation,
+                repeat: lane.track.repeat,
+                beats: false,
+            });
+            instance.apply(std::slice::from_ref(&event));
+            edit = Some(event);
+        }
+        if frame % 2 == 0 && instance.is_overridden(master, level) {
+            take.hold(frame, float(instance.params(master).target_at(level)));
+        }
+        if frame % 20 == 0 {
+            images.push(r.render_next().unwrap().rgba);
+        } else {
+            r.render_only().unwrap();
+        }
+        performed.push(float(r.instance_mut().params(master).get("level")));
+    }
+    assert_eq!(performed[100], fader(100), "the performer had the master");
+    assert_eq!((performed[59], performed[250]), (1.0, 0.25), "the lane before and after the take");
+    let edit = edit.unwrap();
+    let (replayed, replayed_images) = levels(scene.clone(), 300, &[(0, edit.clone())]);
+    assert_eq!(replayed, performed, "the lane with the take, from the show's start");
+    assert!(replayed_images == images, "the frames it renders are the performed ones");
+    // Saved into the file: the show read from it plays the performance with no events at all.
+    let mut r = OffscreenRenderer::new(gpu(), &assets(), scene, Some((16, 16)), None, None).unwrap();
+    r.instance_mut().apply(&[edit]);
+    let show = r.instance_mut().scene().show.clone().unwrap();
+    let source = show.file.as_ref().unwrap();
+    let saved = with_lanes(&source.text, &source.file.timeline.lanes).unwrap();
+    assert!(saved.contains("(target: \"blue/limit_set.hit_color.x\""), "the other lanes stay: {saved}");
+    assert_eq!(levels(show_from(&saved), 300, &[]), (performed, images), "the saved show plays the take");
+}
+
+#[test]
+fn lanes_edited_live_are_checked_as_a_files_are_and_removing_one_leaves_its_parameter() {
+    let scene = show_from(TIMED);
+    let lane = |target: &str, keys: &[(f32, f64)]| {
+        ControlEvent::Lane(LaneKeys {
+            target: target.into(),
+            keys: keys.iter().map(|&(t, v)| (t, indra::params::RawValue::Number(v))).collect(),
+            interpolation: indra::params::Interpolation::Linear,
+            repeat: indra::params::LoopMode::Once,
+            beats: false,
+        })
+    };
+    let refused = [
+        lane("nowhere.level", &[(0.0, 1.0)]),
+        lane("master.level", &[(-1.0, 1.0)]),
+        lane("master.nothing", &[(0.0, 1.0)]),
+        lane("layer/1.opacity.x", &[(0.0, 1.0)]),
+        lane("red/limit_set.hit_color.x", &[]),
+    ];
+    let mut r = OffscreenRenderer::new(gpu(), &assets(), scene.clone(), Some((16, 16)), None, None).unwrap();
+    r.instance_mut().apply(&refused);
+    let messages = r.instance_mut().take_messages();
+    assert_eq!(messages.len(), refused.len(), "one message each: {messages:#?}");
+    assert_eq!(r.instance_mut().scene().tracks.len(), scene.tracks.len(), "nothing changed");
+    // The master's lane removed at frame 150 (at 0.25 since 2 s): it stays where the lane left it,
+    // and a lane added on the red clip's colour drives it.
+    let events =
+        [(150, lane("master.level", &[])), (150, lane("red/limit_set.hit_color.y", &[(0.0, 0.0), (10.0, 1.0)]))];
+    let (levels_after, _) = levels(scene.clone(), 200, &events);
+    assert!(levels_after[150..].iter().all(|l| *l == 0.25), "{:?}", &levels_after[150..]);
+    let red = scene.node_index("red/limit_set").unwrap();
+    let mut r = OffscreenRenderer::new(gpu(), &assets(), scene, Some((16, 16)), None, None).unwrap();
+    for (frame, event) in events {
+        r.schedule(frame, vec![event]);
+    }
+    for _ in 0..=180 {
+        r.render_only().unwrap();
+    }
+    let green = r.instance_mut().params(red).get("hit_color").components()[1];
+    assert!((green - 0.3).abs() < 1e-4, "the added lane at 3 s of 10: {green}");
 }

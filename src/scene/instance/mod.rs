@@ -185,6 +185,15 @@ impl SceneInstance {
                     self.messages.extend(refused);
                 }
                 ControlEvent::Audio(snapshot) => self.nodes.iter_mut().for_each(|n| n.hear(snapshot)),
+                ControlEvent::Lane(lane) => match super::show::apply_lane(&mut self.scene, lane) {
+                    // The edited lane plays at once: a take recorded into it is heard back.
+                    // A chain edit built ahead from the show before this edit would lose it.
+                    Ok(driven) => {
+                        self.overridden.remove(&driven);
+                        self.revision += 1;
+                    }
+                    Err(e) => self.messages.push(e),
+                },
             }
         }
     }

@@ -10,6 +10,8 @@ mod budget;
 pub mod chain_edit;
 pub mod effects;
 mod file;
+pub mod lane_file;
+pub mod lanes;
 mod load;
 mod mixer;
 mod runtime;
@@ -20,6 +22,7 @@ pub mod timeline;
 pub use file::{
     ClipFile, ClipPolicy, CueFile, EffectFile, Hold, LayerFile, Quantize, ShowFile, TransitionFile, is_show,
 };
+pub use lanes::{LaneTake, MAX_LANE_KEYS, apply_lane, raw_keys, scalar_keys};
 pub use load::{build_show, load_show, parse_show};
 pub use mixer::{Mixer, MixerFrame, TRANSITION_BASE, TransitionUniforms, transition_file};
 pub use runtime::ShowRuntime;

@@ -27,7 +27,7 @@ pub const MAX_LANES: usize = 1024;
 /// The most markers.
 pub const MAX_MARKERS: usize = 4096;
 /// The latest a marker may be: a day, as timecode runs.
-const MAX_SECONDS: f64 = 86_400.0;
+pub(super) const MAX_SECONDS: f64 = 86_400.0;
 
 /// The `timeline` section of a show file.
 #[derive(Clone, Debug, Default, Deserialize)]
