@@ -142,7 +142,10 @@ impl WindowChase {
             None => false,
             Some(Ok(sought)) => {
                 let (frame, from) = (sought.player.now().frame, sought.from);
-                log::info!("timecode: sought frame {frame} from frame {from}, the code is at {wanted}");
+                match self.placed {
+                    Some(_) => log::info!("sought frame {frame} from frame {from}, for frame {wanted}"),
+                    None => log::info!("timecode: sought frame {frame} from frame {from}, the code is at {wanted}"),
+                }
                 (*player, *runtime) = (sought.player, sought.runtime);
                 self.seek = None;
                 true

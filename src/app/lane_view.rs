@@ -155,7 +155,9 @@ impl LaneView {
     /// edits the performer made.
     pub fn draw(&mut self, ui: &mut egui::Ui, instance: &SceneInstance, now: FrameTime) -> Vec<ControlEvent> {
         let mut events = Vec::new();
-        let Some((show, _)) = instance.show() else { return events };
+        if instance.show().is_none() {
+            return events;
+        }
         self.poll_save();
         egui::CollapsingHeader::new("timeline").default_open(true).show(ui, |ui| {
             ui.horizontal(|ui| {
@@ -181,7 +183,7 @@ impl LaneView {
                     .on_hover_text("write the lanes into the show file")
                     .clicked()
                 {
-                    self.save(show.file.as_deref(), show.sources.first());
+                    self.save(instance.show_source());
                 }
                 if let Some(status) = &self.status {
                     ui.small(status);
@@ -232,7 +234,9 @@ impl LaneView {
             painter.line_segment([pos2(x, rect.top()), pos2(x, rect.bottom())], Stroke::new(2.0, color));
         };
         mark(now.seconds, Color32::RED);
-        let pointer = response.interact_pointer_pos().map(|p| f64::from(axes.key_time(p.x)));
+        // Where the press is, or was at release (a slow frame may see the whole drag at once).
+        let pointer = response.interact_pointer_pos().or(ui.input(|i| i.pointer.latest_pos()));
+        let pointer = pointer.map(|p| f64::from(axes.key_time(p.x)));
         if response.dragged() {
             self.ghost = pointer;
         }
@@ -307,7 +311,9 @@ impl LaneView {
         let shown = dragging.unwrap_or_else(|| keys.clone());
         self.paint(ui, &axes, &shown, lane, now);
         let pointer = response.interact_pointer_pos();
-        if let Some(at) = pointer.filter(|_| response.drag_started())
+        // The key under the press, not under the pointer when the drag is seen to start.
+        let pressed = ui.input(|i| i.pointer.press_origin()).or(pointer);
+        if let Some(at) = pressed.filter(|_| response.drag_started())
             && let Some(index) = axes.key_at(&keys, at)
         {
             self.drag = Some(KeyDrag { target: lane.target.clone(), index, keys: keys.clone() });
@@ -391,9 +397,10 @@ impl LaneView {
         event
     }
 
-    /// Writes the lanes of `source` into the show file at `path` on a thread of its own.
-    fn save(&mut self, source: Option<&ShowSource>, path: Option<&String>) {
-        let (Some(source), Some(path)) = (source, path.map(std::path::PathBuf::from).filter(|p| p.is_file())) else {
+    /// Writes the lanes of the show's `source` into its file on a thread of its own.
+    fn save(&mut self, source: Option<(&ShowSource, &str)>) {
+        let Some((source, path)) = source.map(|(s, p)| (s, std::path::PathBuf::from(p))).filter(|(_, p)| p.is_file())
+        else {
             self.status = Some("the show is built in: copy its file and run that to save lanes".into());
             return;
         };

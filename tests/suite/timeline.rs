@@ -279,8 +279,7 @@ fn a_fader_move_recorded_into_a_lane_replays_at_every_step_and_from_the_saved_fi
     // Saved into the file: the show read from it plays the performance with no events at all.
     let mut r = OffscreenRenderer::new(gpu(), &assets(), scene, Some((16, 16)), None, None).unwrap();
     r.instance_mut().apply(&[edit]);
-    let show = r.instance_mut().scene().show.clone().unwrap();
-    let source = show.file.as_ref().unwrap();
+    let (source, _) = r.instance_mut().show_source().unwrap();
     let saved = with_lanes(&source.text, &source.file.timeline.lanes).unwrap();
     assert!(saved.contains("(target: \"blue/limit_set.hit_color.x\""), "the other lanes stay: {saved}");
     assert_eq!(levels(show_from(&saved), 300, &[]), (performed, images), "the saved show plays the take");

@@ -112,6 +112,13 @@ impl SceneInstance {
         self.show.as_ref().map(|s| (s.plan(), s.state()))
     }
 
+    /// A show's source as edited live (its lanes, its chains) and the file it was read from:
+    /// what saving the lanes writes (the play state's plan keeps the source it was built with).
+    pub fn show_source(&self) -> Option<(&super::show::ShowSource, &str)> {
+        let show = self.scene.show.as_deref()?;
+        Some((show.file.as_deref()?, show.sources.first()?.as_str()))
+    }
+
     /// The validated scene.
     pub fn scene(&self) -> &Scene {
         &self.scene

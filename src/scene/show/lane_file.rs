@@ -20,8 +20,15 @@ pub fn with_lanes(text: &str, lanes: &[TrackFile]) -> Result<String, String> {
             let open = struct_open(b, timeline.start).ok_or("the show's timeline is not a ( … ) section")?;
             let (inner, _) = self::fields(b, open)?;
             match inner.iter().find(|f| f.name == "lanes") {
-                Some(old) => format!("{}{}{}", &text[..old.start], lanes_text(lanes, 8), &text[old.end..]),
-                None => format!("{}\n        lanes: {},{}", &text[..=open], lanes_text(lanes, 8), &text[open + 1..]),
+                Some(old) => {
+                    let list = lanes_text(lanes, indent_at(text, old.start) + 4);
+                    format!("{}{list}{}", &text[..old.start], &text[old.end..])
+                }
+                None => {
+                    let field = indent_at(text, timeline.start) + 4;
+                    let list = lanes_text(lanes, field + 4);
+                    format!("{}\n{}lanes: {list},{}", &text[..=open], " ".repeat(field), &text[open + 1..])
+                }
             }
         }
         None => {
@@ -78,6 +85,12 @@ pub fn lanes_text(lanes: &[TrackFile], indent: usize) -> String {
     out.push_str(&" ".repeat(indent.saturating_sub(4)));
     out.push(']');
     out
+}
+
+/// The indentation of the line `at` is on.
+fn indent_at(text: &str, at: usize) -> usize {
+    let line = text[..at].rfind('\n').map_or(0, |i| i + 1);
+    text[line..].chars().take_while(|c| *c == ' ').count()
 }
 
 /// A number as short as reads back the same: an f32's shortest form where it was one.
@@ -287,6 +300,10 @@ mod tests {
         assert!(saved.contains("// the set for Friday: \"keep\" this ( comment"), "{saved}");
         assert!(saved.contains("/* a note, ) with a bracket */") && saved.contains("], // the old lane"), "{saved}");
         assert!(saved.contains("(0.016666668, 0.3)"), "numbers in their shortest form: {saved}");
+        assert!(
+            saved.contains("\n            (target: \"layer/1.opacity\"") && saved.contains("\n        ], // the old"),
+            "{saved}"
+        );
         assert!(!saved.contains("keys: [(0.0, 1.0)]"), "the old lane is gone: {saved}");
         let parsed: ShowFile = ron_options().from_str(&saved).unwrap();
         assert_eq!(parsed.timeline.markers.len(), 1);
