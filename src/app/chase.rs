@@ -18,9 +18,11 @@ use crate::timecode::chase::{Chasing, Follow, follow, frame_at};
 /// The most steps one displayed frame runs to catch up with the code; further is a seek.
 const MAX_CATCH_UP_STEPS: u32 = 12;
 
-/// Frames the code may be behind the screen before that is a jump back: a live input's timing
-/// wobbles by a frame or two.
-const JITTER_FRAMES: u64 = 2;
+/// How far (seconds) the code may be behind the screen before that is a jump back, sought;
+/// less is waited for. A live input's timing wobbles, and on a busy machine audio reaches the
+/// show in late bursts: the code read from it can seem to go back by half a second (the LTC
+/// chase test saw up to 0.57 s while the machine compiled). A desk's locate is further.
+const JITTER_SECONDS: f64 = 0.75;
 
 /// How long after a seek that failed no other is tried (it would fail each frame).
 const RETRY_AFTER: Duration = Duration::from_secs(2);
@@ -102,6 +104,7 @@ impl WindowChase {
     ) -> u32 {
         let Some(seconds) = chasing.seconds() else { return 0 };
         let wanted = frame_at(seconds, f64::from(player.now().dt));
+        let jitter = (JITTER_SECONDS / f64::from(player.now().dt)) as u64;
         if !self.take_sought(wanted, player, runtime, overlay) {
             return 0;
         }
@@ -109,7 +112,7 @@ impl WindowChase {
         let plan = match next.checked_sub(1) {
             // Nothing stepped yet: a code near the start is stepped to, as a show plays.
             None if wanted < u64::from(MAX_CATCH_UP_STEPS) => Follow::Step(wanted as u32 + 1),
-            drawn => follow(wanted, drawn, MAX_CATCH_UP_STEPS, JITTER_FRAMES),
+            drawn => follow(wanted, drawn, MAX_CATCH_UP_STEPS, jitter),
         };
         let steps = match plan {
             Follow::Hold => 0,

@@ -21,9 +21,10 @@ const JUMP_FRAMES: f64 = 2.0;
 const CATCH_UP: f64 = 0.04;
 /// The most the speed is off normal.
 const MAX_SPEED_CHANGE: f64 = 0.02;
-/// A report older than this (the show closed or stalled) stops the code: silence until the
-/// next.
-pub const STALE_SECONDS: f64 = 0.25;
+/// A report older than this (the show closed or hung) stops the code: silence until the next.
+/// A second, not a frame or two: a window that stalls for a moment on a busy machine (a build,
+/// a slow frame) must not cut the code a desk is chasing.
+pub const STALE_SECONDS: f64 = 1.0;
 
 /// Where the show is for [`LtcFollower::fill`]: its position in code seconds (the timeline's
 /// seconds plus its start label's) when the block's first sample sounds, and how old the
@@ -183,7 +184,7 @@ mod tests {
         // No report for longer than the stale time: silence.
         let mut follower = LtcFollower::new(48_000, rate, 0.5);
         let mut block = vec![1.0; 48_000];
-        follower.fill(&mut block, Some(ShowPosition { seconds: 10.0, age: 0.3 }));
+        follower.fill(&mut block, Some(ShowPosition { seconds: 10.0, age: STALE_SECONDS + 0.05 }));
         assert!(block.iter().all(|&s| s == 0.0));
         follower.fill(&mut block, None);
         assert!(block.iter().all(|&s| s == 0.0) && follower.frames == 0);
