@@ -5,6 +5,7 @@
 //! move into it; save the lanes into the show file. Every edit is a `ControlEvent::Lane`, so a
 //! recording of the set holds it and a replay makes it on the same frame.
 
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::sync::mpsc::{Receiver, TryRecvError};
 
@@ -263,15 +264,7 @@ impl LaneView {
         let mut events = Vec::new();
         let keys = scalar_keys(&lane.track);
         let recordable = keys.is_some() && !lane.beats && lane.track.time_scale == 1.0;
-        let edit = |keys: Vec<(f32, f32)>| {
-            ControlEvent::Lane(LaneKeys {
-                target: lane.target.clone(),
-                keys: raw_keys(&keys),
-                interpolation: lane.track.interpolation,
-                repeat: lane.track.repeat,
-                beats: lane.beats,
-            })
-        };
+        let edit = |keys: Vec<(f32, f32)>| edit(lane, &keys);
         ui.horizontal(|ui| {
             let armed = self.armed.contains_key(&lane.target);
             let hint = "record: arm, then move the parameter; disarm to keep the take";
@@ -289,7 +282,7 @@ impl LaneView {
                 }
             }
             if ui.small_button("x").on_hover_text("remove this lane").clicked() {
-                events.push(ControlEvent::Lane(LaneKeys { keys: Vec::new(), ..lane_keys(lane) }));
+                events.push(edit(Vec::new()));
             }
             let unit = if lane.beats { " (beats)" } else { "" };
             ui.label(format!("{}{unit}", lane.target));
@@ -347,14 +340,20 @@ impl LaneView {
         let painter = ui.painter_at(axes.rect);
         let armed = self.armed.contains_key(&lane.target);
         painter.rect_filled(axes.rect, 0.0, if armed { Color32::from_rgb(60, 20, 20) } else { Color32::from_gray(20) });
-        let with =
-            |(time, value): (f32, f32)| crate::params::Key { time, value: crate::params::ParamValue::Float(value) };
-        let track =
-            Track::new(keys.iter().copied().map(with).collect(), lane.track.interpolation, lane.track.repeat, 1.0);
+        // The lane's own track, unless a key is being dragged (its keys are then `keys`).
+        let scale = lane.track.time_scale;
+        let track = if self.drag.as_ref().is_some_and(|d| d.target == lane.target) {
+            let with =
+                |(time, value): (f32, f32)| crate::params::Key { time, value: crate::params::ParamValue::Float(value) };
+            let keys = keys.iter().copied().map(with).collect();
+            Cow::Owned(Track::new(keys, lane.track.interpolation, lane.track.repeat, scale))
+        } else {
+            Cow::Borrowed(&lane.track)
+        };
         let points = (0..=axes.rect.width() as usize / 2)
             .map(|i| {
                 let x = axes.rect.left() + i as f32 * 2.0;
-                pos2(x, axes.y(track.sample(f64::from(axes.key_time(x))).components()[0]))
+                pos2(x, axes.y(track.sample(f64::from(axes.key_time(x) / scale)).components()[0]))
             })
             .collect();
         painter.line(points, Stroke::new(1.5, Color32::LIGHT_BLUE));
@@ -435,16 +434,15 @@ fn lane<'a>(instance: &'a SceneInstance, target: &str) -> Option<&'a BoundTrack>
     instance.scene().tracks.iter().find(|t| t.show_clock && t.target == target)
 }
 
-/// `lane` as an edit that leaves it as it is.
-fn lane_keys(lane: &BoundTrack) -> LaneKeys {
-    let keys = scalar_keys(&lane.track).map(|k| raw_keys(&k)).unwrap_or_default();
-    LaneKeys {
+/// `lane` given `keys` (none: removed), the rest of it as it is.
+fn edit(lane: &BoundTrack, keys: &[(f32, f32)]) -> ControlEvent {
+    ControlEvent::Lane(LaneKeys {
         target: lane.target.clone(),
-        keys,
+        keys: raw_keys(keys),
         interpolation: lane.track.interpolation,
         repeat: lane.track.repeat,
         beats: lane.beats,
-    }
+    })
 }
 
 #[cfg(test)]

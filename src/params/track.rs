@@ -61,7 +61,9 @@ impl Track {
     pub fn sample(&self, seconds: f64) -> ParamValue {
         let (first, last) = (&self.keys[0], &self.keys[self.keys.len() - 1]);
         let t = self.local_time(seconds * f64::from(self.time_scale), f64::from(first.time), f64::from(last.time));
-        let next = self.keys.iter().position(|k| f64::from(k.time) > t).unwrap_or(self.keys.len());
+        // Keys are sorted: a binary search, as tracks are sampled every step and a recorded
+        // lane holds thousands of keys.
+        let next = self.keys.partition_point(|k| f64::from(k.time) <= t);
         if next == 0 {
             return first.value;
         }
