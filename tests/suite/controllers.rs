@@ -43,6 +43,7 @@ impl Jack {
         let n = SERVERS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
         let name = format!("indra-test-{}-{n}", std::process::id());
         let turn = TURN.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        clear_stale_registrations();
         let log = std::env::temp_dir().join(format!("{name}.log"));
         let spawned = Command::new("jackd")
             // Synchronous: each cycle waits for every client, so a client a busy machine delays
@@ -65,9 +66,9 @@ impl Jack {
             .is_ok_and(|o| o.status.success())
         {
             let said = std::fs::read_to_string(&log).unwrap_or_default();
-            // JACK's registry holds eight servers; one that did not stop cleanly keeps its place.
+            // Stale places were cleared above; these are servers still running.
             let hint = if said.contains("Too many servers") {
-                "\n(registrations of earlier runs' servers: with no jackd running, `rm -rf /dev/shm/jack*` clears them)"
+                "\n(JACK's registry is full of running servers: `pgrep -a jackd` lists them)"
             } else {
                 ""
             };
@@ -75,6 +76,25 @@ impl Jack {
             std::thread::sleep(Duration::from_millis(100));
         }
         Some(jack)
+    }
+}
+
+/// JACK's registry holds eight servers and frees a dead one's place only for a server of the
+/// same name; a jackd killed before it could unregister (a test machine reused, a run cut off)
+/// keeps its place for good. With no jackd running at all, every registration is stale, and
+/// the registry and the servers' segments are removed.
+fn clear_stale_registrations() {
+    let running =
+        std::fs::read_dir("/proc").into_iter().flatten().flatten().any(|entry| {
+            std::fs::read_to_string(entry.path().join("comm")).is_ok_and(|name| name.trim_end() == "jackd")
+        });
+    if running {
+        return;
+    }
+    for entry in std::fs::read_dir("/dev/shm").into_iter().flatten().flatten() {
+        if entry.file_name().to_string_lossy().starts_with("jack") {
+            let _ = std::fs::remove_file(entry.path());
+        }
     }
 }
 
