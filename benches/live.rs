@@ -11,7 +11,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use indra::assets::Assets;
 use indra::control::osc::OscReceiver;
 use indra::control::osc_route::OscRouter;
-use indra::gpu::{BackendChoice, Gpu, GpuOptions};
+use indra::gpu::{Gpu, GpuOptions};
 use indra::live::LiveReload;
 use indra::offscreen::OffscreenRenderer;
 use indra::scene::load_scene;
@@ -88,7 +88,7 @@ fn reload_latency(c: &mut Criterion) {
     copy_assets(&root);
     let assets = Assets::new(Some(root.clone()));
     let scene = load_scene(&assets, "kleinian_classic").unwrap();
-    let gpu = Gpu::headless(&GpuOptions { backend: BackendChoice::Auto, adapter: None }).unwrap();
+    let gpu = Gpu::headless(&GpuOptions::default()).unwrap();
     let mut renderer = OffscreenRenderer::new(gpu, &assets, scene, Some((256, 256)), None, None).unwrap();
     let mut live = LiveReload::new(&assets).unwrap();
     let shader = root.join("shaders/kleinian.wgsl");

@@ -29,8 +29,8 @@ const REPEATS: usize = 200;
 
 fn main() -> Result<(), String> {
     let particles: u32 = std::env::args().nth(1).map_or(Ok(1 << 20), |a| a.parse()).map_err(|e| format!("{e}"))?;
-    let gpu =
-        Gpu::headless(&GpuOptions { backend: BackendChoice::Vulkan, adapter: None }).map_err(|e| e.to_string())?;
+    let gpu = Gpu::headless(&GpuOptions { backend: BackendChoice::Vulkan, ..GpuOptions::default() })
+        .map_err(|e| e.to_string())?;
     if !gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
         return Err(format!("{} has no timestamp queries", gpu.adapter_label()));
     }

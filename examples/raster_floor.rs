@@ -60,8 +60,8 @@ fn main() -> Result<(), String> {
     let mut args = std::env::args().skip(1).map(|a| a.parse::<u32>().map_err(|e| e.to_string()));
     let width = args.next().unwrap_or(Ok(3840))?;
     let height = args.next().unwrap_or(Ok(2160))?;
-    let gpu =
-        Gpu::headless(&GpuOptions { backend: BackendChoice::Vulkan, adapter: None }).map_err(|e| e.to_string())?;
+    let gpu = Gpu::headless(&GpuOptions { backend: BackendChoice::Vulkan, ..GpuOptions::default() })
+        .map_err(|e| e.to_string())?;
     if !gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS) {
         return Err(format!("{} has no timestamps inside encoders", gpu.adapter_label()));
     }

@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand};
 use indra::gpu::BackendChoice;
+use indra::gpu::tuning::TuningSource;
 
 /// Limits glibc to two malloc arenas. By default each thread that allocates while the others
 /// hold theirs gets an arena of its own, up to eight per core, and a show's clip builds, reloads
@@ -56,6 +57,11 @@ struct GpuArgs {
     /// Use the adapter whose name contains this text (e.g. llvmpipe, H100).
     #[arg(long, global = true)]
     adapter: Option<String>,
+    /// What parameters set to `auto` take: `saved` (what `indra tune` measured on this adapter;
+    /// the default of run and bench), `off` (the built-in defaults; the default of render and
+    /// bake, so that rendered bytes never hang on a measurement), or a tuning file.
+    #[arg(long, global = true, value_name = "saved|off|FILE")]
+    tuning: Option<String>,
 }
 
 #[derive(Subcommand)]
@@ -80,6 +86,9 @@ enum Command {
     Bench(cli::BenchArgs),
     /// Triangulate rings from a JSON or SVG file; print triangle count, area deviation and time.
     Triangulate(cli::TriangulateArgs),
+    /// Measure, on this adapter, the options that only change how fast a node draws (the
+    /// rasterizer, StarGlow's layout), and save the fastest as what `auto` takes here.
+    Tune(cli::TuneArgs),
 }
 
 fn main() -> ExitCode {
@@ -93,7 +102,14 @@ fn main() -> ExitCode {
     for folder in &cli.allow_paths {
         assets = assets.allowing(folder);
     }
-    let gpu = indra::gpu::GpuOptions { backend: cli.gpu.backend, adapter: cli.gpu.adapter };
+    let live = matches!(cli.command, None | Some(Command::Run(_) | Command::Bench(_)));
+    let tuning = match cli.gpu.tuning.as_deref() {
+        None if live => TuningSource::Saved,
+        None | Some("off") => TuningSource::Defaults,
+        Some("saved") => TuningSource::Saved,
+        Some(file) => TuningSource::File(file.into()),
+    };
+    let gpu = indra::gpu::GpuOptions { backend: cli.gpu.backend, adapter: cli.gpu.adapter, tuning };
     let result = match cli.command {
         _ if cli.list_cameras => cli::list_cameras(),
         _ if cli.list_ndi => cli::list_ndi(),
@@ -106,6 +122,7 @@ fn main() -> ExitCode {
         Some(Command::List) => cli::list(&assets),
         Some(Command::Bench(args)) => cli::bench(&assets, &gpu, &args),
         Some(Command::Triangulate(args)) => cli::triangulate(&args),
+        Some(Command::Tune(args)) => cli::tune(&assets, &gpu, &args),
     };
     // Worker threads end, and GPU objects let go of off the render thread are released, before
     // the driver unloads (a clip still building at exit is a few seconds at most).

@@ -48,6 +48,8 @@ pub struct Overlay {
     pub last_take: Option<String>,
     /// The show's timeline under the clip grid.
     pub lanes: super::lane_view::LaneView,
+    /// What `auto` parameters take on this adapter (`Tuning::summary`).
+    pub tuning: String,
 }
 
 impl Default for Overlay {
@@ -66,6 +68,7 @@ impl Default for Overlay {
             record_clicked: false,
             last_take: None,
             lanes: Default::default(),
+            tuning: String::new(),
         }
     }
 }
@@ -387,6 +390,7 @@ fn audio_learn_button(ui: &mut egui::Ui, instance: &SceneInstance, hub: &mut Con
 }
 
 fn timing_panel(ui: &mut egui::Ui, overlay: &Overlay) {
+    ui.small(&overlay.tuning);
     ui.label("GPU time per pass (rolling median)");
     if overlay.timings.is_empty() {
         ui.small("no timestamps on this adapter, or none yet");

@@ -322,6 +322,7 @@ impl Running {
                     self.lights = None;
                 }
                 (self.egui_state, self.egui_renderer) = egui_parts(&self.window, &gpu, self.config.format);
+                self.overlay.tuning = gpu.tuning.summary();
                 self.gpu = gpu;
                 self.guard.reset();
                 self.retry = None;

@@ -99,6 +99,8 @@ impl WindowApp {
         let clock = FixedClock::new(scene.dt, scene.seed);
         let size = (config.width, config.height);
         let mut overlay = Overlay::default();
+        overlay.tuning = gpu.tuning.summary();
+        log::info!("{}", overlay.tuning);
         for n in self.notices.drain(..) {
             overlay.report(n);
         }

@@ -94,6 +94,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     let device = Gpu::headless(gpu).map_err(|e| e.to_string())?;
     let adapter = device.adapter_label();
     let timestamps = device.has_timestamps();
+    let tuning = device.tuning.summary();
     let name = scene.name.clone();
     let mut renderer =
         OffscreenRenderer::new(device, assets, scene, Some(args.size), None, None).map_err(|e| e.to_string())?;
@@ -153,6 +154,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     let wall_median = record.wall_median();
     say!("scene      {name}");
     say!("adapter    {adapter}");
+    say!("tuning     {tuning}");
     say!(
         "size       {}x{}   frames {} (+{} warm-up) from frame {}",
         args.size.0,

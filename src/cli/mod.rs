@@ -28,6 +28,7 @@ mod render_dmx;
 mod run;
 mod source;
 mod triangulate;
+mod tune;
 
 pub use assemble::{AssembleArgs, assemble};
 pub use bake::{BakeArgs, bake};
@@ -39,6 +40,7 @@ use render_dmx::RenderDmx;
 pub use run::{RunArgs, run};
 
 pub use triangulate::{TriangulateArgs, triangulate};
+pub use tune::{TuneArgs, tune};
 
 /// The scene `indra` opens with no arguments.
 pub const DEFAULT_SCENE: &str = "kleinian";

@@ -164,6 +164,22 @@ pub fn user_data(name: &str) -> PathBuf {
     }
 }
 
+/// The performer's configuration folder for indra, which settings made once for a machine are
+/// kept in (the choices `indra tune` measured): `%APPDATA%\indra` on Windows,
+/// `~/Library/Application Support/indra` on macOS, else `$XDG_CONFIG_HOME/indra` or
+/// `~/.config/indra`. `None` where the environment names no home.
+pub fn user_config() -> Option<PathBuf> {
+    let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty()).map(PathBuf::from);
+    let folder = if cfg!(windows) {
+        var("APPDATA")?
+    } else if cfg!(target_os = "macos") {
+        var("HOME")?.join("Library/Application Support")
+    } else {
+        var("XDG_CONFIG_HOME").or_else(|| var("HOME").map(|home| home.join(".config")))?
+    };
+    Some(folder.join("indra"))
+}
+
 /// A file's bytes and where they came from.
 #[derive(Clone, Debug)]
 pub struct NamedBytes {

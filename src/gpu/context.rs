@@ -2,6 +2,8 @@
 
 use std::sync::{Arc, Mutex};
 
+use super::tuning::{AdapterKey, Tuning, TuningSource};
+
 /// Which graphics API to ask wgpu for.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum BackendChoice {
@@ -23,6 +25,8 @@ pub struct GpuOptions {
     pub backend: BackendChoice,
     /// Case-insensitive substring of the adapter name (e.g. "llvmpipe", "H100").
     pub adapter: Option<String>,
+    /// What `auto` parameters take on the adapter (see [`super::tuning`]).
+    pub tuning: TuningSource,
 }
 
 /// Why no device could be had; each variant's message says what to do.
@@ -82,6 +86,9 @@ pub struct Gpu {
     lost: Arc<Mutex<Option<String>>>,
     /// How the adapter was chosen, to choose again after a loss.
     options: GpuOptions,
+    /// What `auto` parameters take on this adapter: the choices `indra tune` measured here, or
+    /// the built-in defaults.
+    pub tuning: Arc<Tuning>,
 }
 
 impl Gpu {
@@ -142,7 +149,12 @@ impl Gpu {
         // Lavapipe compiles and keeps a shader variant per dispatch of values it can inline
         // from uniform buffers: bind parameter blocks as storage there (see `blocks_in_storage`).
         super::binding::set_blocks_in_storage(is_lavapipe(&info));
-        Ok(Self { instance, adapter, device, queue, uncaptured, lost, options: options.clone() })
+        let (tuning, note) = Tuning::load(&options.tuning, &AdapterKey::of(&info));
+        if let Some(note) = note {
+            log::warn!("{note}");
+        }
+        let tuning = Arc::new(tuning);
+        Ok(Self { instance, adapter, device, queue, uncaptured, lost, options: options.clone(), tuning })
     }
 
     /// A new device on the same instance, chosen as this one was, for a show to move to after

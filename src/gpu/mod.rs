@@ -12,6 +12,7 @@ mod raster;
 mod readback;
 mod reaper;
 mod shader;
+pub mod tuning;
 mod watchdog;
 
 pub use binding::{

@@ -181,6 +181,19 @@ pub struct NodeSetup<'a> {
 }
 
 impl NodeSetup<'_> {
+    /// What `rasterizer: auto` takes in `technique` on this adapter (see [`NodeSetup::tuned`]).
+    pub fn tuned_rasterizer(&self, technique: &str) -> Rasterizer {
+        self.tuned(technique, "rasterizer").unwrap_or(Rasterizer::Auto)
+    }
+
+    /// The option of `technique`'s enum parameter `param` that `indra tune` measured fastest on
+    /// this adapter (what the parameter's `auto` takes), if it measured one.
+    pub fn tuned<E: crate::params::ParamEnum>(&self, technique: &str, param: &str) -> Option<E> {
+        let name = self.gpu.tuning.choice(technique, param)?;
+        let index = E::OPTIONS.iter().position(|option| *option == name)?;
+        Some(E::from_index(index as u32))
+    }
+
     /// The scene's sample count, lowered to the largest this adapter can render and resolve for
     /// every format in `formats` (colour targets and depth), at least 1.
     pub fn samples_for(&self, formats: &[wgpu::TextureFormat]) -> u32 {
@@ -343,12 +356,26 @@ impl Msaa {
 crate::param_enum! {
     /// A `rasterizer` parameter: how a node that draws geometry fills its pixels.
     pub enum Rasterizer {
+        /// What `indra tune` measured fastest on this adapter; compute where it measured nothing.
+        Auto = "auto",
         /// In compute, through a visibility buffer (64-bit atomics), where the adapter allows:
         /// on GPUs whose raster path is narrow (the H100/H200) a multisampled 4K target costs
         /// ~6 ms to clear and resolve before anything is drawn.
         Compute = "compute",
         /// The hardware rasterizer.
         Pipeline = "pipeline",
+    }
+}
+
+impl Rasterizer {
+    /// Whether a node draws in compute (where it can): `auto` stands for `tuned`, what the
+    /// node took from [`NodeSetup::tuned`] when it was made.
+    pub fn in_compute(self, tuned: Rasterizer) -> bool {
+        match self {
+            Rasterizer::Auto => tuned != Rasterizer::Pipeline,
+            Rasterizer::Compute => true,
+            Rasterizer::Pipeline => false,
+        }
     }
 }
 

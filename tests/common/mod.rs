@@ -18,7 +18,7 @@ use indra::scene::{Scene, load_scene, parse_scene};
 
 /// A headless device. Vulkan (lavapipe on CI) so that goldens are made by one backend.
 pub fn gpu() -> Gpu {
-    Gpu::headless(&GpuOptions { backend: BackendChoice::Vulkan, adapter: None })
+    Gpu::headless(&GpuOptions { backend: BackendChoice::Vulkan, ..GpuOptions::default() })
         .expect("a Vulkan adapter (on a machine without a GPU: apt-get install mesa-vulkan-drivers libvulkan1)")
 }
 

@@ -41,5 +41,6 @@ mod slurm;
 mod timecode;
 mod timeline;
 mod triangulate;
+mod tune;
 mod video;
 mod window;

@@ -24,7 +24,7 @@ use crate::params::ParamSet;
 use crate::time::{FrameTime, MAX_CATCH_UP_STEPS};
 
 use super::splat_draw::SplatUniforms;
-use super::{NodeSetup, Rasterizer, Technique, TechniqueInfo};
+use super::{NodeSetup, Technique, TechniqueInfo};
 
 /// The registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -244,7 +244,7 @@ impl Technique for Cloth {
         });
         let triangles = state.triangles(view.uniforms.sphere[3] > 0.0);
         let in_compute = !debug
-            && settings.rasterizer == Rasterizer::Compute
+            && settings.rasterizer.in_compute(this.renderer.tuned)
             && this
                 .renderer
                 .compute

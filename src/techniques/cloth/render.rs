@@ -6,7 +6,7 @@ use crate::gpu::ShaderError;
 use crate::graph::{PassContext, RasterTargets};
 use crate::techniques::splat_draw::{self, SplatDraw};
 use crate::techniques::visibility::PixelRays;
-use crate::techniques::{NodeSetup, linear_rgba};
+use crate::techniques::{NodeSetup, Rasterizer, linear_rgba};
 use crate::time::FrameTime;
 use std::cell::RefCell;
 
@@ -103,6 +103,8 @@ pub struct Renderer {
     /// The lit surface and sphere drawn in compute, where the adapter has 64-bit atomics (a
     /// cell: its passes keep bind groups while the graph holds the node shared).
     pub compute: Option<RefCell<SplatDraw>>,
+    /// What `rasterizer: auto` takes on this adapter.
+    pub tuned: Rasterizer,
 }
 
 impl Renderer {
@@ -163,7 +165,8 @@ impl Renderer {
         } else {
             None
         };
-        Ok(Self { surface, sphere, lines, points, insets, layout, uniform, samples, compute })
+        let tuned = setup.tuned_rasterizer(super::INFO.name);
+        Ok(Self { surface, sphere, lines, points, insets, layout, uniform, samples, compute, tuned })
     }
 
     /// Two triangles per grid cell, shared vertices: indices are particle numbers.

@@ -144,6 +144,8 @@ pub struct CubeField {
     /// The compute draw, where the adapter has 64-bit atomics (a cell: its passes keep bind
     /// groups while the graph holds the node shared).
     compute: Option<(RefCell<SplatDraw>, wgpu::BindGroup)>,
+    /// What `rasterizer: auto` takes on this adapter.
+    tuned: Rasterizer,
 }
 
 fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
@@ -188,7 +190,8 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         None
     };
     let scratch = Vec::with_capacity(MAX_CUBES);
-    Ok(Box::new(CubeField { pipeline, samples, block, instances, scratch, compute }))
+    let tuned = setup.tuned_rasterizer(INFO.name);
+    Ok(Box::new(CubeField { pipeline, samples, block, instances, scratch, compute, tuned }))
 }
 
 impl Technique for CubeField {
@@ -204,7 +207,7 @@ impl Technique for CubeField {
         let uniforms = CubeFieldUniforms::from_params(&settings, size);
         cubes_at(&settings, time, &mut self.scratch);
         let count = self.scratch.len() as u32;
-        let in_compute = settings.rasterizer == Rasterizer::Compute
+        let in_compute = settings.rasterizer.in_compute(self.tuned)
             && self.compute.as_mut().is_some_and(|c| c.0.get_mut().prepare(size, self.samples, count, false));
         let this: &'r CubeField = self;
         if in_compute {

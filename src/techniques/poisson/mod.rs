@@ -209,6 +209,8 @@ pub struct Poisson {
     /// The compute draw, where the adapter has 64-bit atomics (a cell: its passes keep bind
     /// groups while the graph holds the node shared).
     compute: Option<(RefCell<SplatDraw>, wgpu::BindGroup)>,
+    /// What `rasterizer: auto` takes on this adapter.
+    tuned: Rasterizer,
 }
 
 /// Bytes of one instance: position and insertion index.
@@ -268,6 +270,7 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
         pending: Vec::new(),
         device: device.clone(),
         compute,
+        tuned: setup.tuned_rasterizer(INFO.name),
     }))
 }
 
@@ -354,7 +357,7 @@ impl Technique for Poisson {
 
         let (w, h) = graph.output_size();
         let uniforms = camera(&key, &settings, time, w as f32 / h as f32, count, self.samples);
-        let in_compute = settings.rasterizer == Rasterizer::Compute
+        let in_compute = settings.rasterizer.in_compute(self.tuned)
             && self
                 .compute
                 .as_mut()

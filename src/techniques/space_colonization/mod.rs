@@ -137,6 +137,8 @@ pub struct SpaceColonization {
     mesh: Option<Arc<SkinnedMesh>>,
     /// Whether the last frame's tubes were drawn in compute.
     drew_in_compute: bool,
+    /// What `rasterizer: auto` takes on this adapter.
+    tuned: Rasterizer,
 }
 
 /// The models a node reads: loaded off the render thread, the last one kept by path (a restart
@@ -197,6 +199,7 @@ impl SpaceColonization {
             models,
             mesh,
             drew_in_compute: false,
+            tuned: setup.tuned_rasterizer(INFO.name),
         })
     }
 
@@ -488,7 +491,7 @@ impl Technique for SpaceColonization {
         // Tubes go to the compute draw with the floor and the glow; lines (added up whatever
         // their depth) stay with the pipeline.
         let glow_triangles = if extras.mesh { self.state.mesh.index_count / 3 } else { 0 };
-        let in_compute = style == Style::Tubes && params.rasterizer == Rasterizer::Compute && {
+        let in_compute = style == Style::Tubes && params.rasterizer.in_compute(self.tuned) && {
             let u = compute_draw::RasterUniforms::new(view_proj, eye, (w, h), samples, self.state.capacity, b)
                 .with_extras(extras.floor, glow_triangles);
             self.renderer.prepare_compute(&self.queue, &u)

@@ -70,8 +70,9 @@ crate::param_enum! {
 crate::param_enum! {
     /// The `layout` parameter: which pass layout to use.
     pub enum LayoutChoice {
-        /// The scan where the streaks step whole texels along the axes and reach past the image
-        /// (the book's defaults at 1080p and 4K), else Fused: the same image, the fewest passes.
+        /// What `indra tune` measured fastest on this adapter; where it measured nothing, the
+        /// scan where the streaks step whole texels along the axes and reach past the image (the
+        /// book's defaults at 1080p and 4K), else Fused: the same image, the fewest passes.
         Auto = "Auto",
         /// The book's pass layout.
         Book = "Book",
@@ -184,6 +185,8 @@ pub struct StarGlow {
     uniforms: Vec<wgpu::Buffer>,
     /// Bind groups by (slot, kernel id, texture ids): steady-state frames create none.
     bind_groups: RefCell<BindGroupCache<(usize, [u64; 4])>>,
+    /// What `layout: Auto` takes on this adapter (`Auto` itself: the scan where it applies).
+    tuned: LayoutChoice,
 }
 
 /// A pipeline and the layout of its one bind group.
@@ -284,7 +287,8 @@ fn create(setup: &NodeSetup<'_>) -> Result<Box<dyn Technique>, ShaderError> {
     });
     let uniforms =
         (0..MAX_PASSES).map(|_| crate::gpu::uniform_buffer::<StarGlowUniforms>(device, "star_glow_uniforms")).collect();
-    Ok(Box::new(StarGlow { kernels, sampler, uniforms, bind_groups: RefCell::default() }))
+    let tuned = setup.tuned(INFO.name, "layout").unwrap_or(LayoutChoice::Auto);
+    Ok(Box::new(StarGlow { kernels, sampler, uniforms, bind_groups: RefCell::default(), tuned }))
 }
 
 impl Technique for StarGlow {
@@ -296,7 +300,10 @@ impl Technique for StarGlow {
         inputs: &[TextureHandle],
     ) -> TextureHandle {
         let source = inputs[0];
-        let settings = Settings::read(params);
+        let mut settings = Settings::read(params);
+        if settings.layout == LayoutChoice::Auto {
+            settings.layout = self.tuned;
+        }
         // A zero-effect setting adds no passes: the source goes straight through.
         if settings.intensity <= 0.0 {
             return source;

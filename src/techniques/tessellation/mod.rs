@@ -93,6 +93,8 @@ pub struct Tessellation {
     compute_raster: Option<RefCell<ComputeRaster>>,
     /// Whether the last frame was drawn in compute.
     drew_in_compute: bool,
+    /// What `rasterizer: auto` takes on this adapter.
+    tuned: Rasterizer,
     /// The last frame's uniforms (tests compare against the CPU reference with them).
     last: Option<TessUniforms>,
 }
@@ -220,6 +222,7 @@ impl Tessellation {
             draw_groups: RefCell::default(),
             compute_raster,
             drew_in_compute: false,
+            tuned: setup.tuned_rasterizer(INFO.name),
             last: None,
         })
     }
@@ -397,7 +400,7 @@ impl Technique for Tessellation {
         self.draw_groups.get_mut().begin_frame();
         let settings = Settings::read(params);
         let samples = settings.msaa.samples(self.samples);
-        self.drew_in_compute = settings.rasterizer == Rasterizer::Compute
+        self.drew_in_compute = settings.rasterizer.in_compute(self.tuned)
             && self.compute_raster.as_mut().is_some_and(|r| r.get_mut().prepare(&self.queue, size, samples, u.grid));
 
         let this: &'r Tessellation = self;
