@@ -36,6 +36,7 @@ mod pipewire;
 mod recovery;
 mod seek;
 mod show;
+mod show_memory;
 #[cfg(target_os = "linux")]
 mod slurm;
 mod timecode;
