@@ -226,12 +226,22 @@ fn a_show_chases_ltc_on_its_audio_input_through_a_jump_a_dropout_and_a_stop() {
 
     let play = format!("play desk {} cpal_client_.*_in:in_1", code.display());
     assert_eq!(devices.command(&play), "playing");
-    std::thread::sleep(Duration::from_secs(15));
+    // Where the desk's file was at each cycle, on the wall clock, until it has played to its end:
+    // 14 s of code, longer where a busy machine runs JACK's cycles late.
+    let length = out.stdout.len() as u64;
+    let mut cycles: Vec<(f64, u64)> = Vec::new();
+    let deadline = std::time::Instant::now() + Duration::from_secs(90);
+    while cycles.last().is_none_or(|&(_, at)| at < length) {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the desk played {:?} of {length} samples in 90 s",
+            cycles.last()
+        );
+        std::thread::sleep(Duration::from_millis(500));
+        let played = devices.command("played desk");
+        cycles.extend(played.as_array().unwrap().iter().map(|c| (c[0].as_f64().unwrap(), c[1].as_u64().unwrap())));
+    }
     show.interrupt();
-    // Where the desk's file was at each cycle, on the wall clock.
-    let cycles: Vec<(f64, u64)> = (devices.command("played desk").as_array().unwrap().iter())
-        .map(|c| (c[0].as_f64().unwrap(), c[1].as_u64().unwrap()))
-        .collect();
     assert!(cycles.len() > 1000, "{} cycles played", cycles.len());
     // A segment of the file: its first label (a 25 fps count) and its samples.
     let run = |frame: u64, from: u64, to: u64| {

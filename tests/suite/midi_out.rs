@@ -175,7 +175,18 @@ fn the_show_is_the_timecode_master_over_mtc_and_ltc() {
     // (69 read there once); how the labels run and where they fall is checked below.
     assert!(frames.len() >= 55, "{} LTC frames read in over 3 s", frames.len());
     let steps = frames.windows(2).filter(|w| w[1].0 != w[0].0 + 1).count();
-    assert!(steps <= locates, "{steps} breaks in the LTC labels with {locates} MTC locates");
+    // Where the audio clock lost time against the wall clock (JACK's dummy driver runs its
+    // cycles late on a busy machine, and the samples do not catch up), the code falls behind the
+    // show, and the labels jump forward to it, as they must: a break for each frame lost is
+    // allowed beside the MTC's locates. On a quiet machine nothing is lost and none is.
+    let (first_cycle, last_cycle) = (cycles[0], cycles[cycles.len() - 1]);
+    let lost = (last_cycle.0 - first_cycle.0) - (last_cycle.1 - first_cycle.1) as f64 / 48_000.0;
+    let allowed = locates + (lost.max(0.0) * 25.0).ceil() as usize;
+    assert!(
+        steps <= allowed,
+        "{steps} breaks in the LTC labels with {locates} MTC locates and {:.0} ms of audio time lost",
+        lost * 1e3
+    );
     // When sample `s` of the recording came: the cycle it was in, on the cycle's clock.
     let time_of = |s: u64| {
         let i = cycles.partition_point(|&(_, first)| first <= s).max(1) - 1;
@@ -194,6 +205,16 @@ fn the_show_is_the_timecode_master_over_mtc_and_ltc() {
     gaps.sort_by(f64::total_cmp);
     assert!(gaps.len() >= 50, "{} LTC frames beside the MTC", gaps.len());
     let (median, p90) = (gaps[gaps.len() / 2], gaps[gaps.len() * 9 / 10].abs().max(gaps[gaps.len() / 10].abs()));
-    eprintln!("LTC against MTC: {median:+.2} frames median, {p90:.2} at the 10th/90th percentile");
-    assert!(median.abs() < 0.5 && p90 < 0.75, "LTC off the MTC by {median:+.2} frames median, {p90:.2} p10/p90");
+    // Audio time lost (above) puts the code behind by as much, up to the two frames past which
+    // it jumps, until its vari-speed (2 %) has caught up: the tolerance grows by that much.
+    let behind = (lost.max(0.0) * 25.0).min(2.0);
+    eprintln!(
+        "LTC against MTC: {median:+.2} frames median, {p90:.2} at the 10th/90th percentile; {:.0} ms of audio time lost",
+        lost * 1e3
+    );
+    assert!(
+        median.abs() < 0.5 + behind && p90 < 0.75 + behind,
+        "LTC off the MTC by {median:+.2} frames median, {p90:.2} p10/p90, with {:.0} ms of audio time lost",
+        lost * 1e3
+    );
 }
