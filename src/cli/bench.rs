@@ -138,8 +138,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         let newest = renderer.last_submission();
         let wait_for = if args.pipelined { std::mem::replace(&mut in_flight, newest) } else { newest };
         if let Some(index) = wait_for {
-            let wait = wgpu::PollType::Wait { submission_index: Some(index), timeout: None };
-            let _ = renderer.gpu().device.poll(wait);
+            renderer.wait_for(index);
         }
         let now = Instant::now();
         let ms = |from: Instant, to: Instant| (to - from).as_secs_f64() * 1e3;

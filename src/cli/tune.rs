@@ -45,51 +45,19 @@ struct Tunable {
     needs_atomics: bool,
 }
 
-const RASTERIZER: &[&str] = &["compute", "pipeline"];
+/// A technique's `rasterizer`, measured in `scene` from frame `start`.
+const fn rasterizer(technique: &'static str, scene: &'static str, start: u64) -> Tunable {
+    Tunable { technique, parameter: "rasterizer", options: &["compute", "pipeline"], scene, start, needs_atomics: true }
+}
 
 /// Everything `auto` can stand for. Msaa is not here: its options draw different images, a
 /// choice of look for the performer, not of speed; no kernel has workgroup-size variants.
 const TUNABLES: &[Tunable] = &[
-    Tunable {
-        technique: "tessellation",
-        parameter: "rasterizer",
-        options: RASTERIZER,
-        scene: "tessellation_fluid",
-        start: 120,
-        needs_atomics: true,
-    },
-    Tunable {
-        technique: "space_colonization",
-        parameter: "rasterizer",
-        options: RASTERIZER,
-        scene: "space_colonization_tubes",
-        start: 200,
-        needs_atomics: true,
-    },
-    Tunable {
-        technique: "poisson",
-        parameter: "rasterizer",
-        options: RASTERIZER,
-        scene: "poisson_3d",
-        start: 120,
-        needs_atomics: true,
-    },
-    Tunable {
-        technique: "cube_field",
-        parameter: "rasterizer",
-        options: RASTERIZER,
-        scene: "star_glow",
-        start: 0,
-        needs_atomics: true,
-    },
-    Tunable {
-        technique: "cloth",
-        parameter: "rasterizer",
-        options: RASTERIZER,
-        scene: "cloth",
-        start: 120,
-        needs_atomics: true,
-    },
+    rasterizer("tessellation", "tessellation_fluid", 120),
+    rasterizer("space_colonization", "space_colonization_tubes", 200),
+    rasterizer("poisson", "poisson_3d", 120),
+    rasterizer("cube_field", "star_glow", 0),
+    rasterizer("cloth", "cloth", 120),
     Tunable {
         technique: "star_glow",
         parameter: "layout",
@@ -113,14 +81,15 @@ pub fn tune(assets: &Assets, gpu: &GpuOptions, args: &TuneArgs) -> Result<(), St
     // untuned, never an earlier tuning.
     let device =
         Gpu::headless(&GpuOptions { tuning: TuningSource::Defaults, ..gpu.clone() }).map_err(|e| e.to_string())?;
-    let key = AdapterKey::of(&device.adapter.get_info());
+    let info = device.adapter.get_info();
+    let key = AdapterKey::of(&info);
     let path = match &args.out {
         Some(path) => path.clone(),
         None => Tuning::path_for(&key).ok_or("no configuration folder (set HOME, or give --out FILE)")?,
     };
     // A CPU adapter (lavapipe) draws on the cores that step and record the frame, and its
     // timestamps leave out the work it does at submit: what a frame costs there is its wall time.
-    let cpu_adapter = device.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
+    let cpu_adapter = info.device_type == wgpu::DeviceType::Cpu;
     let gpu_clock = device.has_timestamps() && !cpu_adapter;
     let clock = if gpu_clock { "GPU" } else { "wall" };
     say!("adapter    {}", device.adapter_label());
@@ -131,6 +100,7 @@ pub fn tune(assets: &Assets, gpu: &GpuOptions, args: &TuneArgs) -> Result<(), St
         args.frames,
         args.warmup
     );
+    let assets = &assets.rendering_at(Some(args.size));
     let atomics = device.device.features().contains(indra::techniques::splat_draw::FEATURES);
     let mut tuning = Tuning { key: Some(key), clock: clock.into(), choices: Vec::new() };
     for tunable in TUNABLES.iter().filter(|t| args.only.is_empty() || args.only.iter().any(|o| o == t.technique)) {
@@ -162,8 +132,8 @@ pub fn tune(assets: &Assets, gpu: &GpuOptions, args: &TuneArgs) -> Result<(), St
     Ok(())
 }
 
-/// The median frame of `tunable`'s scene with every node of its technique set to `option`:
-/// GPU time (`gpu_clock`) or wall time.
+/// The median frame of `tunable`'s scene (from `assets`, which render at `args.size`) with every
+/// node of its technique set to `option`: GPU time (`gpu_clock`) or wall time.
 fn measure(
     assets: &Assets,
     device: &Gpu,
@@ -172,7 +142,6 @@ fn measure(
     args: &TuneArgs,
     gpu_clock: bool,
 ) -> Result<f64, String> {
-    let assets = &assets.rendering_at(Some(args.size));
     let mut scene = load_scene(assets, tunable.scene).map_err(|e| e.to_string())?;
     let ids: Vec<String> =
         scene.nodes.iter().filter(|n| n.technique.name == tunable.technique).map(|n| n.id.clone()).collect();
@@ -195,8 +164,7 @@ fn measure(
         let began = Instant::now();
         renderer.render_only().map_err(|e| e.to_string())?;
         if let Some(index) = renderer.last_submission() {
-            let wait = wgpu::PollType::Wait { submission_index: Some(index), timeout: None };
-            let _ = renderer.gpu().device.poll(wait);
+            renderer.wait_for(index);
         }
         walls.push(began.elapsed().as_secs_f64() * 1e3);
     }

@@ -250,6 +250,12 @@ impl OffscreenRenderer {
         self.submitted.clone()
     }
 
+    /// Waits until the GPU has done submission `index` (one of [`Self::last_submission`]).
+    pub fn wait_for(&self, index: wgpu::SubmissionIndex) {
+        let wait = wgpu::PollType::Wait { submission_index: Some(index), timeout: None };
+        let _ = self.gpu.device.poll(wait);
+    }
+
     /// Renders the next frame and reads it back.
     pub fn render_next(&mut self) -> Result<RenderedFrame, RenderError> {
         let (time, stats) = self.render_only()?;
