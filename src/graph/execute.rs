@@ -6,8 +6,7 @@ use std::time::{Duration, Instant};
 
 use super::builder::{Access, BufferOrigin, FrameGraph, PassContext, ResolvedTexture, Resource, TextureOrigin};
 use super::compile::{GraphError, compile};
-use super::pool::{PoolKey, TexturePool, texture_bytes};
-use super::resource::next_resource_id;
+use super::pool::{BufferPool, PoolKey, TexturePool, texture_bytes};
 use super::timing::{GpuTimer, PassTiming};
 
 /// What the graph reports about one frame.
@@ -40,17 +39,10 @@ pub struct FrameOutput {
     pub stats: FrameStats,
 }
 
-struct PooledBuffer {
-    size: u64,
-    buffer: wgpu::Buffer,
-    id: u64,
-    in_use: bool,
-}
-
 /// What persists between frames for the graph: the texture pool, pooled buffers and the timer.
 pub struct GraphRuntime {
     pool: TexturePool,
-    buffers: Vec<PooledBuffer>,
+    buffers: BufferPool,
     timer: Option<GpuTimer>,
     /// Whether each pass is recorded inside a debug group of its name.
     debug_groups: bool,
@@ -66,7 +58,7 @@ impl GraphRuntime {
         let debug_groups = device.adapter_info().device_type != wgpu::DeviceType::Cpu;
         Self {
             pool: TexturePool::new(),
-            buffers: Vec::new(),
+            buffers: BufferPool::default(),
             timer: timed.then(|| GpuTimer::new(device, queue)),
             debug_groups,
         }
@@ -82,10 +74,16 @@ impl GraphRuntime {
         &self.pool
     }
 
+    /// The transient buffer pool.
+    pub fn buffer_pool(&self) -> &BufferPool {
+        &self.buffers
+    }
+
     /// Keeps idle pool textures instead of dropping them after two seconds (see
     /// [`TexturePool::set_hold`]).
     pub fn hold_transients(&mut self, hold: bool) {
         self.pool.set_hold(hold);
+        self.buffers.set_hold(hold);
     }
 
     /// Compiles and records `graph` into `encoder`. Submit the encoder, then call `after_submit`.
@@ -210,7 +208,7 @@ impl GraphRuntime {
                 if life.is_some_and(|(_, last)| last == position)
                     && let Some(i) = buffer_index[b]
                 {
-                    self.buffers[i].in_use = false;
+                    self.buffers.release(i);
                 }
             }
         }
@@ -219,9 +217,7 @@ impl GraphRuntime {
         }
         stats.textures_created = self.pool.created_this_frame();
         self.pool.end_frame();
-        for b in &mut self.buffers {
-            b.in_use = false;
-        }
+        self.buffers.end_frame();
         Ok((textures, stats))
     }
 
@@ -296,20 +292,8 @@ impl GraphRuntime {
         match &graph.buffers[b].origin {
             BufferOrigin::Imported(buffer, id) => (buffer.clone(), *id, None),
             BufferOrigin::Transient { size } => {
-                let index = self.buffers.iter().position(|e| !e.in_use && e.size == *size).unwrap_or_else(|| {
-                    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("graph_transient_buffer"),
-                        size: *size,
-                        usage: wgpu::BufferUsages::STORAGE
-                            | wgpu::BufferUsages::COPY_DST
-                            | wgpu::BufferUsages::COPY_SRC,
-                        mapped_at_creation: false,
-                    });
-                    self.buffers.push(PooledBuffer { size: *size, buffer, id: next_resource_id(), in_use: false });
-                    self.buffers.len() - 1
-                });
-                self.buffers[index].in_use = true;
-                (self.buffers[index].buffer.clone(), self.buffers[index].id, Some(index))
+                let (index, buffer, id) = self.buffers.acquire(device, *size);
+                (buffer, id, Some(index))
             }
         }
     }

@@ -16,6 +16,6 @@ mod timing;
 pub use builder::{FrameGraph, PassBuilder, PassContext, RasterTargets};
 pub use compile::{CompiledGraph, GraphError, compile};
 pub use execute::{FrameOutput, FrameStats, GraphRuntime};
-pub use pool::{TexturePool, texture_bytes};
+pub use pool::{BufferPool, TexturePool, texture_bytes};
 pub use resource::{BufferHandle, Extent, PersistentTexture, PingPong, TextureDesc, TextureHandle, next_resource_id};
 pub use timing::{PassTiming, RollingMedian};

@@ -1,6 +1,6 @@
-//! The transient texture pool: textures persist across frames and are handed out again within a
-//! frame once their previous user's last reader has run (wgpu has no memory aliasing; this reuse
-//! is how the graph saves memory).
+//! The transient pools: textures and storage buffers persist across frames and are handed out
+//! again within a frame once their previous user's last reader has run (wgpu has no memory
+//! aliasing; this reuse is how the graph saves memory).
 
 use super::builder::ResolvedTexture;
 use super::resource::next_resource_id;
@@ -91,14 +91,7 @@ impl TexturePool {
 
     /// Ends a frame: everything becomes free; textures idle for long are dropped.
     pub(crate) fn end_frame(&mut self) {
-        let frame = self.frame;
-        if !self.hold {
-            self.entries.retain(|e| frame.saturating_sub(e.last_frame) < EVICT_AFTER_FRAMES);
-        }
-        for e in &mut self.entries {
-            e.in_use = false;
-        }
-        self.frame += 1;
+        end_frame(&mut self.entries, &mut self.frame, self.hold);
         self.created_this_frame = 0;
     }
 
@@ -134,6 +127,103 @@ impl TexturePool {
             })
             .sum()
     }
+}
+
+struct PooledBuffer {
+    size: u64,
+    buffer: wgpu::Buffer,
+    id: u64,
+    in_use: bool,
+    last_frame: u64,
+}
+
+/// Owns the GPU buffers behind transient graph buffers (the compute draws' visibility buffers,
+/// scratch), kept and dropped as the texture pool keeps its textures.
+#[derive(Default)]
+pub struct BufferPool {
+    entries: Vec<PooledBuffer>,
+    frame: u64,
+    hold: bool,
+}
+
+impl BufferPool {
+    /// A free buffer of exactly `size` bytes, or a new one; its index and id.
+    pub(crate) fn acquire(&mut self, device: &wgpu::Device, size: u64) -> (usize, wgpu::Buffer, u64) {
+        let index = self.entries.iter().position(|e| !e.in_use && e.size == size).unwrap_or_else(|| {
+            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("graph_transient_buffer"),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let id = next_resource_id();
+            self.entries.push(PooledBuffer { size, buffer, id, in_use: false, last_frame: self.frame });
+            self.entries.len() - 1
+        });
+        let entry = &mut self.entries[index];
+        entry.in_use = true;
+        entry.last_frame = self.frame;
+        (index, entry.buffer.clone(), entry.id)
+    }
+
+    /// Returns a buffer for later passes of this frame (its last reader has run).
+    pub(crate) fn release(&mut self, index: usize) {
+        self.entries[index].in_use = false;
+    }
+
+    /// Ends a frame as [`TexturePool::end_frame`] does.
+    pub(crate) fn end_frame(&mut self) {
+        end_frame(&mut self.entries, &mut self.frame, self.hold);
+    }
+
+    /// Whether idle buffers stay, as [`TexturePool::set_hold`].
+    pub fn set_hold(&mut self, hold: bool) {
+        self.hold = hold;
+    }
+
+    /// Bytes of all pooled buffers.
+    pub fn bytes(&self) -> u64 {
+        self.entries.iter().map(|e| e.size).sum()
+    }
+}
+
+/// What a pool's entry tells of its use.
+trait Lendable {
+    /// The last frame it was lent in.
+    fn last_frame(&self) -> u64;
+    /// Makes it free for the next frame.
+    fn free(&mut self);
+}
+
+impl Lendable for Entry {
+    fn last_frame(&self) -> u64 {
+        self.last_frame
+    }
+
+    fn free(&mut self) {
+        self.in_use = false;
+    }
+}
+
+impl Lendable for PooledBuffer {
+    fn last_frame(&self) -> u64 {
+        self.last_frame
+    }
+
+    fn free(&mut self) {
+        self.in_use = false;
+    }
+}
+
+/// Ends a pool's `frame`: every entry free, those idle for [`EVICT_AFTER_FRAMES`] dropped unless
+/// the pool `hold`s them.
+fn end_frame<E: Lendable>(entries: &mut Vec<E>, frame: &mut u64, hold: bool) {
+    if !hold {
+        let now = *frame;
+        entries.retain(|e| now.saturating_sub(e.last_frame()) < EVICT_AFTER_FRAMES);
+    }
+    entries.iter_mut().for_each(Lendable::free);
+    *frame += 1;
 }
 
 /// Bytes a single-mip 2-D texture occupies.

@@ -6,6 +6,7 @@
 //! pipeline stays for adapters without 64-bit atomics.
 
 use crate::gpu::{BindGroupCache, ComputeKernel, ShaderError, buffer_entry as entry, storage_entry as storage};
+use crate::graph::{BufferHandle, FrameGraph};
 use crate::techniques::NodeSetup;
 use crate::techniques::visibility::VisibilityBuffer;
 
@@ -58,9 +59,10 @@ pub struct SplatDraw {
     big_queue: Option<(u32, wgpu::Buffer)>,
     /// The large primitives' dispatch (queued, chunks of the largest, rows), written by the raster.
     big_args: wgpu::Buffer,
-    /// Group 1 by kernel (`RASTER`, `RASTER_BIG`, `RESOLVE`) and output texture id (0 for the
-    /// raster kernels); dropped when a buffer they bind is made anew.
-    groups: BindGroupCache<(u8, u64)>,
+    /// Group 1 by kernel (`RASTER`, `RASTER_BIG`, `RESOLVE`), the id of the visibility buffer
+    /// the graph lent, and the output texture's id (0 for the raster kernels); dropped when a
+    /// buffer they bind is made anew.
+    groups: BindGroupCache<(u8, u64, u64)>,
 }
 
 impl SplatDraw {
@@ -138,8 +140,9 @@ impl SplatDraw {
     /// frame. False when the buffer would exceed the device's limits (the caller draws with the
     /// pipeline).
     pub fn prepare(&mut self, size: (u32, u32), samples: u32, count: u32, primitives_made: bool) -> bool {
-        let made = VisibilityBuffer::ensure(&mut self.visibility, &self.device, "splat_visibility", size, samples);
-        let Some(mut made) = made else { return false };
+        let Some(visibility) = VisibilityBuffer::fitting(&self.device, size, samples) else { return false };
+        self.visibility = Some(visibility);
+        let mut made = false;
         if self.big_queue.as_ref().is_none_or(|(capacity, _)| *capacity < count) {
             // Room to grow into, so that a growing set does not make a queue every frame.
             let capacity = count.max(1024).next_power_of_two();
@@ -159,14 +162,15 @@ impl SplatDraw {
         true
     }
 
-    /// The visibility buffer and its graph id (after a successful [`Self::prepare`]).
-    pub fn visibility(&self) -> Option<(&wgpu::Buffer, u64)> {
-        self.visibility.as_ref().map(|v| (&v.buffer, v.id))
+    /// Declares this frame's visibility buffer in `graph` as `name` (after a successful
+    /// [`Self::prepare`]): the raster writes it, the resolve reads it.
+    pub fn declare_visibility(&self, graph: &mut FrameGraph<'_>, name: &str) -> BufferHandle {
+        self.visibility.expect("prepared").declare(graph, name)
     }
 
     /// Records the coverage of `u.count` primitives (from `primitives`, where group 1 binds
     /// them): the visibility buffer cleared, then one thread per primitive and one workgroup per
-    /// large one; `view` is group 0.
+    /// large one, into the visibility buffer the graph lent (with its id); `view` is group 0.
     pub fn record_raster(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -174,13 +178,13 @@ impl SplatDraw {
         u: &SplatUniforms,
         view: &wgpu::BindGroup,
         primitives: Option<&wgpu::Buffer>,
+        (v, v_id): &(wgpu::Buffer, u64),
     ) {
-        let (Some(visibility), Some((_, big_queue))) = (&self.visibility, &self.big_queue) else { return };
+        let Some((_, big_queue)) = &self.big_queue else { return };
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(u));
         let (device, uniforms, args) = (&self.device, &self.uniforms, &self.big_args);
-        let v = &visibility.buffer;
         for (kernel, layout) in [(RASTER, &self.raster_layout), (RASTER_BIG, &self.big_layout)] {
-            self.groups.get_or_create((kernel, 0), || {
+            self.groups.get_or_create((kernel, *v_id, 0), || {
                 let own = if kernel == RASTER {
                     vec![entry(5, big_queue), entry(6, args)]
                 } else {
@@ -192,7 +196,8 @@ impl SplatDraw {
                 device.create_bind_group(&wgpu::BindGroupDescriptor { label, layout, entries: &entries })
             });
         }
-        let (Some(small), Some(big)) = (self.groups.get(&(RASTER, 0)), self.groups.get(&(RASTER_BIG, 0))) else {
+        let (Some(small), Some(big)) = (self.groups.get(&(RASTER, *v_id, 0)), self.groups.get(&(RASTER_BIG, *v_id, 0)))
+        else {
             return;
         };
         encoder.clear_buffer(v, 0, None);
@@ -209,25 +214,26 @@ impl SplatDraw {
         pass.dispatch_workgroups_indirect(args, 0);
     }
 
-    /// Records the shading of every pixel into `image` (its view and graph id); `view` and
-    /// `primitives` as for [`Self::record_raster`].
+    /// Records the shading of every pixel into `image` (its view and graph id); `view`,
+    /// `primitives` and the lent visibility buffer as for [`Self::record_raster`].
     pub fn record_resolve(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         view: &wgpu::BindGroup,
         primitives: Option<&wgpu::Buffer>,
+        (v, v_id): &(wgpu::Buffer, u64),
         image: (&wgpu::TextureView, u64),
     ) {
         let Some(visibility) = &self.visibility else { return };
         let (device, layout, uniforms) = (&self.device, &self.resolve_layout, &self.uniforms);
-        let group = self.groups.get_or_create((RESOLVE, image.1), || {
+        let group = self.groups.get_or_create((RESOLVE, *v_id, image.1), || {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("splat_resolve_group"),
                 layout,
                 entries: &[
                     [Some(entry(0, uniforms)), primitives.map(|p| entry(1, p))].into_iter().flatten().collect(),
                     vec![
-                        entry(3, &visibility.buffer),
+                        entry(3, v),
                         wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(image.0) },
                     ],
                 ]

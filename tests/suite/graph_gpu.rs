@@ -165,3 +165,47 @@ fn persistent_ping_pong_state_is_written_even_if_nothing_reads_it() {
     let (other, _) = state.write_and_history();
     assert_eq!(&read_texture_rgba8(&gpu.device, &gpu.queue, &other.texture).unwrap()[..4], &[255, 0, 0, 255]);
 }
+
+/// A frame in which `buffers` compute steps each write a transient buffer of 1 KiB that the next
+/// reads, into an output image.
+fn buffer_frame(runtime: &mut GraphRuntime, gpu: &indra::gpu::Gpu, buffers: usize) {
+    let mut graph = FrameGraph::new((8, 8));
+    let out = graph.create_texture("out", TextureDesc::full(wgpu::TextureFormat::Rgba8Unorm));
+    let mut last = None;
+    for i in 0..buffers {
+        let b = graph.create_buffer(format!("b{i}"), 1024);
+        let pass = graph.add_pass(format!("write{i}")).write_buffer(b);
+        let pass = if let Some(previous) = last { pass.read_buffer(previous) } else { pass };
+        pass.record(move |ctx| {
+            let buffer = ctx.buffer(b).clone();
+            ctx.encoder.clear_buffer(&buffer, 0, None);
+        });
+        last = Some(b);
+    }
+    let pass = graph.add_pass("out").render_target(out);
+    let pass = if let Some(previous) = last { pass.read_buffer(previous) } else { pass };
+    pass.record(move |ctx| clear(ctx, out, wgpu::Color::GREEN));
+    graph.set_output(out);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    runtime.execute(&gpu.device, &gpu.queue, graph, &mut encoder).expect("graph compiles");
+    gpu.queue.submit([encoder.finish()]);
+    runtime.after_submit();
+}
+
+#[test]
+fn transient_buffers_are_shared_in_turn_and_dropped_when_idle_unless_held() {
+    let gpu = common::gpu();
+    for hold in [false, true] {
+        let mut runtime = GraphRuntime::new(&gpu.device, &gpu.queue);
+        runtime.hold_transients(hold);
+        buffer_frame(&mut runtime, &gpu, 4);
+        // b0 → b1 → b2 → b3: each buffer is free once the step after it has read it, so two
+        // take turns.
+        assert_eq!(runtime.buffer_pool().bytes(), 2 * 1024, "four buffers in turn need two");
+        for _ in 0..130 {
+            buffer_frame(&mut runtime, &gpu, 0);
+        }
+        let kept = if hold { 2 * 1024 } else { 0 };
+        assert_eq!(runtime.buffer_pool().bytes(), kept, "idle buffers after two seconds (hold {hold})");
+    }
+}

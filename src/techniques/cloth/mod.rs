@@ -24,6 +24,7 @@ use crate::params::ParamSet;
 use crate::time::{FrameTime, MAX_CATCH_UP_STEPS};
 
 use super::splat_draw::SplatUniforms;
+use super::visibility::lent;
 use super::{NodeSetup, Technique, TechniqueInfo};
 
 /// The registry entry.
@@ -252,8 +253,7 @@ impl Technique for Cloth {
                 .is_some_and(|c| c.borrow_mut().prepare((w, h), this.renderer.samples, triangles, false));
         if in_compute {
             let compute = this.renderer.compute.as_ref().expect("prepared");
-            let (buffer, id) = compute.borrow().visibility().map(|(b, id)| (b.clone(), id)).expect("prepared");
-            let visibility = graph.import_buffer("cloth/visibility", &buffer, id);
+            let visibility = compute.borrow().declare_visibility(graph, "cloth/visibility");
             let image = graph.create_texture("cloth/image", TextureDesc::full(FORMAT));
             let b = view.background;
             let background = [b.r as f32, b.g as f32, b.b as f32, 1.0];
@@ -261,7 +261,8 @@ impl Technique for Cloth {
             let group = &state.draw_groups[&state.cur];
             graph.add_pass("cloth/raster").read_buffer(cur).read_buffer(normals).write_buffer(visibility).record(
                 move |ctx| {
-                    compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &splat, group, None);
+                    let lent = lent(ctx, visibility);
+                    compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &splat, group, None, &lent);
                 },
             );
             graph
@@ -273,7 +274,8 @@ impl Technique for Cloth {
                 .record(move |ctx| {
                     // Views are shared handles: a clone frees the context for the encoder.
                     let (image_view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
-                    compute.borrow_mut().record_resolve(ctx.encoder, group, None, (&image_view, id));
+                    let lent = lent(ctx, visibility);
+                    compute.borrow_mut().record_resolve(ctx.encoder, group, None, &lent, (&image_view, id));
                 });
             return image;
         }

@@ -20,7 +20,7 @@ use std::cell::RefCell;
 pub use particles::{CubeInstance, MAX_CUBES, cubes_at};
 
 use super::splat_draw::{self, SplatDraw, SplatUniforms};
-use super::visibility::PixelRays;
+use super::visibility::{PixelRays, lent};
 use super::{NodeSetup, Rasterizer, Technique, TechniqueInfo, srgb_to_linear};
 
 /// The registry entry.
@@ -237,19 +237,20 @@ impl CubeField {
         count: u32,
     ) -> TextureHandle {
         let (compute, view) = self.compute.as_ref().expect("prepared");
-        let (buffer, id) = compute.borrow().visibility().map(|(b, id)| (b.clone(), id)).expect("prepared");
-        let visibility = graph.import_buffer("cube_field/visibility", &buffer, id);
+        let visibility = compute.borrow().declare_visibility(graph, "cube_field/visibility");
         let image = graph.create_texture("cube_field/image", TextureDesc::full(FORMAT));
         let splat = SplatUniforms::new(graph.output_size(), count, self.samples, [0.0, 0.0, 0.0, 1.0]);
         graph.add_pass("cube_field/raster").write_buffer(visibility).record(move |ctx| {
             ctx.queue.write_buffer(&self.block.buffer, 0, bytemuck::bytes_of(&uniforms));
             ctx.queue.write_buffer(&self.instances, 0, bytemuck::cast_slice(&self.scratch));
-            compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &splat, view, Some(&self.instances));
+            let lent = lent(ctx, visibility);
+            compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &splat, view, Some(&self.instances), &lent);
         });
         graph.add_pass("cube_field/resolve").read_buffer(visibility).write(image).record(move |ctx| {
             // Views are shared handles: a clone frees the context for the encoder.
             let (image_view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
-            compute.borrow_mut().record_resolve(ctx.encoder, view, Some(&self.instances), (&image_view, id));
+            let lent = lent(ctx, visibility);
+            compute.borrow_mut().record_resolve(ctx.encoder, view, Some(&self.instances), &lent, (&image_view, id));
         });
         image
     }

@@ -19,6 +19,7 @@ mod sampler;
 use sampler::Sampler;
 
 use super::splat_draw::{self, SplatDraw, SplatUniforms};
+use super::visibility::lent;
 use super::{NodeSetup, Rasterizer, Technique, TechniqueInfo};
 
 /// The registry entry.
@@ -400,18 +401,21 @@ impl Poisson {
     ) -> TextureHandle {
         let this: &'r Poisson = self;
         let (compute, view) = this.compute.as_ref().expect("prepared");
-        let (buffer, id) = compute.borrow().visibility().map(|(b, id)| (b.clone(), id)).expect("prepared");
-        let visibility = graph.import_buffer("poisson/visibility", &buffer, id);
+        let visibility = compute.borrow().declare_visibility(graph, "poisson/visibility");
         let image = graph.create_texture("poisson/image", TextureDesc::full(FORMAT));
         let raster = SplatUniforms::new(graph.output_size(), count, uniforms.samples, [0.0, 0.0, 0.0, 1.0]);
         graph.add_pass("poisson/raster").write_buffer(visibility).record(move |ctx| {
             this.upload(ctx.queue, &uniforms, first_new);
-            compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &raster, view, Some(this.instances.buffer()));
+            let lent = lent(ctx, visibility);
+            let instances = Some(this.instances.buffer());
+            compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &raster, view, instances, &lent);
         });
         graph.add_pass("poisson/resolve").read_buffer(visibility).write(image).record(move |ctx| {
             // Views are shared handles: a clone frees the context for the encoder.
             let (image_view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
-            compute.borrow_mut().record_resolve(ctx.encoder, view, Some(this.instances.buffer()), (&image_view, id));
+            let lent = lent(ctx, visibility);
+            let instances = Some(this.instances.buffer());
+            compute.borrow_mut().record_resolve(ctx.encoder, view, instances, &lent, (&image_view, id));
         });
         image
     }

@@ -8,7 +8,8 @@
 use crate::gpu::{
     BindGroupCache, ComputeKernel, JoinedSource, ShaderError, buffer_entry as entry, storage_entry as storage,
 };
-use crate::techniques::visibility::{PixelRays, VisibilityBuffer};
+use crate::graph::{BufferHandle, FrameGraph, PassContext};
+use crate::techniques::visibility::{PixelRays, VisibilityBuffer, lent};
 
 use super::FORMAT;
 
@@ -111,7 +112,24 @@ impl RasterUniforms {
 /// Workgroups per glow triangle (`GLOW_CHUNKS` in the shader).
 const GLOW_CHUNKS: u32 = 16;
 
-/// The kernels and the visibility buffer of the compute draw.
+/// The buffers the frame graph lends the compute draw each frame: as handles while the frame is
+/// declared, as buffers and their ids while it is recorded.
+#[derive(Clone, Copy, Debug)]
+pub struct Lent<B> {
+    /// One 64-bit word per sample (see [`VisibilityBuffer`]).
+    pub visibility: B,
+    /// The glow's sum per pixel, a u32 each, on frames that draw the glow.
+    pub glow_sum: Option<B>,
+}
+
+impl Lent<BufferHandle> {
+    /// The buffers behind the handles in a pass.
+    pub fn in_pass(&self, ctx: &PassContext<'_>) -> Lent<(wgpu::Buffer, u64)> {
+        Lent { visibility: lent(ctx, self.visibility), glow_sum: self.glow_sum.map(|sums| lent(ctx, sums)) }
+    }
+}
+
+/// The kernels of the compute draw (its buffers are lent, see [`Lent`]).
 pub struct ComputeDraw {
     device: wgpu::Device,
     raster: ComputeKernel,
@@ -128,10 +146,10 @@ pub struct ComputeDraw {
     resolve_layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     visibility: Option<VisibilityBuffer>,
-    /// The glow's sum per pixel (a u32 each) and its graph id, made with the visibility buffer.
-    glow_sum: Option<(wgpu::Buffer, u64)>,
-    /// Group 1 of the floor's fill and of the glow (they bind no per-frame resource).
-    extras_groups: Option<[wgpu::BindGroup; 2]>,
+    /// Group 1 of the floor's fill, by the id of the visibility buffer the graph lent.
+    floor_groups: BindGroupCache<u64>,
+    /// Group 1 of the glow, by the ids of the lent visibility buffer and glow sums.
+    glow_groups: BindGroupCache<(u64, u64)>,
     /// This frame's uniforms.
     frame: Option<RasterUniforms>,
     /// Edge slots this frame (the raster's threads).
@@ -141,10 +159,12 @@ pub struct ComputeDraw {
     big_queue: Option<(u32, wgpu::Buffer)>,
     /// The queue kernels' dispatches: (x, 1, 1) for the medium edges at byte 0, the large at 16.
     big_args: wgpu::Buffer,
-    /// Group 1 of the raster and of the queue kernel, by the growth's argument buffer id.
-    raster_groups: BindGroupCache<u64, [wgpu::BindGroup; 2]>,
-    /// Group 1 of the resolve, by the output texture id.
-    resolve_groups: BindGroupCache<u64>,
+    /// Group 1 of the raster and of the queue kernel, by the growth's argument buffer id and the
+    /// lent visibility buffer's.
+    raster_groups: BindGroupCache<(u64, u64), [wgpu::BindGroup; 2]>,
+    /// Group 1 of the resolve, by the ids of the lent visibility buffer, the lent glow sums and
+    /// the output texture.
+    resolve_groups: BindGroupCache<(u64, u64, u64)>,
 }
 
 impl ComputeDraw {
@@ -201,8 +221,8 @@ impl ComputeDraw {
             resolve_layout,
             uniforms: crate::gpu::uniform_buffer::<RasterUniforms>(device, "sc_raster_uniforms"),
             visibility: None,
-            glow_sum: None,
-            extras_groups: None,
+            floor_groups: BindGroupCache::default(),
+            glow_groups: BindGroupCache::default(),
             frame: None,
             capacity: 0,
             big_queue: None,
@@ -222,14 +242,9 @@ impl ComputeDraw {
     /// Readies the visibility buffer for `u`'s size and samples and writes the uniforms; false
     /// when the buffer would exceed the device's limits (the caller draws with the pipeline).
     pub fn prepare(&mut self, queue: &wgpu::Queue, u: &RasterUniforms) -> bool {
-        let made = VisibilityBuffer::ensure(
-            &mut self.visibility,
-            &self.device,
-            "sc_visibility",
-            (u.width, u.height),
-            u.samples,
-        );
-        let Some(mut made) = made else { return false };
+        let size = (u.width, u.height);
+        let Some(visibility) = VisibilityBuffer::fitting(&self.device, size, u.samples) else { return false };
+        self.visibility = Some(visibility);
         if self.big_queue.as_ref().is_none_or(|(capacity, _)| *capacity < u.capacity) {
             let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("sc_big_queue"),
@@ -239,69 +254,48 @@ impl ComputeDraw {
                 mapped_at_creation: false,
             });
             self.big_queue = Some((u.capacity, buffer));
-            made = true;
-        }
-        if made {
             self.raster_groups = BindGroupCache::default();
-            self.resolve_groups = BindGroupCache::default();
-            self.make_extras_buffers(u);
         }
         self.raster_groups.begin_frame();
         self.resolve_groups.begin_frame();
+        self.floor_groups.begin_frame();
+        self.glow_groups.begin_frame();
         self.capacity = u.capacity;
         self.frame = Some(*u);
         queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(u));
         true
     }
 
-    /// Makes the glow's sums for `u`'s size and the floor's and the glow's bind groups over
-    /// them and the visibility buffer.
-    fn make_extras_buffers(&mut self, u: &RasterUniforms) {
-        let Some(visibility) = &self.visibility else { return };
-        let device = &self.device;
-        let sums = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("sc_glow_sum"),
-            size: (u64::from(u.width) * u64::from(u.height) * 4).max(4),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let group = |layout, entries: &[wgpu::BindGroupEntry]| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("sc_extras_group"), layout, entries })
-        };
-        let (uniforms, v) = (&self.uniforms, &visibility.buffer);
-        self.extras_groups = Some([
-            group(&self.floor_layout, &[entry(0, uniforms), entry(11, v)]),
-            group(&self.glow_layout, &[entry(0, uniforms), entry(3, v), entry(9, &sums)]),
-        ]);
-        self.glow_sum = Some((sums, crate::graph::next_resource_id()));
-    }
-
-    /// The glow's sums and their graph id (after a successful [`Self::prepare`]).
-    pub fn glow_sum(&self) -> Option<(&wgpu::Buffer, u64)> {
-        self.glow_sum.as_ref().map(|(buffer, id)| (buffer, *id))
-    }
-
-    /// The visibility buffer and its graph id (after a successful [`Self::prepare`]).
-    pub fn visibility(&self) -> Option<(&wgpu::Buffer, u64)> {
-        self.visibility.as_ref().map(|v| (&v.buffer, v.id))
+    /// Declares this frame's visibility buffer and, if it draws the `glow`, the glow's sums (a
+    /// u32 per pixel) in `graph` (after a successful [`Self::prepare`]): the graph lends both
+    /// from its pool.
+    pub fn declare_buffers(&self, graph: &mut FrameGraph<'_>, glow: bool) -> Lent<BufferHandle> {
+        let visibility = self.visibility.expect("prepared");
+        let (width, height, _) = visibility.key();
+        let sums = (u64::from(width) * u64::from(height) * 4).max(4);
+        Lent {
+            visibility: visibility.declare(graph, "space_colonization/visibility"),
+            glow_sum: glow.then(|| graph.create_buffer("space_colonization/glow_sum", sums)),
+        }
     }
 
     /// Records the coverage: the visibility buffer cleared, then one thread per edge slot
-    /// (`view` is group 0; `args` the growth's indirect arguments, holding the grown count).
+    /// (`view` is group 0; `args` the growth's indirect arguments, holding the grown count; the
+    /// last the visibility buffer the graph lent and its id).
     pub fn record_raster(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         view: &wgpu::BindGroup,
         args: (&wgpu::Buffer, u64),
+        (v, v_id): (&wgpu::Buffer, u64),
     ) {
         let (Some(visibility), Some((_, queue))) = (&self.visibility, &self.big_queue) else { return };
         let (device, uniforms, big_args) = (&self.device, &self.uniforms, &self.big_args);
         let (raster_layout, big_layout) = (&self.raster_layout, &self.big_layout);
-        let groups = self.raster_groups.get_or_create(args.1, || {
+        let groups = self.raster_groups.get_or_create((args.1, v_id), || {
             let group = |layout, entries: &[wgpu::BindGroupEntry]| {
                 device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("sc_raster_group"), layout, entries })
             };
-            let v = &visibility.buffer;
             [
                 group(
                     raster_layout,
@@ -312,7 +306,7 @@ impl ComputeDraw {
         });
         let floor = self.frame.is_some_and(|u| u.floor != 0);
         if !floor {
-            encoder.clear_buffer(&visibility.buffer, 0, None);
+            encoder.clear_buffer(v, 0, None);
         }
         encoder.clear_buffer(queue, 0, Some(16));
         for offset in [0, 16, 32] {
@@ -322,10 +316,18 @@ impl ComputeDraw {
             label: Some("space_colonization/raster"),
             timestamp_writes: None,
         });
-        if let (true, Some([floor_group, _])) = (floor, &self.extras_groups) {
+        if floor {
+            let (floor_layout, floor_fill) = (&self.floor_layout, &self.floor_fill);
+            let floor_group = self.floor_groups.get_or_create(v_id, || {
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("sc_floor_group"),
+                    layout: floor_layout,
+                    entries: &[entry(0, uniforms), entry(11, v)],
+                })
+            });
             // The floor writes every word: the clear's work, with the floor's hits.
             let (width, height, _) = visibility.key();
-            self.floor_fill.dispatch(&mut pass, &[view, floor_group], [width, height, 1]);
+            floor_fill.dispatch(&mut pass, &[view, floor_group], [width, height, 1]);
         }
         // Rows of at most 65,535 workgroups; the shader numbers threads across them.
         let slots = self.capacity.max(1);
@@ -341,13 +343,25 @@ impl ComputeDraw {
 
     /// Records the model's glow (`view` is group 0): its sums cleared, then a workgroup per
     /// triangle and chunk; nothing where this frame draws no glow.
-    pub fn record_glow(&mut self, encoder: &mut wgpu::CommandEncoder, view: &wgpu::BindGroup) {
-        let (Some(u), Some((sums, _)), Some([_, group])) = (self.frame, &self.glow_sum, &self.extras_groups) else {
+    pub fn record_glow(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &wgpu::BindGroup,
+        lent: &Lent<(wgpu::Buffer, u64)>,
+    ) {
+        let (Some(u), (v, v_id), Some((sums, sums_id))) =
+            (self.frame.filter(|u| u.glow != 0), &lent.visibility, &lent.glow_sum)
+        else {
             return;
         };
-        if u.glow == 0 {
-            return;
-        }
+        let (device, layout, uniforms) = (&self.device, &self.glow_layout, &self.uniforms);
+        let group = self.glow_groups.get_or_create((*v_id, *sums_id), || {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("sc_glow_group"),
+                layout,
+                entries: &[entry(0, uniforms), entry(3, v), entry(9, sums)],
+            })
+        });
         encoder.clear_buffer(sums, 0, None);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("space_colonization/glow"),
@@ -362,17 +376,20 @@ impl ComputeDraw {
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         view: &wgpu::BindGroup,
+        lent: &Lent<(wgpu::Buffer, u64)>,
         image: (&wgpu::TextureView, u64),
     ) {
-        let (Some(visibility), Some((sums, _))) = (&self.visibility, &self.glow_sum) else { return };
+        let Some(visibility) = &self.visibility else { return };
+        // Without the glow the shader reads no sums: the visibility buffer stands in for them.
+        let ((v, v_id), (sums, sums_id)) = (&lent.visibility, lent.glow_sum.as_ref().unwrap_or(&lent.visibility));
         let (device, layout, uniforms) = (&self.device, &self.resolve_layout, &self.uniforms);
-        let group = self.resolve_groups.get_or_create(image.1, || {
+        let group = self.resolve_groups.get_or_create((*v_id, *sums_id, image.1), || {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("sc_resolve_group"),
                 layout,
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 3, resource: visibility.buffer.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 3, resource: v.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(image.0) },
                     entry(10, sums),
                 ],

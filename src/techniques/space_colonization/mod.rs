@@ -530,10 +530,8 @@ impl Technique for SpaceColonization {
             },
         );
         if in_compute {
-            let (buffer, id) = this.renderer.compute_visibility().expect("prepared");
-            let visibility = graph.import_buffer("space_colonization/visibility", &buffer, id);
-            let (buffer, id) = this.renderer.compute_glow_sum().expect("prepared");
-            let glow = graph.import_buffer("space_colonization/glow_sum", &buffer, id);
+            let lent = this.renderer.declare_compute_buffers(graph, glow_triangles > 0).expect("prepared");
+            let visibility = lent.visibility;
             let image = graph.create_texture("space_colonization/image", TextureDesc::full(FORMAT));
             graph
                 .add_pass("space_colonization/raster")
@@ -541,26 +539,25 @@ impl Technique for SpaceColonization {
                 .read_buffer(nodes)
                 .read_buffer(args)
                 .write_buffer(visibility)
-                .record(move |ctx| this.renderer.record_compute_raster(ctx.encoder, state));
-            if glow_triangles > 0 {
+                .record(move |ctx| this.renderer.record_compute_raster(ctx, state, lent));
+            if let Some(glow) = lent.glow_sum {
                 graph
                     .add_pass("space_colonization/glow")
                     .read_buffer(visibility)
                     .write_buffer(glow)
-                    .record(move |ctx| this.renderer.record_compute_glow(ctx.encoder, state));
+                    .record(move |ctx| this.renderer.record_compute_glow(ctx, state, lent));
             }
-            graph
-                .add_pass("space_colonization/resolve")
+            let resolve = graph.add_pass("space_colonization/resolve");
+            let resolve = match lent.glow_sum {
+                Some(glow) => resolve.read_buffer(glow),
+                None => resolve,
+            };
+            resolve
                 .read_buffer(posed)
                 .read_buffer(nodes)
                 .read_buffer(visibility)
-                .read_buffer(glow)
                 .write(image)
-                .record(move |ctx| {
-                    // Views are shared handles: a clone frees the context for the encoder.
-                    let (view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
-                    this.renderer.record_compute_resolve(ctx.encoder, state, (&view, id));
-                });
+                .record(move |ctx| this.renderer.record_compute_resolve(ctx, state, lent, image));
             return image;
         }
         // The pipeline's targets only where it draws: the compute draw needs none of them.

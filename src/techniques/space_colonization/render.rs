@@ -4,11 +4,11 @@
 
 use std::cell::RefCell;
 
-use super::compute_draw::{self, ComputeDraw, RasterUniforms};
+use super::compute_draw::{self, ComputeDraw, Lent, RasterUniforms};
 use super::growth::{GrowthState, LINE_ARGS, TUBE_ARGS};
 use super::params::ViewUniforms;
 use crate::gpu::{BindGroupCache, RasterDesc, ShaderError, raster_pipeline};
-use crate::graph::{PassContext, RasterTargets};
+use crate::graph::{BufferHandle, FrameGraph, PassContext, RasterTargets, TextureHandle};
 use crate::techniques::NodeSetup;
 
 /// Vertices around a tube (the draw shader's `SIDES`).
@@ -205,10 +205,10 @@ impl Renderer {
         self.compute.as_mut().is_some_and(|c| c.get_mut().prepare(queue, u))
     }
 
-    /// The compute draw's visibility buffer and its graph id (after [`Self::prepare_compute`]).
-    pub fn compute_visibility(&self) -> Option<(wgpu::Buffer, u64)> {
-        let compute = self.compute.as_ref()?.borrow();
-        compute.visibility().map(|(buffer, id)| (buffer.clone(), id))
+    /// Declares the buffers the graph lends the compute draw this frame (after
+    /// [`Self::prepare_compute`]).
+    pub fn declare_compute_buffers(&self, graph: &mut FrameGraph<'_>, glow: bool) -> Option<Lent<BufferHandle>> {
+        Some(self.compute.as_ref()?.borrow().declare_buffers(graph, glow))
     }
 
     /// The compute draw and the view group of `state`'s buffers, where both exist.
@@ -219,32 +219,30 @@ impl Renderer {
     }
 
     /// Records the compute draw's coverage of every grown edge.
-    pub fn record_compute_raster(&self, encoder: &mut wgpu::CommandEncoder, state: &GrowthState) {
+    pub fn record_compute_raster(&self, ctx: &mut PassContext<'_>, state: &GrowthState, lent: Lent<BufferHandle>) {
         let Some((mut compute, group)) = self.compute_and_group(state) else { return };
-        compute.record_raster(encoder, group, (&state.args.buffer, state.args.id));
-    }
-
-    /// The compute draw's glow sums and their graph id (after [`Self::prepare_compute`]).
-    pub fn compute_glow_sum(&self) -> Option<(wgpu::Buffer, u64)> {
-        let compute = self.compute.as_ref()?.borrow();
-        compute.glow_sum().map(|(buffer, id)| (buffer.clone(), id))
+        let (visibility, id) = crate::techniques::visibility::lent(ctx, lent.visibility);
+        compute.record_raster(ctx.encoder, group, (&state.args.buffer, state.args.id), (&visibility, id));
     }
 
     /// Records the compute draw's glow of the model's mesh over what the raster kept.
-    pub fn record_compute_glow(&self, encoder: &mut wgpu::CommandEncoder, state: &GrowthState) {
+    pub fn record_compute_glow(&self, ctx: &mut PassContext<'_>, state: &GrowthState, lent: Lent<BufferHandle>) {
         let Some((mut compute, group)) = self.compute_and_group(state) else { return };
-        compute.record_glow(encoder, group);
+        compute.record_glow(ctx.encoder, group, &lent.in_pass(ctx));
     }
 
     /// Records the compute draw's shading into `image` (its view and graph id).
     pub fn record_compute_resolve(
         &self,
-        encoder: &mut wgpu::CommandEncoder,
+        ctx: &mut PassContext<'_>,
         state: &GrowthState,
-        image: (&wgpu::TextureView, u64),
+        lent: Lent<BufferHandle>,
+        image: TextureHandle,
     ) {
         let Some((mut compute, group)) = self.compute_and_group(state) else { return };
-        compute.record_resolve(encoder, group, image);
+        // Views are shared handles: a clone frees the context for the encoder.
+        let (view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
+        compute.record_resolve(ctx.encoder, group, &lent.in_pass(ctx), (&view, id));
     }
 
     /// Records the draw of every grown edge into `targets` (resolved if multisampled).

@@ -7,6 +7,7 @@
 use crate::gpu::{BindGroupCache, ComputeKernel, JoinedSource, ShaderError, storage_entry as storage};
 
 use super::FORMAT;
+use crate::graph::{BufferHandle, FrameGraph};
 use crate::techniques::visibility::VisibilityBuffer;
 
 /// Features the compute draw needs.
@@ -57,10 +58,11 @@ pub struct ComputeRaster {
     visibility: Option<VisibilityBuffer>,
     corners: Option<Corners>,
     /// Group 2 of the raster kernels (with and without the queue's arguments, which the second
-    /// reads as its dispatch); made with the visibility buffer.
-    raster_groups: Option<[wgpu::BindGroup; 2]>,
-    /// Group 2 of the resolve: output texture id → group; cleared with the visibility.
-    resolve_groups: BindGroupCache<u64>,
+    /// reads as its dispatch), with the id of the visibility buffer they bind.
+    raster_groups: Option<(u64, [wgpu::BindGroup; 2])>,
+    /// Group 2 of the resolve by (visibility buffer id, output texture id); cleared with the
+    /// corners.
+    resolve_groups: BindGroupCache<(u64, u64)>,
 }
 
 /// What one frame's compute draw binds.
@@ -149,11 +151,8 @@ impl ComputeRaster {
     /// writes the uniforms; false when the visibility buffer would exceed the device's limits
     /// (the caller draws with the pipeline then).
     pub fn prepare(&mut self, queue: &wgpu::Queue, size: (u32, u32), samples: u32, grid: u32) -> bool {
-        match VisibilityBuffer::ensure(&mut self.visibility, &self.device, "tessellation_visibility", size, samples) {
-            None => return false,
-            Some(true) => self.forget_groups(),
-            Some(false) => {}
-        }
+        let Some(visibility) = VisibilityBuffer::fitting(&self.device, size, samples) else { return false };
+        self.visibility = Some(visibility);
         let limits = self.device.limits();
         let largest = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         if self.corners.as_ref().is_none_or(|c| c.grid != grid) {
@@ -205,20 +204,26 @@ impl ComputeRaster {
         [group(&self.raster_layout, Some(&self.big_args)), group(&self.big_layout, None)]
     }
 
-    /// The visibility buffer and its graph id (after a successful [`Self::prepare`]).
-    pub fn visibility(&self) -> Option<(&wgpu::Buffer, u64)> {
-        self.visibility.as_ref().map(|v| (&v.buffer, v.id))
+    /// Declares this frame's visibility buffer in `graph` as `name` (after a successful
+    /// [`Self::prepare`]): the raster writes it, the resolve reads it.
+    pub fn declare_visibility(&self, graph: &mut FrameGraph<'_>, name: &str) -> BufferHandle {
+        self.visibility.expect("prepared").declare(graph, name)
     }
 
-    /// Records the coverage: clear the visibility buffer, then cover every refined triangle
-    /// (the dispatch the scan wrote) and the queued large ones.
-    pub fn record_raster(&mut self, encoder: &mut wgpu::CommandEncoder, b: &DrawBindings<'_>) {
-        let (Some(visibility), Some(corners)) = (&self.visibility, &self.corners) else { return };
-        if self.raster_groups.is_none() {
-            self.raster_groups = Some(self.make_raster_groups(&visibility.buffer, &corners.buffer));
+    /// Records the coverage into the visibility buffer the graph lent (with its id): clear it,
+    /// then cover every refined triangle (the dispatch the scan wrote) and the queued large ones.
+    pub fn record_raster(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        b: &DrawBindings<'_>,
+        (visibility, v_id): &(wgpu::Buffer, u64),
+    ) {
+        let Some(corners) = &self.corners else { return };
+        if self.raster_groups.as_ref().is_none_or(|(id, _)| id != v_id) {
+            self.raster_groups = Some((*v_id, self.make_raster_groups(visibility, &corners.buffer)));
         }
-        let groups = self.raster_groups.as_ref().expect("made above");
-        encoder.clear_buffer(&visibility.buffer, 0, None);
+        let (_, groups) = self.raster_groups.as_ref().expect("made above");
+        encoder.clear_buffer(visibility, 0, None);
         encoder.clear_buffer(&self.big_args, 0, Some(4));
         encoder.clear_buffer(&self.big_args, 12, Some(4));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -235,23 +240,25 @@ impl ComputeRaster {
         pass.dispatch_workgroups_indirect(&self.big_args, 0);
     }
 
-    /// Records the shading: each pixel's distinct triangles shaded and averaged into `image`.
+    /// Records the shading from the lent visibility buffer: each pixel's distinct triangles
+    /// shaded and averaged into `image`.
     pub fn record_resolve(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         b: &DrawBindings<'_>,
+        (v, v_id): &(wgpu::Buffer, u64),
         image: (&wgpu::TextureView, u64),
     ) {
         let (Some(visibility), Some(corners)) = (&self.visibility, &self.corners) else { return };
         let (device, uniforms) = (&self.device, &self.uniforms);
         let entry = |binding, resource| wgpu::BindGroupEntry { binding, resource };
-        let group = self.resolve_groups.get_or_create(image.1, || {
+        let group = self.resolve_groups.get_or_create((*v_id, image.1), || {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("tessellation_resolve_group"),
                 layout: &self.resolve_layout,
                 entries: &[
                     entry(0, uniforms.as_entire_binding()),
-                    entry(4, visibility.buffer.as_entire_binding()),
+                    entry(4, v.as_entire_binding()),
                     entry(7, corners.buffer.as_entire_binding()),
                     entry(5, wgpu::BindingResource::TextureView(image.0)),
                 ],

@@ -32,6 +32,7 @@ use crate::graph::{BufferHandle, FrameGraph, PassBuilder, PassContext, RasterTar
 use crate::params::ParamSet;
 use crate::time::FrameTime;
 
+use super::visibility::lent;
 use super::{NodeSetup, Technique, TechniqueInfo};
 use compute_raster::{ComputeRaster, DrawBindings};
 
@@ -330,16 +331,23 @@ impl Tessellation {
     }
 
     /// Records the compute draw's coverage (`image` None) or its shading into `image`.
-    fn record_compute_draw(&self, ctx: &mut PassContext<'_>, height: TextureHandle, image: Option<TextureHandle>) {
+    fn record_compute_draw(
+        &self,
+        ctx: &mut PassContext<'_>,
+        height: TextureHandle,
+        visibility: BufferHandle,
+        image: Option<TextureHandle>,
+    ) {
         let (b, Some(raster)) = (&self.buffers, &self.compute_raster) else { return };
         let mesh = self.draw_group(ctx, height, b);
         let bindings = DrawBindings { uniforms: &self.uniform_group, mesh: &mesh, args: &b.args.0 };
+        let lent = lent(ctx, visibility);
         match image {
-            None => raster.borrow_mut().record_raster(ctx.encoder, &bindings),
+            None => raster.borrow_mut().record_raster(ctx.encoder, &bindings, &lent),
             Some(image) => {
                 // Views are shared handles: a clone frees the context for the encoder.
                 let (view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
-                raster.borrow_mut().record_resolve(ctx.encoder, &bindings, (&view, id));
+                raster.borrow_mut().record_resolve(ctx.encoder, &bindings, &lent, (&view, id));
             }
         }
     }
@@ -432,19 +440,18 @@ impl Technique for Tessellation {
         let mesh = [factors, levels, offsets, args];
         if this.drew_in_compute {
             let raster = this.compute_raster.as_ref().expect("drawn in compute").borrow();
-            let (buffer, id) = raster.visibility().expect("prepared");
-            let visibility = graph.import_buffer("tessellation/visibility", buffer, id);
+            let visibility = raster.declare_visibility(graph, "tessellation/visibility");
             drop(raster);
             let image = graph.create_texture("tessellation/image", TextureDesc::full(FORMAT));
             reading_mesh(graph.add_pass("tessellation/raster"), height, mesh)
                 .write_buffer(visibility)
-                .record(move |ctx| this.record_compute_draw(ctx, height, None));
+                .record(move |ctx| this.record_compute_draw(ctx, height, visibility, None));
             graph
                 .add_pass("tessellation/resolve")
                 .read(height)
                 .read_buffer(visibility)
                 .write(image)
-                .record(move |ctx| this.record_compute_draw(ctx, height, Some(image)));
+                .record(move |ctx| this.record_compute_draw(ctx, height, visibility, Some(image)));
             return image;
         }
         let targets = graph.create_raster_targets("tessellation", FORMAT, Some(DEPTH), samples);
