@@ -118,6 +118,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         None => super::bench_record::FrameRecord::new(cue_steps.unwrap_or(1)),
     };
     let mut edits = fx_steps.map(|every| super::bench_fx::EffectToggle::new(&mut renderer, &args.fx, every));
+    let mut switch_passes = super::bench_switch::SwitchPasses::default();
     let mut last = Instant::now();
     let mut stats = None;
     let mut in_flight = None;
@@ -143,6 +144,10 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
         let now = Instant::now();
         let ms = |from: Instant, to: Instant| (to - from).as_secs_f64() * 1e3;
         record.push(ms(last, now), ms(last, recorded), go.then_some(time.frame));
+        if !args.pipelined {
+            let latest = renderer.runtime().latest_frame_timings();
+            switch_passes.push(i, latest, go.then(|| ms(last, now)));
+        }
         last = now;
         stats = Some(s);
     }
@@ -196,7 +201,7 @@ pub fn bench(assets: &Assets, gpu: &GpuOptions, args: &BenchArgs) -> Result<(), 
     say!("{:<28} {:>9.3} ms", "step + record (CPU median)", record.cpu_median());
     let wall_label = if args.pipelined { "frame interval (median)" } else { "frame wall time (median)" };
     say!("{:<28} {:>9.3} ms  ({:.1} fps)", wall_label, wall_median, 1e3 / wall_median.max(1e-9));
-    for line in record.switch_report() {
+    for line in record.switch_report().into_iter().chain(switch_passes.report()) {
         say!("{line}");
     }
     for line in renderer.instance_mut().bench_reports() {

@@ -19,6 +19,7 @@ mod bake;
 mod bench;
 mod bench_fx;
 mod bench_record;
+mod bench_switch;
 mod chase;
 mod check;
 mod list;

@@ -233,6 +233,13 @@ impl GraphRuntime {
         self.timer.as_ref().map(|t| t.timings()).unwrap_or_default()
     }
 
+    /// The passes of the latest frame whose timestamps were read back, with their GPU
+    /// milliseconds (empty without timestamp support): waiting for a frame, then starting the
+    /// next, reads it.
+    pub fn latest_frame_timings(&self) -> Vec<(String, f64)> {
+        self.timer.as_ref().map(|t| t.latest_frame().to_vec()).unwrap_or_default()
+    }
+
     /// Rolling median of the summed GPU pass time per frame, milliseconds.
     pub fn frame_gpu_median_ms(&self) -> Option<f64> {
         self.timer.as_ref().and_then(|t| t.frame_median_ms())

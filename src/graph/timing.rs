@@ -82,6 +82,8 @@ pub(crate) struct GpuTimer {
     /// Per frame, the first pass's start to the last pass's end: the passes' time and the GPU's
     /// gaps between them.
     frame_span: RollingMedian,
+    /// The passes of the latest frame read back, with their milliseconds.
+    latest: Vec<(String, f64)>,
     current: Option<usize>,
 }
 
@@ -121,6 +123,7 @@ impl GpuTimer {
             medians: BTreeMap::new(),
             frame_total: RollingMedian::new(WINDOW),
             frame_span: RollingMedian::new(WINDOW),
+            latest: Vec::new(),
             current: None,
         }
     }
@@ -192,10 +195,12 @@ impl GpuTimer {
             slot.buffer.unmap();
             slot.busy = false;
             let mut total = 0.0;
+            self.latest.clear();
             for (i, name) in slot.names.iter().enumerate().take(stamps.len() / 2) {
                 let ms = stamps[2 * i + 1].wrapping_sub(stamps[2 * i]) as f64 * self.period_ns / 1e6;
                 total += ms;
                 self.medians.entry(name.clone()).or_insert_with(|| RollingMedian::new(WINDOW)).push(ms);
+                self.latest.push((name.clone(), ms));
             }
             self.frame_total.push(total);
             let passes = stamps.len() / 2;
@@ -214,6 +219,11 @@ impl GpuTimer {
                 m.median().map(|median_ms| PassTiming { name: name.clone(), median_ms, samples: m.len() })
             })
             .collect()
+    }
+
+    /// The passes of the latest frame read back and their milliseconds, in the order they ran.
+    pub fn latest_frame(&self) -> &[(String, f64)] {
+        &self.latest
     }
 
     /// Median of the summed pass times per frame, milliseconds.
