@@ -314,6 +314,12 @@ impl PassContext<'_> {
         self.buffers[buffer.0 as usize].as_ref().map(|b| b.1).unwrap_or(0)
     }
 
+    /// A declared buffer (a shared handle, so the context is free for the encoder) and its id:
+    /// a buffer the graph lends may differ from frame to frame.
+    pub fn buffer_and_id(&self, buffer: BufferHandle) -> (wgpu::Buffer, u64) {
+        (self.buffer(buffer).clone(), self.buffer_id(buffer))
+    }
+
     /// Begins a render pass into `targets` that clears to `clear` and ends resolved into the image.
     pub fn begin_draw(&mut self, targets: &RasterTargets, clear: wgpu::Color) -> wgpu::RenderPass<'_> {
         self.begin_resolved_pass(targets.color, targets.msaa, targets.depth, clear)

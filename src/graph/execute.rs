@@ -237,7 +237,7 @@ impl GraphRuntime {
     /// milliseconds (empty without timestamp support): waiting for a frame, then starting the
     /// next, reads it.
     pub fn latest_frame_timings(&self) -> Vec<(String, f64)> {
-        self.timer.as_ref().map(|t| t.latest_frame().to_vec()).unwrap_or_default()
+        self.timer.as_ref().map(|t| t.latest_frame()).unwrap_or_default()
     }
 
     /// Rolling median of the summed GPU pass time per frame, milliseconds.

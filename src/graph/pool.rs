@@ -20,24 +20,74 @@ pub struct PoolKey {
     pub samples: u32,
 }
 
-struct Entry {
-    key: PoolKey,
-    resolved: ResolvedTexture,
+/// Frames a pooled texture or buffer may sit unused before it is freed (after a resize, say).
+const EVICT_AFTER_FRAMES: u64 = 120;
+
+/// An item of a pool, with its use.
+struct Loan<T> {
+    item: T,
+    /// Lent in this frame and not yet given back.
     in_use: bool,
+    /// The last frame it was lent in.
     last_frame: u64,
 }
 
-/// Frames a pooled texture may sit unused before it is freed (after a resize, say).
-const EVICT_AFTER_FRAMES: u64 = 120;
+/// The lending both pools share: a free item that fits, or a new one; given back once its last
+/// reader has run; dropped after [`EVICT_AFTER_FRAMES`] idle unless the pool holds its items.
+struct Lender<T> {
+    loans: Vec<Loan<T>>,
+    frame: u64,
+    hold: bool,
+}
+
+impl<T> Default for Lender<T> {
+    fn default() -> Self {
+        Self { loans: Vec::new(), frame: 0, hold: false }
+    }
+}
+
+impl<T> Lender<T> {
+    /// Lends a free item that `fits`, or one `make` makes; its index, the item, and whether it
+    /// was made.
+    fn lend(&mut self, fits: impl Fn(&T) -> bool, make: impl FnOnce() -> T) -> (usize, &T, bool) {
+        let found = self.loans.iter().position(|l| !l.in_use && fits(&l.item));
+        let index = found.unwrap_or_else(|| {
+            self.loans.push(Loan { item: make(), in_use: false, last_frame: self.frame });
+            self.loans.len() - 1
+        });
+        let loan = &mut self.loans[index];
+        loan.in_use = true;
+        loan.last_frame = self.frame;
+        (index, &loan.item, found.is_none())
+    }
+
+    fn give_back(&mut self, index: usize) {
+        self.loans[index].in_use = false;
+    }
+
+    /// Ends a frame: everything free, items idle for long dropped unless held.
+    fn end_frame(&mut self) {
+        let now = self.frame;
+        if !self.hold {
+            self.loans.retain(|l| now.saturating_sub(l.last_frame) < EVICT_AFTER_FRAMES);
+        }
+        for loan in &mut self.loans {
+            loan.in_use = false;
+        }
+        self.frame += 1;
+    }
+
+    fn items(&self) -> impl Iterator<Item = &T> {
+        self.loans.iter().map(|l| &l.item)
+    }
+}
 
 /// Owns the GPU textures behind transient graph resources.
 #[derive(Default)]
 pub struct TexturePool {
-    entries: Vec<Entry>,
-    frame: u64,
+    /// Each texture with the key it was made for.
+    lender: Lender<(PoolKey, ResolvedTexture)>,
     created_this_frame: usize,
-    /// Keep idle textures (a show: a clip that comes back finds its textures).
-    hold: bool,
 }
 
 impl TexturePool {
@@ -48,57 +98,34 @@ impl TexturePool {
 
     /// A free texture matching `key` (same size and format, at least the usage), or a new one.
     pub(crate) fn acquire(&mut self, device: &wgpu::Device, key: PoolKey) -> (usize, ResolvedTexture) {
-        let found = self.entries.iter().position(|e| {
-            !e.in_use
-                && e.key.size == key.size
-                && e.key.format == key.format
-                && e.key.layers == key.layers
-                && e.key.samples == key.samples
-                && e.key.usage.contains(key.usage)
-        });
-        let index = found.unwrap_or_else(|| {
-            self.created_this_frame += 1;
-            let texture = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("graph_transient"),
-                size: wgpu::Extent3d {
-                    width: key.size.0,
-                    height: key.size.1,
-                    depth_or_array_layers: key.layers.unwrap_or(1),
-                },
-                mip_level_count: 1,
-                sample_count: key.samples,
-                dimension: wgpu::TextureDimension::D2,
-                format: key.format,
-                usage: key.usage,
-                view_formats: &[],
-            });
-            let dimension = key.layers.map(|_| wgpu::TextureViewDimension::D2Array);
-            let view = texture.create_view(&wgpu::TextureViewDescriptor { dimension, ..Default::default() });
-            let resolved = ResolvedTexture { texture, view, id: next_resource_id() };
-            self.entries.push(Entry { key, resolved, in_use: false, last_frame: self.frame });
-            self.entries.len() - 1
-        });
-        let entry = &mut self.entries[index];
-        entry.in_use = true;
-        entry.last_frame = self.frame;
-        (index, entry.resolved.clone())
+        let fits = |(k, _): &(PoolKey, ResolvedTexture)| {
+            k.size == key.size
+                && k.format == key.format
+                && k.layers == key.layers
+                && k.samples == key.samples
+                && k.usage.contains(key.usage)
+        };
+        let (index, (_, resolved), made) = self.lender.lend(fits, || (key, create_texture(device, key)));
+        let resolved = resolved.clone();
+        self.created_this_frame += usize::from(made);
+        (index, resolved)
     }
 
     /// Returns a texture for later passes of this frame (its last reader has run).
     pub(crate) fn release(&mut self, index: usize) {
-        self.entries[index].in_use = false;
+        self.lender.give_back(index);
     }
 
     /// Ends a frame: everything becomes free; textures idle for long are dropped.
     pub(crate) fn end_frame(&mut self) {
-        end_frame(&mut self.entries, &mut self.frame, self.hold);
+        self.lender.end_frame();
         self.created_this_frame = 0;
     }
 
     /// Whether idle textures stay (`true`: a show, whose clips come and go) or are dropped after
     /// two seconds unused (a scene: after a resize, the old sizes go).
     pub fn set_hold(&mut self, hold: bool) {
-        self.hold = hold;
+        self.lender.hold = hold;
     }
 
     /// Textures created during the current frame (0 in a steady state).
@@ -108,122 +135,83 @@ impl TexturePool {
 
     /// Textures the pool holds.
     pub fn len(&self) -> usize {
-        self.entries.len()
+        self.lender.loans.len()
     }
 
     /// Whether the pool holds no texture.
     pub fn is_empty(&self) -> bool {
-        self.entries.is_empty()
+        self.lender.loans.is_empty()
     }
 
     /// Bytes of all pooled textures.
     pub fn bytes(&self) -> u64 {
-        self.entries
-            .iter()
-            .map(|e| {
-                texture_bytes(e.key.size, e.key.format)
-                    * u64::from(e.key.layers.unwrap_or(1))
-                    * u64::from(e.key.samples)
-            })
+        self.lender
+            .items()
+            .map(|(k, _)| texture_bytes(k.size, k.format) * u64::from(k.layers.unwrap_or(1)) * u64::from(k.samples))
             .sum()
     }
 }
 
-struct PooledBuffer {
-    size: u64,
-    buffer: wgpu::Buffer,
-    id: u64,
-    in_use: bool,
-    last_frame: u64,
+/// A texture and its view for `key`.
+fn create_texture(device: &wgpu::Device, key: PoolKey) -> ResolvedTexture {
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("graph_transient"),
+        size: wgpu::Extent3d { width: key.size.0, height: key.size.1, depth_or_array_layers: key.layers.unwrap_or(1) },
+        mip_level_count: 1,
+        sample_count: key.samples,
+        dimension: wgpu::TextureDimension::D2,
+        format: key.format,
+        usage: key.usage,
+        view_formats: &[],
+    });
+    let dimension = key.layers.map(|_| wgpu::TextureViewDimension::D2Array);
+    let view = texture.create_view(&wgpu::TextureViewDescriptor { dimension, ..Default::default() });
+    ResolvedTexture { texture, view, id: next_resource_id() }
 }
 
 /// Owns the GPU buffers behind transient graph buffers (the compute draws' visibility buffers,
-/// scratch), kept and dropped as the texture pool keeps its textures.
+/// scratch), lent as the texture pool lends its textures.
 #[derive(Default)]
 pub struct BufferPool {
-    entries: Vec<PooledBuffer>,
-    frame: u64,
-    hold: bool,
+    /// Each buffer with its id.
+    lender: Lender<(wgpu::Buffer, u64)>,
 }
 
 impl BufferPool {
     /// A free buffer of exactly `size` bytes, or a new one; its index and id.
     pub(crate) fn acquire(&mut self, device: &wgpu::Device, size: u64) -> (usize, wgpu::Buffer, u64) {
-        let index = self.entries.iter().position(|e| !e.in_use && e.size == size).unwrap_or_else(|| {
+        let make = || {
             let buffer = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("graph_transient_buffer"),
                 size,
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
-            let id = next_resource_id();
-            self.entries.push(PooledBuffer { size, buffer, id, in_use: false, last_frame: self.frame });
-            self.entries.len() - 1
-        });
-        let entry = &mut self.entries[index];
-        entry.in_use = true;
-        entry.last_frame = self.frame;
-        (index, entry.buffer.clone(), entry.id)
+            (buffer, next_resource_id())
+        };
+        let (index, (buffer, id), _) = self.lender.lend(|(b, _)| b.size() == size, make);
+        (index, buffer.clone(), *id)
     }
 
     /// Returns a buffer for later passes of this frame (its last reader has run).
     pub(crate) fn release(&mut self, index: usize) {
-        self.entries[index].in_use = false;
+        self.lender.give_back(index);
     }
 
     /// Ends a frame as [`TexturePool::end_frame`] does.
     pub(crate) fn end_frame(&mut self) {
-        end_frame(&mut self.entries, &mut self.frame, self.hold);
+        self.lender.end_frame();
     }
 
     /// Whether idle buffers stay, as [`TexturePool::set_hold`].
     pub fn set_hold(&mut self, hold: bool) {
-        self.hold = hold;
+        self.lender.hold = hold;
     }
 
     /// Bytes of all pooled buffers.
     pub fn bytes(&self) -> u64 {
-        self.entries.iter().map(|e| e.size).sum()
+        self.lender.items().map(|(b, _)| b.size()).sum()
     }
-}
-
-/// What a pool's entry tells of its use.
-trait Lendable {
-    /// The last frame it was lent in.
-    fn last_frame(&self) -> u64;
-    /// Makes it free for the next frame.
-    fn free(&mut self);
-}
-
-impl Lendable for Entry {
-    fn last_frame(&self) -> u64 {
-        self.last_frame
-    }
-
-    fn free(&mut self) {
-        self.in_use = false;
-    }
-}
-
-impl Lendable for PooledBuffer {
-    fn last_frame(&self) -> u64 {
-        self.last_frame
-    }
-
-    fn free(&mut self) {
-        self.in_use = false;
-    }
-}
-
-/// Ends a pool's `frame`: every entry free, those idle for [`EVICT_AFTER_FRAMES`] dropped unless
-/// the pool `hold`s them.
-fn end_frame<E: Lendable>(entries: &mut Vec<E>, frame: &mut u64, hold: bool) {
-    if !hold {
-        let now = *frame;
-        entries.retain(|e| now.saturating_sub(e.last_frame()) < EVICT_AFTER_FRAMES);
-    }
-    entries.iter_mut().for_each(Lendable::free);
-    *frame += 1;
 }
 
 /// Bytes a single-mip 2-D texture occupies.

@@ -82,8 +82,10 @@ pub(crate) struct GpuTimer {
     /// Per frame, the first pass's start to the last pass's end: the passes' time and the GPU's
     /// gaps between them.
     frame_span: RollingMedian,
-    /// The passes of the latest frame read back, with their milliseconds.
-    latest: Vec<(String, f64)>,
+    /// The slot of the latest frame read back (its names stay until it is reused), and its
+    /// passes' milliseconds: kept without copying names, as every frame reads one back.
+    latest: Option<usize>,
+    latest_ms: Vec<f64>,
     current: Option<usize>,
 }
 
@@ -123,7 +125,8 @@ impl GpuTimer {
             medians: BTreeMap::new(),
             frame_total: RollingMedian::new(WINDOW),
             frame_span: RollingMedian::new(WINDOW),
-            latest: Vec::new(),
+            latest: None,
+            latest_ms: Vec::new(),
             current: None,
         }
     }
@@ -135,6 +138,9 @@ impl GpuTimer {
         self.current = free.then_some(self.next);
         if let Some(s) = self.current {
             self.slots[s].names.clear();
+            if self.latest == Some(s) {
+                self.latest = None;
+            }
         }
         free
     }
@@ -183,7 +189,7 @@ impl GpuTimer {
 
     /// Reads every slot whose mapping has completed.
     fn collect(&mut self) {
-        for slot in &mut self.slots {
+        for (index, slot) in self.slots.iter_mut().enumerate() {
             if !slot.busy || !slot.ready.load(Ordering::Acquire) {
                 continue;
             }
@@ -195,12 +201,13 @@ impl GpuTimer {
             slot.buffer.unmap();
             slot.busy = false;
             let mut total = 0.0;
-            self.latest.clear();
+            self.latest = Some(index);
+            self.latest_ms.clear();
             for (i, name) in slot.names.iter().enumerate().take(stamps.len() / 2) {
                 let ms = stamps[2 * i + 1].wrapping_sub(stamps[2 * i]) as f64 * self.period_ns / 1e6;
                 total += ms;
                 self.medians.entry(name.clone()).or_insert_with(|| RollingMedian::new(WINDOW)).push(ms);
-                self.latest.push((name.clone(), ms));
+                self.latest_ms.push(ms);
             }
             self.frame_total.push(total);
             let passes = stamps.len() / 2;
@@ -222,8 +229,9 @@ impl GpuTimer {
     }
 
     /// The passes of the latest frame read back and their milliseconds, in the order they ran.
-    pub fn latest_frame(&self) -> &[(String, f64)] {
-        &self.latest
+    pub fn latest_frame(&self) -> Vec<(String, f64)> {
+        let Some(slot) = self.latest else { return Vec::new() };
+        self.slots[slot].names.iter().cloned().zip(self.latest_ms.iter().copied()).collect()
     }
 
     /// Median of the summed pass times per frame, milliseconds.

@@ -140,8 +140,9 @@ impl SplatDraw {
     /// frame. False when the buffer would exceed the device's limits (the caller draws with the
     /// pipeline).
     pub fn prepare(&mut self, size: (u32, u32), samples: u32, count: u32, primitives_made: bool) -> bool {
-        let Some(visibility) = VisibilityBuffer::fitting(&self.device, size, samples) else { return false };
-        self.visibility = Some(visibility);
+        if !VisibilityBuffer::ensure(&mut self.visibility, &self.device, size, samples) {
+            return false;
+        }
         let mut made = false;
         if self.big_queue.as_ref().is_none_or(|(capacity, _)| *capacity < count) {
             // Room to grow into, so that a growing set does not make a queue every frame.

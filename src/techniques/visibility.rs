@@ -3,7 +3,7 @@
 //! order, then shaded per pixel: the store of the compute draws (tessellation, space colonization,
 //! Poisson).
 
-use crate::graph::{BufferHandle, FrameGraph, PassContext};
+use crate::graph::{BufferHandle, FrameGraph};
 
 /// The visibility buffer a compute draw needs for one image size and sample count. The frame
 /// graph lends it each frame from its pool of buffers, so nodes that draw one after another share
@@ -17,18 +17,20 @@ pub struct VisibilityBuffer {
 }
 
 impl VisibilityBuffer {
-    /// The buffer for `size` × `samples`, or `None` when it would exceed the device's buffer
-    /// limits (the caller draws with the pipeline then).
-    pub fn fitting(device: &wgpu::Device, size: (u32, u32), samples: u32) -> Option<Self> {
+    /// Keeps `slot` for `size` × `samples` (checked against the device's buffer limits only
+    /// when those change); false, and `slot` emptied, when the buffer would exceed them (the
+    /// caller draws with the pipeline then).
+    pub fn ensure(slot: &mut Option<Self>, device: &wgpu::Device, size: (u32, u32), samples: u32) -> bool {
+        let key = (size.0, size.1, samples);
+        if slot.is_some_and(|v| v.key == key) {
+            return true;
+        }
         let limits = device.limits();
-        let bytes = Self::bytes_for(size, samples);
-        (bytes <= limits.max_storage_buffer_binding_size.min(limits.max_buffer_size))
-            .then_some(Self { key: (size.0, size.1, samples), bytes: bytes.max(8) })
-    }
-
-    /// Bytes of the buffer for `size` × `samples`: one 64-bit word per sample.
-    pub fn bytes_for(size: (u32, u32), samples: u32) -> u64 {
-        u64::from(size.0) * u64::from(size.1) * u64::from(samples.max(1)) * 8
+        // One 64-bit word per sample.
+        let bytes = u64::from(size.0) * u64::from(size.1) * u64::from(samples.max(1)) * 8;
+        let fits = bytes <= limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        *slot = fits.then_some(Self { key, bytes: bytes.max(8) });
+        fits
     }
 
     /// Declares this frame's buffer in `graph` as `name`.
@@ -40,11 +42,6 @@ impl VisibilityBuffer {
     pub fn key(&self) -> (u32, u32, u32) {
         self.key
     }
-}
-
-/// The buffer the graph lent as `handle` in this pass, and its id (for caching bind groups).
-pub fn lent(ctx: &PassContext<'_>, handle: BufferHandle) -> (wgpu::Buffer, u64) {
-    (ctx.buffer(handle).clone(), ctx.buffer_id(handle))
 }
 
 /// The rays of a perspective camera at `eye` seen through `view_proj` over a `size` image: the

@@ -24,7 +24,6 @@ use crate::params::ParamSet;
 use crate::time::{FrameTime, MAX_CATCH_UP_STEPS};
 
 use super::splat_draw::SplatUniforms;
-use super::visibility::lent;
 use super::{NodeSetup, Technique, TechniqueInfo};
 
 /// The registry entry.
@@ -261,7 +260,7 @@ impl Technique for Cloth {
             let group = &state.draw_groups[&state.cur];
             graph.add_pass("cloth/raster").read_buffer(cur).read_buffer(normals).write_buffer(visibility).record(
                 move |ctx| {
-                    let lent = lent(ctx, visibility);
+                    let lent = ctx.buffer_and_id(visibility);
                     compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &splat, group, None, &lent);
                 },
             );
@@ -274,7 +273,7 @@ impl Technique for Cloth {
                 .record(move |ctx| {
                     // Views are shared handles: a clone frees the context for the encoder.
                     let (image_view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
-                    let lent = lent(ctx, visibility);
+                    let lent = ctx.buffer_and_id(visibility);
                     compute.borrow_mut().record_resolve(ctx.encoder, group, None, &lent, (&image_view, id));
                 });
             return image;

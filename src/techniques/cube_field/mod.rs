@@ -20,7 +20,7 @@ use std::cell::RefCell;
 pub use particles::{CubeInstance, MAX_CUBES, cubes_at};
 
 use super::splat_draw::{self, SplatDraw, SplatUniforms};
-use super::visibility::{PixelRays, lent};
+use super::visibility::PixelRays;
 use super::{NodeSetup, Rasterizer, Technique, TechniqueInfo, srgb_to_linear};
 
 /// The registry entry.
@@ -243,13 +243,13 @@ impl CubeField {
         graph.add_pass("cube_field/raster").write_buffer(visibility).record(move |ctx| {
             ctx.queue.write_buffer(&self.block.buffer, 0, bytemuck::bytes_of(&uniforms));
             ctx.queue.write_buffer(&self.instances, 0, bytemuck::cast_slice(&self.scratch));
-            let lent = lent(ctx, visibility);
+            let lent = ctx.buffer_and_id(visibility);
             compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &splat, view, Some(&self.instances), &lent);
         });
         graph.add_pass("cube_field/resolve").read_buffer(visibility).write(image).record(move |ctx| {
             // Views are shared handles: a clone frees the context for the encoder.
             let (image_view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
-            let lent = lent(ctx, visibility);
+            let lent = ctx.buffer_and_id(visibility);
             compute.borrow_mut().record_resolve(ctx.encoder, view, Some(&self.instances), &lent, (&image_view, id));
         });
         image

@@ -19,7 +19,6 @@ mod sampler;
 use sampler::Sampler;
 
 use super::splat_draw::{self, SplatDraw, SplatUniforms};
-use super::visibility::lent;
 use super::{NodeSetup, Rasterizer, Technique, TechniqueInfo};
 
 /// The registry entry.
@@ -406,14 +405,14 @@ impl Poisson {
         let raster = SplatUniforms::new(graph.output_size(), count, uniforms.samples, [0.0, 0.0, 0.0, 1.0]);
         graph.add_pass("poisson/raster").write_buffer(visibility).record(move |ctx| {
             this.upload(ctx.queue, &uniforms, first_new);
-            let lent = lent(ctx, visibility);
+            let lent = ctx.buffer_and_id(visibility);
             let instances = Some(this.instances.buffer());
             compute.borrow_mut().record_raster(ctx.encoder, ctx.queue, &raster, view, instances, &lent);
         });
         graph.add_pass("poisson/resolve").read_buffer(visibility).write(image).record(move |ctx| {
             // Views are shared handles: a clone frees the context for the encoder.
             let (image_view, id) = (ctx.view(image).clone(), ctx.texture_id(image));
-            let lent = lent(ctx, visibility);
+            let lent = ctx.buffer_and_id(visibility);
             let instances = Some(this.instances.buffer());
             compute.borrow_mut().record_resolve(ctx.encoder, view, instances, &lent, (&image_view, id));
         });

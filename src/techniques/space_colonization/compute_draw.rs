@@ -9,7 +9,7 @@ use crate::gpu::{
     BindGroupCache, ComputeKernel, JoinedSource, ShaderError, buffer_entry as entry, storage_entry as storage,
 };
 use crate::graph::{BufferHandle, FrameGraph, PassContext};
-use crate::techniques::visibility::{PixelRays, VisibilityBuffer, lent};
+use crate::techniques::visibility::{PixelRays, VisibilityBuffer};
 
 use super::FORMAT;
 
@@ -125,7 +125,10 @@ pub struct Lent<B> {
 impl Lent<BufferHandle> {
     /// The buffers behind the handles in a pass.
     pub fn in_pass(&self, ctx: &PassContext<'_>) -> Lent<(wgpu::Buffer, u64)> {
-        Lent { visibility: lent(ctx, self.visibility), glow_sum: self.glow_sum.map(|sums| lent(ctx, sums)) }
+        Lent {
+            visibility: ctx.buffer_and_id(self.visibility),
+            glow_sum: self.glow_sum.map(|sums| ctx.buffer_and_id(sums)),
+        }
     }
 }
 
@@ -242,9 +245,9 @@ impl ComputeDraw {
     /// Readies the visibility buffer for `u`'s size and samples and writes the uniforms; false
     /// when the buffer would exceed the device's limits (the caller draws with the pipeline).
     pub fn prepare(&mut self, queue: &wgpu::Queue, u: &RasterUniforms) -> bool {
-        let size = (u.width, u.height);
-        let Some(visibility) = VisibilityBuffer::fitting(&self.device, size, u.samples) else { return false };
-        self.visibility = Some(visibility);
+        if !VisibilityBuffer::ensure(&mut self.visibility, &self.device, (u.width, u.height), u.samples) {
+            return false;
+        }
         if self.big_queue.as_ref().is_none_or(|(capacity, _)| *capacity < u.capacity) {
             let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("sc_big_queue"),

@@ -221,7 +221,7 @@ impl Renderer {
     /// Records the compute draw's coverage of every grown edge.
     pub fn record_compute_raster(&self, ctx: &mut PassContext<'_>, state: &GrowthState, lent: Lent<BufferHandle>) {
         let Some((mut compute, group)) = self.compute_and_group(state) else { return };
-        let (visibility, id) = crate::techniques::visibility::lent(ctx, lent.visibility);
+        let (visibility, id) = ctx.buffer_and_id(lent.visibility);
         compute.record_raster(ctx.encoder, group, (&state.args.buffer, state.args.id), (&visibility, id));
     }
 

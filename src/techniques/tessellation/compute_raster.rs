@@ -151,8 +151,9 @@ impl ComputeRaster {
     /// writes the uniforms; false when the visibility buffer would exceed the device's limits
     /// (the caller draws with the pipeline then).
     pub fn prepare(&mut self, queue: &wgpu::Queue, size: (u32, u32), samples: u32, grid: u32) -> bool {
-        let Some(visibility) = VisibilityBuffer::fitting(&self.device, size, samples) else { return false };
-        self.visibility = Some(visibility);
+        if !VisibilityBuffer::ensure(&mut self.visibility, &self.device, size, samples) {
+            return false;
+        }
         let limits = self.device.limits();
         let largest = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
         if self.corners.as_ref().is_none_or(|c| c.grid != grid) {

@@ -32,7 +32,6 @@ use crate::graph::{BufferHandle, FrameGraph, PassBuilder, PassContext, RasterTar
 use crate::params::ParamSet;
 use crate::time::FrameTime;
 
-use super::visibility::lent;
 use super::{NodeSetup, Technique, TechniqueInfo};
 use compute_raster::{ComputeRaster, DrawBindings};
 
@@ -341,7 +340,7 @@ impl Tessellation {
         let (b, Some(raster)) = (&self.buffers, &self.compute_raster) else { return };
         let mesh = self.draw_group(ctx, height, b);
         let bindings = DrawBindings { uniforms: &self.uniform_group, mesh: &mesh, args: &b.args.0 };
-        let lent = lent(ctx, visibility);
+        let lent = ctx.buffer_and_id(visibility);
         match image {
             None => raster.borrow_mut().record_raster(ctx.encoder, &bindings, &lent),
             Some(image) => {
